@@ -1,0 +1,209 @@
+/*
+ * filter.c - median, uniform (moving average) and weighted (correlate)
+ * filters along one axis of (outer, n, inner) arrays; see mtcore.h.
+ *
+ * The driver cuts each line into chunks of output frames.  For a chunk it
+ * builds a table with one pointer per input row that the chunk's windows
+ * read: rows before the line (filling phase) and after it (draining phase)
+ * are mapped by the edge mode, interior rows (steady state) point straight
+ * into the array.  A kernel then computes the chunk's output rows from that
+ * table, its inner loop running over the contiguous channels of a row, so
+ * that it vectorises and never tests for edges.
+ *
+ * When the filtered axis is (nearly) the last one, rows are only a few
+ * values wide; the driver then gathers TILE_LINES lines side by side into a
+ * small tile, so that they become the channels, and scatters the results back.
+ */
+#include "mtcore.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum {
+    MIN_CHUNK = 256,       /* output frames per chunk, at least */
+    TILE_LINES = 16,       /* lines gathered into a tile when inner is small */
+    CHANNEL_BLOCK = 256,   /* channels per kernel call on the direct path */
+    SORTED_BUDGET = 1 << 20 /* elements of sorted windows kept at once */
+};
+
+#if defined(__clang__)
+#define MT_IVDEP _Pragma("clang loop vectorize(assume_safety)")
+#elif defined(__GNUC__)
+#define MT_IVDEP _Pragma("GCC ivdep")
+#else
+#define MT_IVDEP
+#endif
+
+/* Index into 0..n-1 of position r of the extended line, or -1 for the fill value. */
+static ptrdiff_t extend_index(ptrdiff_t r, ptrdiff_t n, int mode)
+{
+    if (r >= 0 && r < n)
+        return r;
+    switch (mode) {
+    case MT_MODE_NEAREST:
+        return r < 0 ? 0 : n - 1;
+    case MT_MODE_WRAP: {
+        ptrdiff_t m = r % n;
+        return m < 0 ? m + n : m;
+    }
+    case MT_MODE_REFLECT: {
+        ptrdiff_t period = 2 * n, m = r % period;
+        if (m < 0)
+            m += period;
+        return m < n ? m : period - 1 - m;
+    }
+    case MT_MODE_MIRROR: {
+        if (n == 1)
+            return 0;
+        ptrdiff_t period = 2 * n - 2, m = r % period;
+        if (m < 0)
+            m += period;
+        return m < n ? m : period - m;
+    }
+    default:
+        return -1;
+    }
+}
+
+/* Median sizes with a fixed selection network (Paeth; Devillard 1998). */
+static int has_network(size_t size)
+{
+    return size == 1 || size == 3 || size == 5 || size == 7 || size == 9;
+}
+
+struct job {
+    int filter, mode;
+    size_t outer, n, inner, size;
+    ptrdiff_t lead; /* output frame t reads input frames t - lead .. t - lead + size - 1 */
+    double cval;
+    const double *weights;
+    const void *in;
+    void *out;
+};
+
+#define MT_CAT_(a, b) a##_##b
+#define MT_CAT(a, b) MT_CAT_(a, b)
+#define FN(name) MT_CAT(name, SUFFIX)
+#define MIN(a, b) ((a) < (b) ? (a) : (b))
+
+/* Orders a pair in place; min/max form, so that it compiles to branchless vector code. */
+#define SORT2(a, b)                                                                                \
+    do {                                                                                           \
+        T lo_ = (a) < (b) ? (a) : (b);                                                             \
+        (b) = (a) < (b) ? (b) : (a);                                                               \
+        (a) = lo_;                                                                                 \
+    } while (0)
+
+/*
+ * A kernel for the median of N using the selection network NETWORK on p[0..N-1],
+ * which leaves the median in p[N/2].  Min/max order NaN arbitrarily, so windows
+ * holding NaN are flagged separately and give NaN.
+ */
+#define NETWORK_KERNEL(N, NETWORK)                                                                 \
+    static void FN(median##N)(const T *const *rows, T *out, size_t ostride, size_t m, size_t nch)  \
+    {                                                                                              \
+        for (size_t t = 0; t < m; t++) {                                                           \
+            const T *r[N];                                                                         \
+            for (int j = 0; j < N; j++)                                                            \
+                r[j] = rows[t + j];                                                                \
+            T *o = out + t * ostride;                                                              \
+            MT_IVDEP for (size_t k = 0; k < nch; k++)                                              \
+            {                                                                                      \
+                T p[N];                                                                            \
+                int nan = 0;                                                                       \
+                for (int j = 0; j < N; j++) {                                                      \
+                    p[j] = r[j][k];                                                                \
+                    nan |= p[j] != p[j];                                                           \
+                }                                                                                  \
+                NETWORK;                                                                           \
+                o[k] = nan ? (T)NAN : p[N / 2];                                                    \
+            }                                                                                      \
+        }                                                                                          \
+    }
+
+#define NETWORK1 (void)0
+#define NETWORK3                                                                                   \
+    SORT2(p[0], p[1]);                                                                             \
+    SORT2(p[1], p[2]);                                                                             \
+    SORT2(p[0], p[1])
+#define NETWORK5                                                                                   \
+    SORT2(p[0], p[1]);                                                                             \
+    SORT2(p[3], p[4]);                                                                             \
+    SORT2(p[0], p[3]);                                                                             \
+    SORT2(p[1], p[4]);                                                                             \
+    SORT2(p[1], p[2]);                                                                             \
+    SORT2(p[2], p[3]);                                                                             \
+    SORT2(p[1], p[2])
+#define NETWORK7                                                                                   \
+    SORT2(p[0], p[5]);                                                                             \
+    SORT2(p[0], p[3]);                                                                             \
+    SORT2(p[1], p[6]);                                                                             \
+    SORT2(p[2], p[4]);                                                                             \
+    SORT2(p[0], p[1]);                                                                             \
+    SORT2(p[3], p[5]);                                                                             \
+    SORT2(p[2], p[6]);                                                                             \
+    SORT2(p[2], p[3]);                                                                             \
+    SORT2(p[3], p[6]);                                                                             \
+    SORT2(p[4], p[5]);                                                                             \
+    SORT2(p[1], p[4]);                                                                             \
+    SORT2(p[1], p[3]);                                                                             \
+    SORT2(p[3], p[4])
+#define NETWORK9                                                                                   \
+    SORT2(p[1], p[2]);                                                                             \
+    SORT2(p[4], p[5]);                                                                             \
+    SORT2(p[7], p[8]);                                                                             \
+    SORT2(p[0], p[1]);                                                                             \
+    SORT2(p[3], p[4]);                                                                             \
+    SORT2(p[6], p[7]);                                                                             \
+    SORT2(p[1], p[2]);                                                                             \
+    SORT2(p[4], p[5]);                                                                             \
+    SORT2(p[7], p[8]);                                                                             \
+    SORT2(p[0], p[3]);                                                                             \
+    SORT2(p[5], p[8]);                                                                             \
+    SORT2(p[4], p[7]);                                                                             \
+    SORT2(p[3], p[6]);                                                                             \
+    SORT2(p[1], p[4]);                                                                             \
+    SORT2(p[2], p[5]);                                                                             \
+    SORT2(p[4], p[7]);                                                                             \
+    SORT2(p[4], p[2]);                                                                             \
+    SORT2(p[6], p[4]);                                                                             \
+    SORT2(p[4], p[2])
+
+#define T double
+#define SUFFIX f64
+#include "filter_kernels.inc"
+#undef T
+#undef SUFFIX
+
+#define T float
+#define SUFFIX f32
+#include "filter_kernels.inc"
+#undef T
+#undef SUFFIX
+
+int mt_filter1d(int filter, int dtype, const void *in, void *out, size_t outer, size_t n,
+                size_t inner, size_t size, ptrdiff_t origin, int mode, double cval,
+                const double *weights)
+{
+    if (filter < MT_FILTER_MEDIAN || filter > MT_FILTER_CORRELATE)
+        return MT_EINVAL;
+    if (dtype != MT_FLOAT32 && dtype != MT_FLOAT64)
+        return MT_EDTYPE;
+    if (mode < MT_MODE_REFLECT || mode > MT_MODE_WRAP || size < 1 || size > PTRDIFF_MAX / 4)
+        return MT_EINVAL;
+    ptrdiff_t half = (ptrdiff_t)(size / 2);
+    if (origin < -half || origin > (ptrdiff_t)((size - 1) / 2))
+        return MT_EINVAL;
+    if (filter == MT_FILTER_CORRELATE && weights == NULL)
+        return MT_EINVAL;
+    if (outer == 0 || n == 0 || inner == 0)
+        return MT_OK;
+    if (in == NULL || out == NULL || n > PTRDIFF_MAX / 4 || inner > SIZE_MAX / n ||
+        outer > SIZE_MAX / (n * inner))
+        return MT_EINVAL;
+
+    struct job job = {filter, mode, outer, n, inner, size, half + origin, cval, weights, in, out};
+    return dtype == MT_FLOAT64 ? filter1d_f64(&job) : filter1d_f32(&job);
+}

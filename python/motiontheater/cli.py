@@ -1,0 +1,93 @@
+"""The ``motiontheater`` command line."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections.abc import Sequence
+
+import numpy as np
+
+import mtcore
+
+from . import __version__
+from .examples import noisy_rotations
+
+_FILTERS = {
+    "median": mtcore.median_filter1d,
+    "mean": mtcore.uniform_filter1d,
+    "binomial": mtcore.binomial_filter1d,
+}
+
+
+def _demo(args: argparse.Namespace) -> int:
+    clean, noisy = noisy_rotations(seconds=args.seconds, seed=args.seed)
+    frames, channels = noisy.shape
+    print(
+        f"Synthetic capture: {frames} frames at 120 Hz x {channels} rotation channels (degrees),\n"
+        f"Gaussian jitter of 1.5 deg and single-frame spikes of 20-40 deg on 0.5% of samples.\n"
+        f"Filters of size {args.size} along the frames, edge mode 'nearest'.\n"
+    )
+    rows = [("unfiltered", noisy, 0.0)]
+    for name, fn in _FILTERS.items():
+        start = time.perf_counter()
+        out = fn(noisy, args.size, axis=0, mode="nearest")
+        rows.append((name, out, time.perf_counter() - start))
+    start = time.perf_counter()
+    chained = mtcore.binomial_filter1d(
+        mtcore.median_filter1d(noisy, args.size, axis=0, mode="nearest"), args.size, axis=0, mode="nearest"
+    )
+    rows.append(("median, then binomial", chained, time.perf_counter() - start))
+
+    print("| filter | RMS error (deg) | max error (deg) | samples off by > 5 deg | time |")
+    print("|---|---:|---:|---:|---:|")
+    for name, values, seconds in rows:
+        err = np.abs(values - clean)
+        rms = float(np.sqrt(np.mean(err**2)))
+        timing = f"{seconds * 1e6:.0f} us" if seconds else "-"
+        print(f"| {name} | {rms:.3f} | {float(err.max()):.2f} | {int((err > 5).sum())} | {timing} |")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="motiontheater",
+        description=(
+            "Clean, cut, splice and smooth motion-capture data. "
+            "Run 'motiontheater demo' to smooth a built-in noisy 120 Hz capture."
+        ),
+    )
+    parser.add_argument("--version", action="version", version=f"motiontheater {__version__}")
+    verbs = parser.add_subparsers(dest="verb", metavar="<verb>")
+    demo = verbs.add_parser(
+        "demo",
+        help="smooth a built-in noisy synthetic 120 Hz capture and compare the filters",
+        description=(
+            "Make a synthetic 120 Hz capture (90 rotation channels, the thesis's scene), add "
+            "jitter and marker-pop spikes, smooth it with each filter and print how close each "
+            "result comes to the clean motion."
+        ),
+    )
+    demo.add_argument("--size", type=int, default=5, help="filter window in frames (default 5)")
+    demo.add_argument("--seconds", type=float, default=10.0, help="length of the capture (default 10)")
+    demo.add_argument("--seed", type=int, default=0, help="random seed of the synthetic data")
+    demo.set_defaults(run=_demo)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.verb is None:
+        parser.print_help()
+        return 0
+    try:
+        return args.run(args)
+    except (ValueError, TypeError) as exc:
+        print(f"motiontheater {args.verb}: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,221 @@
+"""One-dimensional smoothing filters with the signatures of scipy.ndimage.
+
+Each filter runs along one axis of an n-d array, in C.  float32 and float64
+are computed natively (float32 stays float32; means are accumulated in
+double); float16 is computed in float32; bool and integer input in float64,
+the result cast to the output type as scipy does (truncation toward zero).
+The input is never modified.  ``output`` may be an array of the input's shape
+(any dtype, any layout, even the input itself) or a dtype.
+
+Edge modes, for the line ``a b c d`` and fill value ``k = cval``:
+
+====================  ===========================
+``reflect``           ``d c b a | a b c d | d c b a``
+``nearest``           ``a a a a | a b c d | d d d d``
+``mirror``            ``  d c b | a b c d | c b a``
+``constant``          ``k k k k | a b c d | k k k k``
+``wrap``              ``a b c d | a b c d | a b c d``
+====================  ===========================
+
+An extension longer than the line repeats the pattern; scipy's aliases
+``grid-mirror``, ``grid-constant`` and ``grid-wrap`` are accepted.  Output
+sample ``i`` reads input samples ``i + j - size // 2 - origin`` for
+``j = 0 .. size - 1``.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import operator
+
+import numpy as np
+from numpy.typing import ArrayLike, DTypeLike
+
+from ._mtcore import ffi, lib
+from ._status import check
+
+__all__ = ["median_filter1d", "uniform_filter1d", "binomial_filter1d", "pascal_weights", "MODES"]
+
+MODES = {
+    "reflect": lib.MT_MODE_REFLECT,
+    "grid-mirror": lib.MT_MODE_REFLECT,
+    "nearest": lib.MT_MODE_NEAREST,
+    "mirror": lib.MT_MODE_MIRROR,
+    "constant": lib.MT_MODE_CONSTANT,
+    "grid-constant": lib.MT_MODE_CONSTANT,
+    "wrap": lib.MT_MODE_WRAP,
+    "grid-wrap": lib.MT_MODE_WRAP,
+}
+
+_NATIVE = {np.dtype(np.float64): lib.MT_FLOAT64, np.dtype(np.float32): lib.MT_FLOAT32}
+_F32, _F64 = np.dtype(np.float32), np.dtype(np.float64)
+
+
+@functools.lru_cache(maxsize=64)
+def _pascal(size: int) -> np.ndarray:
+    n = size - 1
+    # Python integers are exact, and int / int rounds correctly even for huge rows.
+    w = np.array([math.comb(n, k) / 2**n for k in range(size)])
+    w.flags.writeable = False
+    return w
+
+
+def pascal_weights(size: int) -> np.ndarray:
+    """Row ``size - 1`` of Pascal's triangle divided by its sum ``2**(size - 1)``.
+
+    size 3: ``[1, 2, 1] / 4``; size 5: ``[1, 4, 6, 4, 1] / 16``.  Every weight
+    is the correctly rounded float64 of the exact fraction.  Returns a new
+    float64 array of length ``size``.
+    """
+    return _pascal(_check_size(size)).copy()
+
+
+def median_filter1d(
+    input: ArrayLike,
+    size: int,
+    axis: int = -1,
+    output: np.ndarray | DTypeLike | None = None,
+    mode: str = "reflect",
+    cval: float = 0.0,
+    origin: int = 0,
+) -> np.ndarray:
+    """Moving median of ``size`` samples along ``axis``.
+
+    Gives the same result as ``scipy.ndimage.median_filter(input, size=size,
+    axes=(axis,), mode=mode, cval=cval, origin=origin)``: for an even size the
+    upper of the two middle values (rank ``size // 2``), never an average, so
+    the median never invents values.  A window that contains NaN gives NaN
+    (scipy's result is undefined there).
+    """
+    return _filter1d(lib.MT_FILTER_MEDIAN, input, size, axis, output, mode, cval, origin)
+
+
+def uniform_filter1d(
+    input: ArrayLike,
+    size: int,
+    axis: int = -1,
+    output: np.ndarray | DTypeLike | None = None,
+    mode: str = "reflect",
+    cval: float = 0.0,
+    origin: int = 0,
+) -> np.ndarray:
+    """Moving average of ``size`` samples along ``axis``.
+
+    The same result as ``scipy.ndimage.uniform_filter1d`` (to rounding: a
+    running sum in double, restarted every few hundred samples so that long
+    lines do not drift).
+    """
+    return _filter1d(lib.MT_FILTER_UNIFORM, input, size, axis, output, mode, cval, origin)
+
+
+def binomial_filter1d(
+    input: ArrayLike,
+    size: int,
+    axis: int = -1,
+    output: np.ndarray | DTypeLike | None = None,
+    mode: str = "reflect",
+    cval: float = 0.0,
+    origin: int = 0,
+) -> np.ndarray:
+    """Pascal-triangle weighted average of ``size`` samples along ``axis``.
+
+    The weights are :func:`pascal_weights` (size 3: 1 2 1 / 4; size 7:
+    1 6 15 20 15 6 1 / 64), the smoothing filter of the MotionTheater thesis.
+    The same result as ``scipy.ndimage.correlate1d(input,
+    pascal_weights(size), axis, ...)``, to rounding.
+    """
+    return _filter1d(lib.MT_FILTER_CORRELATE, input, size, axis, output, mode, cval, origin)
+
+
+def _check_size(size: int) -> int:
+    try:
+        size = operator.index(size)
+    except TypeError:
+        raise TypeError(f"size must be an integer, got {type(size).__name__}") from None
+    if size < 1:
+        raise ValueError(f"size must be at least 1, got {size}")
+    return size
+
+
+def _work_dtype(dtype: np.dtype) -> np.dtype:
+    """The float type the C kernel computes ``dtype`` in."""
+    if dtype in _NATIVE:
+        return dtype
+    if dtype.kind in "biu" or dtype == np.float16:
+        return _F32 if dtype == np.float16 else _F64
+    if dtype.kind == "f":
+        raise TypeError(
+            f"{dtype} input is not supported: the filters compute in at most float64; "
+            "convert with .astype(numpy.float64) if the loss of precision is acceptable"
+        )
+    raise TypeError(f"input must hold real numbers (bool, integer or float), got dtype {dtype}")
+
+
+def _filter1d(kind, input, size, axis, output, mode, cval, origin):
+    a = np.asarray(input)
+    work = _work_dtype(a.dtype)
+    size = _check_size(size)
+    axis = operator.index(axis)
+    if not -a.ndim <= axis < a.ndim:
+        raise np.exceptions.AxisError(axis, a.ndim)
+    axis %= a.ndim
+    try:
+        code = MODES[mode]
+    except (KeyError, TypeError):
+        raise ValueError(f"mode must be one of {', '.join(map(repr, MODES))}; got {mode!r}") from None
+    cval = float(cval)
+    origin = operator.index(origin)
+    if not -(size // 2) <= origin <= (size - 1) // 2:
+        raise ValueError(
+            f"origin must be in [{-(size // 2)}, {(size - 1) // 2}] for size {size}, got {origin}"
+        )
+
+    target = _target(output, a)
+    if a.dtype != work or not (a.flags.c_contiguous and a.flags.aligned):
+        a = np.require(a, work, ["C", "A"])
+    direct = (
+        target.dtype == work
+        and target.flags.c_contiguous
+        and target.flags.aligned
+        and not np.may_share_memory(target, a)
+    )
+    result = target if direct else np.empty(a.shape, work)
+    if a.size:
+        shape = a.shape
+        weights = (
+            ffi.from_buffer("double[]", _pascal(size))
+            if kind == lib.MT_FILTER_CORRELATE
+            else ffi.NULL
+        )
+        status = lib.mt_filter1d(
+            kind, _NATIVE[work], ffi.from_buffer(a), ffi.from_buffer(result),
+            math.prod(shape[:axis]), shape[axis], math.prod(shape[axis + 1:]),
+            size, origin, code, cval, weights,
+        )
+        check(status, "mt_filter1d")
+    if not direct:
+        if target.dtype == np.bool_:
+            # scipy stores through npy_bool, an unsigned char: values truncate, so only |x| >= 1 is True.
+            result = np.abs(result) >= 1
+        np.copyto(target, result, casting="unsafe")
+    return target
+
+
+def _target(output, a: np.ndarray) -> np.ndarray:
+    """The array the result goes to: ``output``, or a new one of its dtype or the input's."""
+    if output is None:
+        return np.empty(a.shape, a.dtype)
+    if isinstance(output, np.ndarray):
+        if output.shape != a.shape:
+            raise ValueError(f"output must have the input's shape {a.shape}, got {output.shape}")
+        if not output.flags.writeable:
+            raise ValueError("output array is read-only")
+        _work_dtype(output.dtype)
+        return output
+    try:
+        dtype = np.dtype(output)
+    except TypeError:
+        raise TypeError(f"output must be None, an ndarray or a dtype, got {output!r}") from None
+    _work_dtype(dtype)
+    return np.empty(a.shape, dtype)
