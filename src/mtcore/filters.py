@@ -139,17 +139,20 @@ def _check_size(size: int) -> int:
 
 
 def _work_dtype(dtype: np.dtype) -> np.dtype:
-    """The float type the C kernel computes ``dtype`` in."""
-    if dtype in _NATIVE:
-        return dtype
-    if dtype.kind in "biu" or dtype == np.float16:
-        return _F32 if dtype == np.float16 else _F64
+    """The native float type the C kernel computes ``dtype`` in."""
+    if dtype.kind not in "biuf":
+        raise TypeError(f"input must hold real numbers (bool, integer or float), got dtype {dtype}")
+    native = dtype.newbyteorder("=")
+    if native in _NATIVE:
+        return native
+    if native == np.float16:
+        return _F32
     if dtype.kind == "f":
         raise TypeError(
             f"{dtype} input is not supported: the filters compute in at most float64; "
             "convert with .astype(numpy.float64) if the loss of precision is acceptable"
         )
-    raise TypeError(f"input must hold real numbers (bool, integer or float), got dtype {dtype}")
+    return _F64
 
 
 def _filter1d(kind, input, size, axis, output, mode, cval, origin):
@@ -205,7 +208,7 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin):
 def _target(output, a: np.ndarray) -> np.ndarray:
     """The array the result goes to: ``output``, or a new one of its dtype or the input's."""
     if output is None:
-        return np.empty(a.shape, a.dtype)
+        return np.empty(a.shape, a.dtype.newbyteorder("="))
     if isinstance(output, np.ndarray):
         if output.shape != a.shape:
             raise ValueError(f"output must have the input's shape {a.shape}, got {output.shape}")
