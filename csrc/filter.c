@@ -36,6 +36,17 @@ enum {
 #define MT_IVDEP
 #endif
 
+/*
+ * Kernels are compiled for the baseline and for newer x86-64 levels (AVX2,
+ * AVX-512), and the loader picks the best the CPU has: portable wheels
+ * without -march=native, at the speed of a native build.
+ */
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__ELF__) && !defined(MT_NO_CLONES)
+#define MT_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define MT_CLONES
+#endif
+
 /* Index into 0..n-1 of position r of the extended line, or -1 for the fill value. */
 static ptrdiff_t extend_index(ptrdiff_t r, ptrdiff_t n, int mode)
 {
@@ -98,28 +109,34 @@ struct job {
 
 /*
  * A kernel for the median of N using the selection network NETWORK on p[0..N-1],
- * which leaves the median in p[N/2].  Min/max order NaN arbitrarily, so windows
- * holding NaN are flagged separately and give NaN.
+ * which leaves the median in p[N/2].  Min/max order NaN arbitrarily, so the
+ * kernel first notes which table rows hold NaN (one pass over each row, not
+ * one per window) and sets the outputs of windows holding NaN afterwards.
  */
 #define NETWORK_KERNEL(N, NETWORK)                                                                 \
-    static void FN(median##N)(const T *const *rows, T *out, size_t ostride, size_t m, size_t nch)  \
+    static MT_CLONES void FN(median##N)(const T *const *rows, T *out, size_t ostride, size_t m,    \
+                                        size_t nch, unsigned char *nanrow)                         \
     {                                                                                              \
+        for (size_t r = 0; r < m + N - 1; r++)                                                     \
+            nanrow[r] = FN(row_has_nan)(rows[r], nch);                                             \
         for (size_t t = 0; t < m; t++) {                                                           \
             const T *r[N];                                                                         \
-            for (int j = 0; j < N; j++)                                                            \
+            int dirty = 0;                                                                         \
+            for (int j = 0; j < N; j++) {                                                          \
                 r[j] = rows[t + j];                                                                \
+                dirty |= nanrow[t + j];                                                            \
+            }                                                                                      \
             T *o = out + t * ostride;                                                              \
             MT_IVDEP for (size_t k = 0; k < nch; k++)                                              \
             {                                                                                      \
                 T p[N];                                                                            \
-                int nan = 0;                                                                       \
-                for (int j = 0; j < N; j++) {                                                      \
+                for (int j = 0; j < N; j++)                                                        \
                     p[j] = r[j][k];                                                                \
-                    nan |= p[j] != p[j];                                                           \
-                }                                                                                  \
                 NETWORK;                                                                           \
-                o[k] = nan ? (T)NAN : p[N / 2];                                                    \
+                o[k] = p[N / 2];                                                                   \
             }                                                                                      \
+            if (dirty)                                                                             \
+                FN(nan_windows)(rows + t, N, o, nch);                                              \
         }                                                                                          \
     }
 
