@@ -78,6 +78,17 @@ static ptrdiff_t extend_index(ptrdiff_t r, ptrdiff_t n, int mode)
     }
 }
 
+/*
+ * Frames from t0 to the next multiple of chunk (or to end): chunks start at
+ * fixed frames whatever range a call covers, so that the running sums
+ * restart at the same frames when a range begins at a multiple of chunk.
+ */
+static size_t chunk_length(size_t t0, size_t end, size_t chunk)
+{
+    size_t next = (t0 / chunk + 1) * chunk;
+    return (next < end ? next : end) - t0;
+}
+
 /* Median sizes with a fixed selection network (Paeth; Devillard 1998). */
 static int has_network(size_t size)
 {
@@ -86,7 +97,7 @@ static int has_network(size_t size)
 
 struct job {
     int filter, mode;
-    size_t outer, n, inner, size;
+    size_t outer, n, inner, begin, end, size;
     ptrdiff_t lead; /* output frame t reads input frames t - lead .. t - lead + size - 1 */
     double cval;
     const double *weights;
@@ -200,8 +211,13 @@ struct job {
 #undef T
 #undef SUFFIX
 
+size_t mt_filter1d_block(size_t size)
+{
+    return size > MIN_CHUNK ? size : MIN_CHUNK;
+}
+
 int mt_filter1d(int filter, int dtype, const void *in, void *out, size_t outer, size_t n,
-                size_t inner, size_t size, ptrdiff_t origin, int mode, double cval,
+                size_t inner, size_t begin, size_t end, size_t size, ptrdiff_t origin, int mode, double cval,
                 const double *weights)
 {
     if (filter < MT_FILTER_MEDIAN || filter > MT_FILTER_CORRELATE)
@@ -215,12 +231,16 @@ int mt_filter1d(int filter, int dtype, const void *in, void *out, size_t outer, 
         return MT_EINVAL;
     if (filter == MT_FILTER_CORRELATE && weights == NULL)
         return MT_EINVAL;
-    if (outer == 0 || n == 0 || inner == 0)
+    if (begin > end || end > n)
+        return MT_EINVAL;
+    if (outer == 0 || begin == end || inner == 0)
         return MT_OK;
     if (in == NULL || out == NULL || n > PTRDIFF_MAX / 4 || inner > SIZE_MAX / n ||
         outer > SIZE_MAX / (n * inner))
         return MT_EINVAL;
 
-    struct job job = {filter, mode, outer, n, inner, size, half + origin, cval, weights, in, out};
+    struct job job = {.filter = filter, .mode = mode, .outer = outer, .n = n, .inner = inner,
+                      .begin = begin, .end = end, .size = size, .lead = half + origin,
+                      .cval = cval, .weights = weights, .in = in, .out = out};
     return dtype == MT_FLOAT64 ? filter1d_f64(&job) : filter1d_f32(&job);
 }

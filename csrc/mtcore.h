@@ -67,15 +67,24 @@ const char *mt_strerror(int status);
  * One-dimensional filter along the middle axis of (outer, n, inner) arrays of
  * element type `dtype`.  Output sample t is computed from the window of input
  * samples t - size/2 - origin + j, j = 0 .. size-1, extended by `mode` with
- * fill value `cval`.  Requires size >= 1 and
+ * fill value `cval`.  Only output frames begin .. end-1 of every line are
+ * written (0 and n for all of them), so that separate calls on disjoint
+ * ranges can share one output from several threads; a range that begins at
+ * a multiple of mt_filter1d_block(size) gives, bit for bit, what one call
+ * over all frames gives there (the running sums of the uniform filter
+ * restart at those multiples).  Requires
+ * begin <= end <= n, size >= 1 and
  * -(size/2) <= origin <= (size-1)/2; `weights` (size doubles) is read only by
  * MT_FILTER_CORRELATE and may be NULL otherwise.  Means and weighted sums are
  * accumulated in double for float32 data.
  */
 int mt_filter1d(int filter, int dtype, const void *in, void *out,
-                size_t outer, size_t n, size_t inner,
+                size_t outer, size_t n, size_t inner, size_t begin, size_t end,
                 size_t size, ptrdiff_t origin, int mode, double cval,
                 const double *weights);
+
+/* The block length, in frames, of mt_filter1d for a window of `size`. */
+size_t mt_filter1d_block(size_t size);
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

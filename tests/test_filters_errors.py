@@ -84,7 +84,7 @@ def test_c_status_codes_map_to_exceptions():
         args = dict(filter=lib.MT_FILTER_MEDIAN, dtype=lib.MT_FLOAT64, size=3, origin=0, mode=0)
         args.update(change)
         status = lib.mt_filter1d(
-            args["filter"], args["dtype"], buf, buf, 1, 4, 1, args["size"], args["origin"], args["mode"], 0.0, ffi.NULL
+            args["filter"], args["dtype"], buf, buf, 1, 4, 1, 0, 4, args["size"], args["origin"], args["mode"], 0.0, ffi.NULL
         )
         with pytest.raises(exc, match=r"mt_filter1d: .* \(status -\d\)"):
             check(status, "mt_filter1d")

@@ -150,3 +150,20 @@ def test_infinities(rng):
 def test_lists_and_scalars_of_python(rng):
     np.testing.assert_array_equal(mtcore.median_filter1d([1, 9, 2, 8, 3], 3), [1, 2, 8, 3, 3])
     np.testing.assert_allclose(mtcore.uniform_filter1d([1.0, 2.0, 3.0], 3, mode="constant"), [1.0, 2.0, 5 / 3])
+
+
+@pytest.mark.parametrize("workers", [1, 2, 3, 7, -1, None])
+@pytest.mark.parametrize("shape,axis", [((5000, 62), 0), ((62, 5000), 1), ((3, 2999, 5), 1)])
+def test_result_does_not_depend_on_workers(rng, pair, workers, shape, axis):
+    ours, _ = pair
+    x = rng.standard_normal(shape) * 1e3
+    for size in (5, 300):
+        whole = ours(x, size, axis=axis, workers=1)
+        np.testing.assert_array_equal(ours(x, size, axis=axis, workers=workers), whole)
+
+
+@pytest.mark.parametrize("workers,exc", [(0, ValueError), (-2, ValueError), (1.5, TypeError)])
+def test_bad_workers(pair, workers, exc):
+    ours, _ = pair
+    with pytest.raises(exc, match="workers must be"):
+        ours(np.zeros((10, 3)), 3, workers=workers)

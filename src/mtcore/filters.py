@@ -7,6 +7,11 @@ the result cast to the output type as scipy does (truncation toward zero).
 The input is never modified.  ``output`` may be an array of the input's shape
 (any dtype, any layout, even the input itself) or a dtype.
 
+Large arrays are split over the cores by frames (``workers``, keyword-only,
+as in scipy.fft): None uses every core for arrays of a million values or
+more and one thread below; 1 keeps the work in the calling thread; -1 means
+every core.  The result does not depend on the number of workers.
+
 Edge modes, for the line ``a b c d`` and fill value ``k = cval``:
 
 ====================  ===========================
@@ -33,6 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike, DTypeLike
 
 from ._mtcore import ffi, lib
+from ._parallel import cpu_count, run_all
 from ._status import check
 
 __all__ = ["median_filter1d", "uniform_filter1d", "binomial_filter1d", "pascal_weights", "MODES"]
@@ -47,6 +53,9 @@ MODES = {
     "wrap": lib.MT_MODE_WRAP,
     "grid-wrap": lib.MT_MODE_WRAP,
 }
+
+# Below this, handing work to another thread costs more than it saves.
+_PARALLEL_MIN_VALUES = 1 << 20
 
 _NATIVE = {np.dtype(np.float64): lib.MT_FLOAT64, np.dtype(np.float32): lib.MT_FLOAT32}
 _F32, _F64 = np.dtype(np.float32), np.dtype(np.float64)
@@ -79,6 +88,8 @@ def median_filter1d(
     mode: str = "reflect",
     cval: float = 0.0,
     origin: int = 0,
+    *,
+    workers: int | None = None,
 ) -> np.ndarray:
     """Moving median of ``size`` samples along ``axis``.
 
@@ -88,7 +99,7 @@ def median_filter1d(
     the median never invents values.  A window that contains NaN gives NaN
     (scipy's result is undefined there).
     """
-    return _filter1d(lib.MT_FILTER_MEDIAN, input, size, axis, output, mode, cval, origin)
+    return _filter1d(lib.MT_FILTER_MEDIAN, input, size, axis, output, mode, cval, origin, workers)
 
 
 def uniform_filter1d(
@@ -99,6 +110,8 @@ def uniform_filter1d(
     mode: str = "reflect",
     cval: float = 0.0,
     origin: int = 0,
+    *,
+    workers: int | None = None,
 ) -> np.ndarray:
     """Moving average of ``size`` samples along ``axis``.
 
@@ -106,7 +119,7 @@ def uniform_filter1d(
     running sum in double, restarted every few hundred samples so that long
     lines do not drift).
     """
-    return _filter1d(lib.MT_FILTER_UNIFORM, input, size, axis, output, mode, cval, origin)
+    return _filter1d(lib.MT_FILTER_UNIFORM, input, size, axis, output, mode, cval, origin, workers)
 
 
 def binomial_filter1d(
@@ -117,6 +130,8 @@ def binomial_filter1d(
     mode: str = "reflect",
     cval: float = 0.0,
     origin: int = 0,
+    *,
+    workers: int | None = None,
 ) -> np.ndarray:
     """Pascal-triangle weighted average of ``size`` samples along ``axis``.
 
@@ -125,7 +140,7 @@ def binomial_filter1d(
     The same result as ``scipy.ndimage.correlate1d(input,
     pascal_weights(size), axis, ...)``, to rounding.
     """
-    return _filter1d(lib.MT_FILTER_CORRELATE, input, size, axis, output, mode, cval, origin)
+    return _filter1d(lib.MT_FILTER_CORRELATE, input, size, axis, output, mode, cval, origin, workers)
 
 
 def _check_size(size: int) -> int:
@@ -155,7 +170,26 @@ def _work_dtype(dtype: np.dtype) -> np.dtype:
     return _F64
 
 
-def _filter1d(kind, input, size, axis, output, mode, cval, origin):
+def _split(workers: int | None, values: int, frames: int, block: int) -> list[int]:
+    """Frame bounds of the ranges the threads compute: multiples of the C block
+    length, so that the result is the same bit for bit however it is split."""
+    if workers is None:
+        wanted = cpu_count() if values >= _PARALLEL_MIN_VALUES else 1
+    else:
+        try:
+            wanted = operator.index(workers)
+        except TypeError:
+            raise TypeError(f"workers must be an integer or None, got {type(workers).__name__}") from None
+        if wanted == -1:
+            wanted = cpu_count()
+        elif wanted < 1:
+            raise ValueError(f"workers must be a positive integer, -1 (every core) or None, got {wanted}")
+    blocks = -(-frames // block)
+    threads = max(1, min(wanted, blocks))
+    return [min(frames, blocks * i // threads * block) for i in range(threads)] + [frames]
+
+
+def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
     a = np.asarray(input)
     work = _work_dtype(a.dtype)
     size = _check_size(size)
@@ -184,19 +218,26 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin):
         and not np.may_share_memory(target, a)
     )
     result = target if direct else np.empty(a.shape, work)
+    bounds = _split(workers, a.size, a.shape[axis], lib.mt_filter1d_block(size))
     if a.size:
         shape = a.shape
+        n = shape[axis]
         weights = (
             ffi.from_buffer("double[]", _pascal(size))
             if kind == lib.MT_FILTER_CORRELATE
             else ffi.NULL
         )
-        status = lib.mt_filter1d(
+        args = (
             kind, _NATIVE[work], ffi.from_buffer(a), ffi.from_buffer(result),
-            math.prod(shape[:axis]), shape[axis], math.prod(shape[axis + 1:]),
-            size, origin, code, cval, weights,
+            math.prod(shape[:axis]), n, math.prod(shape[axis + 1:]),
         )
-        check(status, "mt_filter1d")
+        tail = (size, origin, code, cval, weights)
+
+        def part(begin: int, end: int):
+            return lambda: lib.mt_filter1d(*args, begin, end, *tail)
+
+        for status in run_all([part(b, e) for b, e in zip(bounds, bounds[1:])]):
+            check(status, "mt_filter1d")
     if not direct:
         if target.dtype == np.bool_:
             # scipy stores through npy_bool, an unsigned char: values truncate, so only |x| >= 1 is True.
