@@ -4,6 +4,8 @@ Run: python -m pytest benchmarks/bench_filters.py
 The table printed at the end is the one in the closing notes of issue 2.
 """
 
+from functools import partial
+
 import numpy as np
 import pytest
 import scipy.ndimage as ndi
@@ -53,30 +55,40 @@ def test_fresh_copy_ceiling(benchmark, record, hour):
     record("ndarray.copy (432000, 62)", "copy", hour.size)
 
 
+# workers=None is the default (every core for arrays this large); workers=1 shows one core's share.
+THREADS = {"all cores": None, "1 thread": 1}
+
+
+@pytest.mark.parametrize("threads", THREADS)
 @pytest.mark.parametrize("size", SIZES)
 @pytest.mark.parametrize("name", OURS)
-def test_hour_axis0_prealloc(benchmark, record, hour, name, size):
+def test_hour_axis0_prealloc(benchmark, record, hour, name, size, threads):
     out = np.empty_like(hour)
-    benchmark.pedantic(OURS[name], (hour, size, 0, out), **FAST)
-    record(f"hour axis 0, output=, {name} {size}", "mtcore", hour.size,
+    benchmark.pedantic(partial(OURS[name], workers=THREADS[threads]), (hour, size, 0, out), **FAST)
+    record(f"hour axis 0, output=, {name} {size}, {threads}", "mtcore", hour.size,
            ceiling="numpy.copyto (432000, 62)", target=">= 40% of copy")
 
 
 @pytest.mark.parametrize("size", SIZES)
 @pytest.mark.parametrize("name", OURS)
-@pytest.mark.parametrize("who", ["mtcore", "scipy"])
+@pytest.mark.parametrize("who", ["scipy", "all cores", "1 thread"])
 def test_hour_axis0_fresh(benchmark, record, hour, name, size, who):
-    fn, plan = (OURS[name], FAST) if who == "mtcore" else (SCIPY[name], SLOW)
-    benchmark.pedantic(fn, (hour, size, 0), **plan)
-    record(f"hour axis 0, fresh, {name} {size}", who, hour.size, ceiling="ndarray.copy (432000, 62)",
+    if who == "scipy":
+        benchmark.pedantic(SCIPY[name], (hour, size, 0), **SLOW)
+        for threads in THREADS:
+            record(f"hour axis 0, fresh, {name} {size}, {threads}", "scipy", hour.size)
+        return
+    benchmark.pedantic(partial(OURS[name], workers=THREADS[who]), (hour, size, 0), **FAST)
+    record(f"hour axis 0, fresh, {name} {size}, {who}", "mtcore", hour.size, ceiling="ndarray.copy (432000, 62)",
            target=">= 40% of copy, >= 10x scipy" + (" (median 30x)" if name == "median" else ""))
 
 
+@pytest.mark.parametrize("threads", THREADS)
 @pytest.mark.parametrize("size", SIZES)
 @pytest.mark.parametrize("name", OURS)
-def test_hour_last_axis(benchmark, record, hour_t, name, size):
-    benchmark.pedantic(OURS[name], (hour_t, size, -1), **FAST)
-    record(f"(62, 432000) axis -1, {name} {size}", "mtcore", hour_t.size,
+def test_hour_last_axis(benchmark, record, hour_t, name, size, threads):
+    benchmark.pedantic(partial(OURS[name], workers=THREADS[threads]), (hour_t, size, -1), **FAST)
+    record(f"(62, 432000) axis -1, {name} {size}, {threads}", "mtcore", hour_t.size,
            ceiling="ndarray.copy (432000, 62)", target=">= 200 M values/s")
 
 
