@@ -60,36 +60,35 @@ def test_median_equals_scipy_and_twin(rng, dtype, mode, size):
                 np.testing.assert_array_equal(got, want.astype(dtype))
 
 
+MEANS = {
+    "uniform": (
+        mtcore.uniform_filter1d,
+        ndi.uniform_filter1d,
+        lambda line, size, *rest: mean_line(line, size, *rest),
+    ),
+    "binomial": (
+        mtcore.binomial_filter1d,
+        lambda x, size, axis, **kw: ndi.correlate1d(x, mtcore.pascal_weights(size), axis, **kw),
+        lambda line, size, *rest: correlate_line(line, list(mtcore.pascal_weights(size)), *rest),
+    ),
+}
+
+
+@pytest.mark.parametrize("name", MEANS)
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 @pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("size", SIZES)
-def test_uniform_equals_scipy_and_twin(rng, dtype, mode, size):
+def test_means_equal_scipy_and_twin(rng, name, dtype, mode, size):
+    ours, theirs, twin = MEANS[name]
     for x, axis in cases(rng, dtype):
         tol = tolerance(x, dtype)
         for origin in origins(size):
             kw = dict(mode=mode, cval=CVAL, origin=origin)
-            got = mtcore.uniform_filter1d(x, size, axis, **kw)
+            got = ours(x, size, axis, **kw)
             assert got.dtype == dtype and got.shape == x.shape
-            np.testing.assert_allclose(got, ndi.uniform_filter1d(x, size, axis, **kw), rtol=0, atol=tol)
+            np.testing.assert_allclose(got, theirs(x, size, axis, **kw), rtol=0, atol=tol)
             if x.size <= 40:
-                want = along_axis(mean_line, x, axis, size, mode, CVAL, origin)
-                np.testing.assert_allclose(got, want, rtol=0, atol=tol)
-
-
-@pytest.mark.parametrize("dtype", [np.float64, np.float32])
-@pytest.mark.parametrize("mode", MODES)
-@pytest.mark.parametrize("size", SIZES)
-def test_binomial_equals_scipy_and_twin(rng, dtype, mode, size):
-    weights = mtcore.pascal_weights(size)
-    for x, axis in cases(rng, dtype):
-        tol = tolerance(x, dtype)
-        for origin in origins(size):
-            kw = dict(mode=mode, cval=CVAL, origin=origin)
-            got = mtcore.binomial_filter1d(x, size, axis, **kw)
-            assert got.dtype == dtype and got.shape == x.shape
-            np.testing.assert_allclose(got, ndi.correlate1d(x, weights, axis, **kw), rtol=0, atol=tol)
-            if x.size <= 40:
-                want = along_axis(correlate_line, x, axis, list(weights), mode, CVAL, origin)
+                want = along_axis(twin, x, axis, size, mode, CVAL, origin)
                 np.testing.assert_allclose(got, want, rtol=0, atol=tol)
 
 

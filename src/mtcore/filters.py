@@ -153,10 +153,10 @@ def _check_size(size: int) -> int:
     return size
 
 
-def _work_dtype(dtype: np.dtype) -> np.dtype:
+def _work_dtype(dtype: np.dtype, role: str = "input") -> np.dtype:
     """The native float type the C kernel computes ``dtype`` in."""
     if dtype.kind not in "biuf":
-        raise TypeError(f"input must hold real numbers (bool, integer or float), got dtype {dtype}")
+        raise TypeError(f"{role} must hold real numbers (bool, integer or float), got dtype {dtype}")
     native = dtype.newbyteorder("=")
     if native in _NATIVE:
         return native
@@ -164,7 +164,7 @@ def _work_dtype(dtype: np.dtype) -> np.dtype:
         return _F32
     if dtype.kind == "f":
         raise TypeError(
-            f"{dtype} input is not supported: the filters compute in at most float64; "
+            f"{dtype} {role} is not supported: the filters compute in at most float64; "
             "convert with .astype(numpy.float64) if the loss of precision is acceptable"
         )
     return _F64
@@ -208,9 +208,14 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
             f"origin must be in [{-(size // 2)}, {(size - 1) // 2}] for size {size}, got {origin}"
         )
 
+    outer, n, inner = math.prod(a.shape[:axis]), a.shape[axis], math.prod(a.shape[axis + 1:])
+    bounds = _split(workers, a.size, n, lib.mt_filter1d_block(size))
     target = _target(output, a)
+
     if a.dtype != work or not (a.flags.c_contiguous and a.flags.aligned):
         a = np.require(a, work, ["C", "A"])
+    # The kernel writes straight into the target when it has the kernel's layout
+    # and type and does not overlap the input; otherwise into a temporary.
     direct = (
         target.dtype == work
         and target.flags.c_contiguous
@@ -218,23 +223,13 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
         and not np.may_share_memory(target, a)
     )
     result = target if direct else np.empty(a.shape, work)
-    bounds = _split(workers, a.size, a.shape[axis], lib.mt_filter1d_block(size))
     if a.size:
-        shape = a.shape
-        n = shape[axis]
-        weights = (
-            ffi.from_buffer("double[]", _pascal(size))
-            if kind == lib.MT_FILTER_CORRELATE
-            else ffi.NULL
-        )
-        args = (
-            kind, _NATIVE[work], ffi.from_buffer(a), ffi.from_buffer(result),
-            math.prod(shape[:axis]), n, math.prod(shape[axis + 1:]),
-        )
+        weights = ffi.from_buffer("double[]", _pascal(size)) if kind == lib.MT_FILTER_CORRELATE else ffi.NULL
+        head = (kind, _NATIVE[work], ffi.from_buffer(a), ffi.from_buffer(result), outer, n, inner)
         tail = (size, origin, code, cval, weights)
 
         def part(begin: int, end: int):
-            return lambda: lib.mt_filter1d(*args, begin, end, *tail)
+            return lambda: lib.mt_filter1d(*head, begin, end, *tail)
 
         for status in run_all([part(b, e) for b, e in zip(bounds, bounds[1:])]):
             check(status, "mt_filter1d")
@@ -255,11 +250,11 @@ def _target(output, a: np.ndarray) -> np.ndarray:
             raise ValueError(f"output must have the input's shape {a.shape}, got {output.shape}")
         if not output.flags.writeable:
             raise ValueError("output array is read-only")
-        _work_dtype(output.dtype)
+        _work_dtype(output.dtype, "output")
         return output
     try:
         dtype = np.dtype(output)
     except TypeError:
         raise TypeError(f"output must be None, an ndarray or a dtype, got {output!r}") from None
-    _work_dtype(dtype)
+    _work_dtype(dtype, "output")
     return np.empty(a.shape, dtype)
