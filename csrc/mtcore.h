@@ -28,7 +28,15 @@ enum mt_status {
     MT_OK = 0,
     MT_EINVAL = -1, /* an argument is outside its documented range */
     MT_ENOMEM = -2, /* scratch memory could not be allocated */
-    MT_EDTYPE = -3  /* the element type code is not one of mt_dtype */
+    MT_EDTYPE = -3, /* the element type code is not one of mt_dtype */
+    /* text scanning (mt_scan_frames); the report says where and what */
+    MT_ESYNTAX = -4,    /* a token that is not a number where a number belongs */
+    MT_ECOUNT = -5,     /* a line holds more or fewer numbers than its key takes */
+    MT_EUNKNOWN = -6,   /* a line starts with a key that is not in the table */
+    MT_EDUPLICATE = -7, /* a key appears twice in one frame */
+    MT_EMISSING = -8,   /* a frame lacks a key that takes numbers */
+    MT_EFRAME = -9,     /* a frame number out of sequence, or a key line before any frame */
+    MT_ERANGE = -10     /* more frames than the output holds, or an output buffer too small */
 };
 
 enum mt_dtype {
@@ -85,6 +93,60 @@ int mt_filter1d(int filter, int dtype, const void *in, void *out,
 
 /* The block length, in frames, of mt_filter1d for a window of `size`. */
 size_t mt_filter1d_block(size_t size);
+
+/*
+ * Frame text: frames of key lines, each frame opened by a line holding only
+ * its frame number (consecutive, from any start), e.g.
+ *
+ *     1
+ *     root 9.37 17.87 -17.32 -2.02 -7.60 -3.23
+ *     ltibia 20.088
+ *
+ * Key i is the byte string keys[i] of key_lens[i] bytes; the counts[i]
+ * numbers of its line go to columns offsets[i] .. offsets[i]+counts[i]-1 of
+ * the frame's row of `channels` values.  Keys may come in any order within a
+ * frame, each at most once; every key with counts[i] > 0 must be present.
+ * Lines end in LF, CRLF or CR; blank lines and lines starting with '#' are
+ * skipped; tokens are separated by spaces or tabs.
+ */
+struct mt_scan_report {
+    size_t frames;         /* frames stored */
+    long long first_frame; /* number of the first frame */
+    size_t line;           /* line of the problem, 1 at the start of the text */
+    size_t offset;         /* byte offset of the start of that line */
+    long long key;         /* key of the problem, or -1 */
+    long long found;       /* numbers found (MT_ECOUNT) or frame number found (MT_EFRAME) */
+    long long expected;    /* numbers or frame number expected */
+};
+
+/* An upper bound on the number of lines of text (for sizing the output of mt_scan_frames). */
+size_t mt_count_lines(const char *text, size_t len);
+
+/* Scans frame text into values (max_frames x channels, row-major). */
+int mt_scan_frames(const char *text, size_t len, const char *const *keys, const size_t *key_lens,
+                   const size_t *offsets, const size_t *counts, size_t nkeys, double *values,
+                   size_t max_frames, size_t channels, struct mt_scan_report *report);
+
+/*
+ * Writes the shortest decimal text that reads back as exactly `value` into
+ * buf (at least MT_NUMBER_MAX bytes, not NUL-terminated); returns its length.
+ * Style of printf %g and Python repr: 17.8693, 1.23246e-13, 3, -0, nan, inf.
+ */
+size_t mt_format_double(double value, char *buf);
+
+/*
+ * Writes frames first .. first+frames-1 of values (frames x channels) as
+ * frame text, the keys in the order given, into buf of cap bytes; *written
+ * receives the length.  MT_ERANGE if cap is below mt_format_bound().
+ */
+int mt_format_frames(const double *values, size_t frames, size_t channels, long long first_frame,
+                     const char *const *keys, const size_t *key_lens, const size_t *offsets,
+                     const size_t *counts, size_t nkeys, char *buf, size_t cap, size_t *written);
+
+/* Bytes that mt_format_frames may need for `frames` frames of these keys. */
+size_t mt_format_bound(size_t frames, const size_t *key_lens, const size_t *counts, size_t nkeys);
+
+enum { MT_NUMBER_MAX = 32 };
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

@@ -11,6 +11,20 @@ const char *mt_strerror(int status)
         return "out of memory for scratch buffers";
     case MT_EDTYPE:
         return "unsupported element type";
+    case MT_ESYNTAX:
+        return "not a number";
+    case MT_ECOUNT:
+        return "wrong count of numbers on a line";
+    case MT_EUNKNOWN:
+        return "unknown key";
+    case MT_EDUPLICATE:
+        return "key twice in one frame";
+    case MT_EMISSING:
+        return "key missing from a frame";
+    case MT_EFRAME:
+        return "frame number out of sequence";
+    case MT_ERANGE:
+        return "output too small";
     default:
         return "unknown status code";
     }

@@ -4,8 +4,23 @@ Fast one-dimensional smoothing filters in C, drop-in replacements for their
 scipy.ndimage counterparts (same signatures, defaults and results)::
 
     from mtcore import median_filter1d, uniform_filter1d, binomial_filter1d
+
+and frame text (AMC bodies) scanned into arrays and written back exactly
+(:func:`scan_frames`, :func:`format_frames`).
 """
 
+from . import errors
 from .filters import MODES, binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
+from .text import format_frames, format_number, scan_frames
 
-__all__ = ["MODES", "binomial_filter1d", "median_filter1d", "pascal_weights", "uniform_filter1d"]
+__all__ = [
+    "MODES",
+    "binomial_filter1d",
+    "errors",
+    "format_frames",
+    "format_number",
+    "median_filter1d",
+    "pascal_weights",
+    "scan_frames",
+    "uniform_filter1d",
+]

@@ -1,23 +1,38 @@
 """The one place where C status codes become Python exceptions."""
 
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from . import errors
 from ._mtcore import ffi, lib
 
-_EXCEPTIONS = {
+_EXCEPTIONS: dict[int, type[Exception]] = {
     lib.MT_EINVAL: ValueError,
     lib.MT_ENOMEM: MemoryError,
     lib.MT_EDTYPE: TypeError,
+    lib.MT_ESYNTAX: errors.NumberError,
+    lib.MT_ECOUNT: errors.CountError,
+    lib.MT_EUNKNOWN: errors.UnknownNameError,
+    lib.MT_EDUPLICATE: errors.DuplicateError,
+    lib.MT_EMISSING: errors.MissingError,
+    lib.MT_EFRAME: errors.SequenceError,
 }
 
 
-def check(status: int, what: str) -> None:
+def check(status: int, what: str, describe: Callable[[int], tuple[str, int, bool]] | None = None) -> None:
     """Raise the exception for a non-zero status of the C call named by ``what``.
 
-    Python validates arguments before every call, so an error here means a
-    broken invariant or exhausted memory; the message says which call failed
-    and what the C core reported.
+    Argument errors (Python validates before every call, so these mean a
+    broken invariant) and exhausted memory name the call and the C message.
+    Errors in scanned text are FormatErrors whose reason and line come from
+    ``describe(status)`` -> (reason, line, truncated), the caller knowing the text.
     """
     if status == lib.MT_OK:
         return
-    message = ffi.string(lib.mt_strerror(status)).decode()
     exc = _EXCEPTIONS.get(status, RuntimeError)
+    if describe is not None and issubclass(exc, errors.FormatError):
+        reason, line, truncated = describe(status)
+        raise (errors.TruncatedError if truncated else exc)(reason, line)
+    message = ffi.string(lib.mt_strerror(status)).decode()
     raise exc(f"{what}: {message} (status {status})")

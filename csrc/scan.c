@@ -1,0 +1,276 @@
+/*
+ * scan.c - frame text (AMC-style) into a values array, in one pass.
+ *
+ * Numbers take an exact fast path: a decimal with at most 19 significant
+ * digits whose mantissa is below 2^53 and whose power of ten is at most 22
+ * in magnitude is the mantissa times or divided by an exactly representable
+ * power of ten, one correctly rounded operation (Clinger 1990).  Anything
+ * else (more digits, large exponents, inf, nan) goes through strtod, so every
+ * value equals what Python's float() gives for the same text.
+ */
+#include "mtcore.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const double exact_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                       1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                       1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+static int is_blank(char c)
+{
+    return c == ' ' || c == '\t' || c == '\v' || c == '\f';
+}
+
+static int is_eol(char c)
+{
+    return c == '\n' || c == '\r';
+}
+
+static int is_digit(char c)
+{
+    return c >= '0' && c <= '9';
+}
+
+/* The end of the token starting at p. */
+static const char *token_end(const char *p, const char *end)
+{
+    while (p < end && !is_blank(*p) && !is_eol(*p))
+        p++;
+    return p;
+}
+
+/* The token [p, end) through strtod; 0 if it is not a number. */
+static int parse_slow(const char *p, const char *end, double *out)
+{
+    char buf[64];
+    size_t n = (size_t)(end - p);
+    if (n >= sizeof buf)
+        return 0;
+    memcpy(buf, p, n);
+    buf[n] = '\0';
+    char *stop;
+    *out = strtod(buf, &stop);
+    return n > 0 && stop == buf + n;
+}
+
+/* Parses the token [p, end) as a number; 0 if it is not one. */
+static int parse_number(const char *p, const char *end, double *out)
+{
+    const char *start = p;
+    int negative = 0;
+    if (p < end && (*p == '-' || *p == '+'))
+        negative = *p++ == '-';
+    uint64_t mantissa = 0;
+    int significant = 0, exp10 = 0, digits = 0;
+    for (; p < end && is_digit(*p); p++, digits++) {
+        if (significant < 19) {
+            mantissa = mantissa * 10 + (uint64_t)(*p - '0');
+            significant += mantissa != 0;
+        } else {
+            exp10++;
+        }
+    }
+    if (p < end && *p == '.') {
+        for (p++; p < end && is_digit(*p); p++, digits++) {
+            if (significant < 19) {
+                mantissa = mantissa * 10 + (uint64_t)(*p - '0');
+                significant += mantissa != 0;
+                exp10--;
+            } else if (*p != '0') {
+                return parse_slow(start, end, out); /* digits beyond what the fast path keeps */
+            }
+        }
+    }
+    if (digits == 0)
+        return parse_slow(start, end, out); /* inf, nan or not a number */
+    if (p < end && (*p == 'e' || *p == 'E')) {
+        ++p;
+        int eneg = 0, evalue = 0;
+        if (p < end && (*p == '-' || *p == '+'))
+            eneg = *p++ == '-';
+        if (p == end || !is_digit(*p))
+            return parse_slow(start, end, out);
+        for (; p < end && is_digit(*p); p++)
+            if (evalue < 100000)
+                evalue = evalue * 10 + (*p - '0');
+        exp10 += eneg ? -evalue : evalue;
+    }
+    if (p != end)
+        return parse_slow(start, end, out);
+    if (mantissa > ((uint64_t)1 << 53) || exp10 < -22 || exp10 > 22)
+        return parse_slow(start, end, out);
+    double v = (double)mantissa;
+    v = exp10 < 0 ? v / exact_pow10[-exp10] : v * exact_pow10[exp10];
+    *out = negative ? -v : v;
+    return 1;
+}
+
+size_t mt_count_lines(const char *text, size_t len)
+{
+    size_t lines = 1;
+    for (size_t i = 0; i < len; i++)
+        lines += (text[i] == '\n') + (text[i] == '\r');
+    return lines;
+}
+
+/* A line holding one token of digits only: the frame number, or -1. */
+static long long frame_number(const char *tok, const char *tok_end, const char *line_rest,
+                              const char *end)
+{
+    if (tok_end - tok > 18)
+        return -1;
+    long long number = 0;
+    for (const char *q = tok; q < tok_end; q++) {
+        if (!is_digit(*q))
+            return -1;
+        number = number * 10 + (*q - '0');
+    }
+    for (const char *q = line_rest; q < end && !is_eol(*q); q++)
+        if (!is_blank(*q))
+            return -1;
+    return number;
+}
+
+struct scan {
+    const char *const *keys;
+    const size_t *key_lens, *offsets, *counts;
+    size_t nkeys;
+    size_t *seen_in;  /* frame (1-based) in which each key was last seen */
+    size_t *order;    /* keys in the order of the first frame, to guess the next key */
+    size_t norder;
+};
+
+static long long find_key(const struct scan *s, const char *tok, size_t n, size_t position)
+{
+    if (position < s->norder) {
+        size_t k = s->order[position];
+        if (s->key_lens[k] == n && memcmp(s->keys[k], tok, n) == 0)
+            return (long long)k;
+    }
+    for (size_t k = 0; k < s->nkeys; k++)
+        if (s->key_lens[k] == n && memcmp(s->keys[k], tok, n) == 0)
+            return (long long)k;
+    return -1;
+}
+
+/* The first key with numbers that frame `frame` (1-based) lacks, or -1. */
+static long long missing_key(const struct scan *s, size_t frame)
+{
+    for (size_t k = 0; k < s->nkeys; k++)
+        if (s->counts[k] > 0 && s->seen_in[k] != frame)
+            return (long long)k;
+    return -1;
+}
+
+static int scan_text(const char *text, const char *end, struct scan *s, double *values,
+                     size_t max_frames, size_t channels, struct mt_scan_report *r)
+{
+    size_t frames = 0, position = 0;
+    long long previous = 0;
+    double *row = NULL;
+    const char *p = text;
+    r->line = 1;
+    while (p < end) {
+        while (p < end && is_blank(*p))
+            p++;
+        if (p < end && !is_eol(*p) && *p != '#') {
+            const char *tok = p, *tok_stop = token_end(p, end);
+            long long number = frame_number(tok, tok_stop, tok_stop, end);
+            if (number >= 0) {
+                if (frames > 0 && (r->key = missing_key(s, frames)) >= 0)
+                    return MT_EMISSING;
+                if (frames > 0 && number != previous + 1) {
+                    r->found = number;
+                    r->expected = previous + 1;
+                    return MT_EFRAME;
+                }
+                if (frames == max_frames)
+                    return MT_ERANGE;
+                if (frames == 0)
+                    r->first_frame = number;
+                row = values + frames * channels;
+                previous = number;
+                frames++;
+                position = 0;
+                r->frames = frames;
+                p = tok_stop;
+            } else {
+                if (frames == 0) {
+                    r->expected = -1; /* a frame number */
+                    return MT_EFRAME;
+                }
+                long long k = find_key(s, tok, (size_t)(tok_stop - tok), position);
+                if (k < 0)
+                    return MT_EUNKNOWN;
+                r->key = k;
+                if (s->seen_in[k] == frames)
+                    return MT_EDUPLICATE;
+                s->seen_in[k] = frames;
+                if (frames == 1)
+                    s->order[s->norder++] = (size_t)k;
+                position++;
+                const size_t count = s->counts[k];
+                double *dst = row + s->offsets[k];
+                p = tok_stop;
+                size_t i = 0;
+                for (;; i++) {
+                    while (p < end && is_blank(*p))
+                        p++;
+                    if (p == end || is_eol(*p))
+                        break;
+                    const char *stop = token_end(p, end);
+                    if (i < count && !parse_number(p, stop, &dst[i])) {
+                        r->found = (long long)i;
+                        return MT_ESYNTAX;
+                    }
+                    p = stop;
+                }
+                if (i != count) {
+                    r->found = (long long)i;
+                    r->expected = (long long)count;
+                    return MT_ECOUNT;
+                }
+                r->key = -1;
+            }
+        }
+        while (p < end && !is_eol(*p))
+            p++; /* the rest of a comment line */
+        if (p < end) {
+            p += (*p == '\r' && p + 1 < end && p[1] == '\n') ? 2 : 1;
+            r->line++;
+            r->offset = (size_t)(p - text);
+        }
+    }
+    if (frames > 0 && (r->key = missing_key(s, frames)) >= 0)
+        return MT_EMISSING;
+    r->frames = frames;
+    return MT_OK;
+}
+
+int mt_scan_frames(const char *text, size_t len, const char *const *keys, const size_t *key_lens,
+                   const size_t *offsets, const size_t *counts, size_t nkeys, double *values,
+                   size_t max_frames, size_t channels, struct mt_scan_report *report)
+{
+    if (report == NULL)
+        return MT_EINVAL;
+    memset(report, 0, sizeof *report);
+    report->key = -1;
+    if ((text == NULL && len > 0) || (nkeys > 0 && (!keys || !key_lens || !offsets || !counts)) ||
+        (values == NULL && max_frames > 0 && channels > 0))
+        return MT_EINVAL;
+    for (size_t k = 0; k < nkeys; k++)
+        if (keys[k] == NULL || key_lens[k] == 0 || offsets[k] > channels ||
+            counts[k] > channels - offsets[k])
+            return MT_EINVAL;
+    struct scan s = {keys, key_lens, offsets, counts, nkeys, NULL, NULL, 0};
+    s.seen_in = calloc(nkeys + 1, sizeof *s.seen_in);
+    s.order = malloc((nkeys + 1) * sizeof *s.order);
+    int status = MT_ENOMEM;
+    if (s.seen_in && s.order)
+        status = scan_text(text, text + len, &s, values, max_frames, channels, report);
+    free(s.seen_in);
+    free(s.order);
+    return status;
+}

@@ -1,0 +1,156 @@
+"""Frame text (the body of an AMC file) to and from arrays, in C.
+
+Frame text is a sequence of frames, each a line holding its frame number
+followed by key lines ``key v1 v2 ...``; see ``mtcore.h``.  Keys are opaque
+byte strings here: the caller (motiontheater's AMC reader) maps bones to keys
+and columns.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from ._mtcore import ffi, lib
+from ._status import check
+
+__all__ = ["scan_frames", "format_frames", "format_number"]
+
+_FORMAT_CHUNK = 2048  # frames per C call when writing: bounds the text buffer
+
+
+class _KeyTable:
+    """Keys, column offsets and counts as C arrays (kept alive with this object)."""
+
+    def __init__(self, keys: Sequence[bytes], offsets: Sequence[int], counts: Sequence[int], channels: int):
+        if not (len(keys) == len(offsets) == len(counts)):
+            raise ValueError("keys, offsets and counts must have the same length")
+        for key, offset, count in zip(keys, offsets, counts):
+            if not key or any(c in key for c in b" \t\r\n"):
+                raise ValueError(f"keys must be non-empty and free of blanks, got {key!r}")
+            if offset < 0 or count < 0 or offset + count > channels:
+                raise ValueError(f"columns {offset}..{offset + count - 1} of key {key!r} exceed {channels} channels")
+        self.keys = list(keys)
+        self.counts = list(counts)
+        self._strings = [ffi.new("char[]", k) for k in keys]
+        self.c_keys = ffi.new("const char *[]", self._strings)
+        self.c_lens = ffi.new("size_t[]", [len(k) for k in keys])
+        self.c_offsets = ffi.new("size_t[]", list(offsets))
+        self.c_counts = ffi.new("size_t[]", list(counts))
+        self.n = len(keys)
+
+
+def _line_text(text: bytes, offset: int) -> str:
+    end = len(text)
+    for stop in (b"\n", b"\r"):
+        found = text.find(stop, offset)
+        if found != -1:
+            end = min(end, found)
+    return text[offset:end].decode("utf-8", "replace").strip()
+
+
+def scan_frames(
+    text: bytes,
+    keys: Sequence[bytes],
+    offsets: Sequence[int],
+    counts: Sequence[int],
+    channels: int,
+    *,
+    noun: str = "key",
+) -> tuple[np.ndarray, int]:
+    """Scan frame text into a new (frames, channels) float64 array.
+
+    Returns the array and the number of the first frame (0 when there are
+    none).  Columns that no key fills are NaN.  Raises a
+    :class:`~mtcore.errors.FormatError` subclass whose ``line`` counts from 1 at
+    the start of ``text`` and whose message calls keys ``noun``.
+    """
+    table = _KeyTable(keys, offsets, counts, channels)
+    required = sum(1 for c in counts if c > 0)
+    # Every frame takes its number line and one line per key with numbers.
+    capacity = lib.mt_count_lines(text, len(text)) // (1 + required) + 1
+    values = np.empty((capacity, channels))
+    if len(table.counts) and sum(table.counts) < channels:
+        values.fill(np.nan)
+    report = ffi.new("struct mt_scan_report *")
+    with ffi.from_buffer(text) as c_text, ffi.from_buffer("double[]", values) as c_values:
+        status = lib.mt_scan_frames(
+            c_text, len(text), table.c_keys, table.c_lens, table.c_offsets, table.c_counts, table.n,
+            c_values, capacity, channels, report,
+        )
+    check(status, "mt_scan_frames", _describer(text, table, report, noun))
+    # Shrinks in place (realloc); the pages past the frames were never touched.
+    values.resize((report.frames, channels), refcheck=False)
+    return values, int(report.first_frame)
+
+
+def _describer(text: bytes, table: _KeyTable, report, noun: str) -> Callable[[int], tuple[str, int, bool]]:
+    def describe(status: int) -> tuple[str, int, bool]:
+        line = _line_text(text, report.offset)
+        key = table.keys[report.key].decode("utf-8", "replace") if report.key >= 0 else None
+        frame = report.first_frame + report.frames - 1
+        truncated = False
+        if status == lib.MT_ESYNTAX:
+            tokens = line.split()
+            token = tokens[report.found + 1] if report.found + 1 < len(tokens) else ""
+            reason = f"expected a number as value {report.found + 1} of {noun} '{key}', found '{token}'"
+        elif status == lib.MT_ECOUNT:
+            reason = f"{noun} '{key}' takes {report.expected} value(s), found {report.found}: '{line[:80]}'"
+        elif status == lib.MT_EUNKNOWN:
+            token = line.split()[0] if line else ""
+            reason = f"unknown {noun} '{token}'; expected one of: " + ", ".join(
+                k.decode("utf-8", "replace") for k in table.keys[:8]
+            ) + (", ..." if len(table.keys) > 8 else "")
+        elif status == lib.MT_EDUPLICATE:
+            reason = f"{noun} '{key}' appears twice in frame {frame}"
+        elif status == lib.MT_EMISSING:
+            truncated = report.offset >= len(text) or not text[report.offset:].strip()
+            reason = f"frame {frame} has no line for {noun} '{key}'" + (
+                " (the file ends there: truncated?)" if truncated else ""
+            )
+        elif report.expected == -1:
+            reason = f"expected a frame number, found '{line[:80]}'"
+        else:
+            reason = f"frame number {report.found} out of sequence: expected {report.expected}"
+        return reason, int(report.line), truncated
+
+    return describe
+
+
+def format_frames(
+    values: np.ndarray,
+    first_frame: int,
+    keys: Sequence[bytes],
+    offsets: Sequence[int],
+    counts: Sequence[int],
+    write: Callable[[bytes], object],
+) -> None:
+    """Write (frames, channels) values as frame text through ``write``, in chunks.
+
+    Key lines come in the order of ``keys``; every number is the shortest text
+    that reads back to exactly the same float64.
+    """
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    if values.ndim != 2:
+        raise ValueError(f"values must be (frames, channels), got shape {values.shape}")
+    frames, channels = values.shape
+    table = _KeyTable(keys, offsets, counts, channels)
+    chunk = max(1, min(frames, _FORMAT_CHUNK))
+    buf = bytearray(lib.mt_format_bound(chunk, table.c_lens, table.c_counts, table.n))
+    written = ffi.new("size_t *")
+    with ffi.from_buffer("double[]", values) as c_values, ffi.from_buffer(buf) as c_buf:
+        for f0 in range(0, frames, chunk):
+            n = min(chunk, frames - f0)
+            status = lib.mt_format_frames(
+                c_values + f0 * channels, n, channels, first_frame + f0, table.c_keys, table.c_lens,
+                table.c_offsets, table.c_counts, table.n, c_buf, len(buf), written,
+            )
+            check(status, "mt_format_frames")
+            write(bytes(memoryview(buf)[: written[0]]))
+
+
+def format_number(value: float) -> str:
+    """The shortest text that reads back as exactly ``value`` (``%g`` style: 17.8693, 1e-05, 3)."""
+    buf = ffi.new("char[]", lib.MT_NUMBER_MAX)
+    return ffi.unpack(buf, lib.mt_format_double(float(value), buf)).decode("ascii")
