@@ -1,22 +1,58 @@
 """motiontheater: motion-capture data (ASF/AMC, BVH) read, cut, splice and smoothed.
 
-The numeric work is done by :mod:`mtcore`, the package's C core; its
-smoothing filters are re-exported here.
+Skeletons and motions are read and written exactly (:func:`read_asf`,
+:func:`read_amc`, :func:`write_asf`, :func:`write_amc`); the numeric work is
+done by :mod:`mtcore`, the package's C core, whose smoothing filters are
+re-exported here.
 """
 
 from importlib.metadata import PackageNotFoundError, version
-
-from mtcore import binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
 
 try:
     __version__ = version("motiontheater")
 except PackageNotFoundError:  # running from a source tree that was never installed
     __version__ = "0+unknown"
 
+from mtcore import binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
+from mtcore.errors import (
+    CountError,
+    DuplicateError,
+    FormatError,
+    HierarchyError,
+    MissingError,
+    NumberError,
+    SequenceError,
+    TruncatedError,
+    UnknownNameError,
+)
+
+from .amc import read_amc, write_amc
+from .asf import read_asf, write_asf
+from .motion import DEFAULT_FRAME_RATE, Motion
+from .skeleton import Bone, Root, Skeleton
+
 __all__ = [
+    "DEFAULT_FRAME_RATE",
+    "Bone",
+    "CountError",
+    "DuplicateError",
+    "FormatError",
+    "HierarchyError",
+    "MissingError",
+    "Motion",
+    "NumberError",
+    "Root",
+    "SequenceError",
+    "Skeleton",
+    "TruncatedError",
+    "UnknownNameError",
     "__version__",
     "binomial_filter1d",
     "median_filter1d",
     "pascal_weights",
+    "read_amc",
+    "read_asf",
     "uniform_filter1d",
+    "write_amc",
+    "write_asf",
 ]

@@ -57,37 +57,42 @@ def scan_frames(
     counts: Sequence[int],
     channels: int,
     *,
+    start: int = 0,
     noun: str = "key",
 ) -> tuple[np.ndarray, int]:
-    """Scan frame text into a new (frames, channels) float64 array.
+    """Scan the frame text ``text[start:]`` into a new (frames, channels) float64 array.
 
     Returns the array and the number of the first frame (0 when there are
     none).  Columns that no key fills are NaN.  Raises a
     :class:`~mtcore.errors.FormatError` subclass whose ``line`` counts from 1 at
-    the start of ``text`` and whose message calls keys ``noun``.
+    ``text[start]`` and whose message calls keys ``noun``.
     """
     table = _KeyTable(keys, offsets, counts, channels)
+    if not 0 <= start <= len(text):
+        raise ValueError(f"start must be within the text's {len(text)} bytes, got {start}")
     required = sum(1 for c in counts if c > 0)
-    # Every frame takes its number line and one line per key with numbers.
-    capacity = lib.mt_count_lines(text, len(text)) // (1 + required) + 1
-    values = np.empty((capacity, channels))
-    if len(table.counts) and sum(table.counts) < channels:
-        values.fill(np.nan)
+    size = len(text) - start
     report = ffi.new("struct mt_scan_report *")
-    with ffi.from_buffer(text) as c_text, ffi.from_buffer("double[]", values) as c_values:
-        status = lib.mt_scan_frames(
-            c_text, len(text), table.c_keys, table.c_lens, table.c_offsets, table.c_counts, table.n,
-            c_values, capacity, channels, report,
-        )
-    check(status, "mt_scan_frames", _describer(text, table, report, noun))
+    with ffi.from_buffer(text) as c_text:
+        # Every frame takes its number line and one line per key with numbers.
+        capacity = lib.mt_count_lines(c_text + start, size) // (1 + required) + 1
+        values = np.empty((capacity, channels))
+        if sum(table.counts) < channels:
+            values.fill(np.nan)
+        with ffi.from_buffer("double[]", values) as c_values:
+            status = lib.mt_scan_frames(
+                c_text + start, size, table.c_keys, table.c_lens, table.c_offsets, table.c_counts,
+                table.n, c_values, capacity, channels, report,
+            )
+    check(status, "mt_scan_frames", _describer(text, start, table, report, noun))
     # Shrinks in place (realloc); the pages past the frames were never touched.
     values.resize((report.frames, channels), refcheck=False)
     return values, int(report.first_frame)
 
 
-def _describer(text: bytes, table: _KeyTable, report, noun: str) -> Callable[[int], tuple[str, int, bool]]:
+def _describer(text: bytes, start: int, table: _KeyTable, report, noun: str) -> Callable[[int], tuple[str, int, bool]]:
     def describe(status: int) -> tuple[str, int, bool]:
-        line = _line_text(text, report.offset)
+        line = _line_text(text, start + report.offset)
         key = table.keys[report.key].decode("utf-8", "replace") if report.key >= 0 else None
         frame = report.first_frame + report.frames - 1
         truncated = False
@@ -105,7 +110,7 @@ def _describer(text: bytes, table: _KeyTable, report, noun: str) -> Callable[[in
         elif status == lib.MT_EDUPLICATE:
             reason = f"{noun} '{key}' appears twice in frame {frame}"
         elif status == lib.MT_EMISSING:
-            truncated = report.offset >= len(text) or not text[report.offset:].strip()
+            truncated = not text[start + report.offset:].strip()
             reason = f"frame {frame} has no line for {noun} '{key}'" + (
                 " (the file ends there: truncated?)" if truncated else ""
             )

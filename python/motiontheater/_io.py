@@ -1,0 +1,54 @@
+"""Reading sources and writing targets: paths or file objects."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import tempfile
+from collections.abc import Iterator
+from typing import IO, Union
+
+Source = Union[str, os.PathLike, IO[bytes], IO[str]]
+
+LINE_BREAK = re.compile(r"\r\n|\r|\n")  # as the C scanner: CRLF, lone CR and LF each end a line
+
+
+def read_source(source: Source) -> tuple[bytes, str | None]:
+    """The bytes of a path or file object, and a name for messages."""
+    if isinstance(source, (str, os.PathLike)):
+        with open(source, "rb") as f:
+            return f.read(), os.fspath(source)
+    data = source.read()
+    if isinstance(data, str):
+        data = data.encode("utf-8", "surrogateescape")
+    return data, getattr(source, "name", None)
+
+
+def decode(data: bytes) -> str:
+    """Text of a file whose comments may hold any bytes: undecodable bytes survive
+    as surrogates and are written back unchanged by :func:`encode`."""
+    return data.decode("utf-8", "surrogateescape")
+
+
+def encode(text: str) -> bytes:
+    return text.encode("utf-8", "surrogateescape")
+
+
+@contextlib.contextmanager
+def output(target: Source) -> Iterator[IO[bytes]]:
+    """A binary stream to write to.  For a path, the text goes to a temporary file
+    beside it that replaces the path only when complete, so that a failure
+    leaves no partial file."""
+    if not isinstance(target, (str, os.PathLike)):
+        yield target.buffer if hasattr(target, "buffer") else target
+        return
+    directory = os.path.dirname(os.path.abspath(target))
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix="-" + os.path.basename(target), dir=directory)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            yield f
+        os.replace(tmp, target)
+    except BaseException:
+        os.unlink(tmp)
+        raise

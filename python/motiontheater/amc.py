@@ -1,0 +1,158 @@
+"""AMC (Acclaim Motion Capture): read and write, the numbers scanned in C."""
+
+from __future__ import annotations
+
+from mtcore import format_frames, format_number, scan_frames
+from mtcore.errors import FormatError
+
+from ._io import Source, decode, encode, output, read_source
+from .motion import DEFAULT_FRAME_RATE, Motion
+from .skeleton import Skeleton
+
+_RATE_KEYS = (":SAMPLES-PER-SECOND", ":SAMPLES_PER_SECOND", ":FRAME-RATE")
+
+
+def _layout(skeleton: Skeleton, joints) -> tuple[list[bytes], list[int], list[int]]:
+    """Keys, first columns and channel counts of the given joints in the canonical layout."""
+    start, offset = {}, 0
+    for joint in skeleton.joint_names:
+        start[joint] = offset
+        offset += len(skeleton.dofs(joint))
+    keys = [encode(j) for j in joints]
+    return keys, [start[j] for j in joints], [len(skeleton.dofs(j)) for j in joints]
+
+
+def _split_header(data: bytes) -> tuple[list[str], int, int]:
+    """Header lines (comments and ':' keywords), the byte offset of the body and its line count."""
+    header, pos, lines = [], 0, 0
+    while pos < len(data):
+        end = len(data)
+        for stop in (b"\n", b"\r"):
+            found = data.find(stop, pos, pos + 65536)
+            if found != -1:
+                end = min(end, found)
+        line = data[pos:end].strip()
+        if line and not line.startswith((b"#", b":")):
+            break
+        if line:
+            header.append(decode(line))
+        pos = end + (2 if data[end:end + 2] == b"\r\n" else 1)
+        lines += 1
+    return header, pos, lines
+
+
+def _header_rate(header: list[str], line_of) -> float | None:
+    for i, line in enumerate(header):
+        words = line.split()
+        if words and words[0].upper() in _RATE_KEYS:
+            try:
+                return float(words[1])
+            except (IndexError, ValueError):
+                raise FormatError(f"expected a number of frames per second after {words[0]}", line_of(i)) from None
+    return None
+
+
+def read_amc(source: Source, skeleton: Skeleton, frame_rate: float | None = None) -> Motion:
+    """Read an AMC file (path or file object) of ``skeleton`` into a :class:`Motion`.
+
+    Bones may come in any order within a frame (and in another order than
+    the ASF); bones without dofs may be listed or not; frames are numbered
+    consecutively from any start.  The frame rate is the header's
+    (``:SAMPLES-PER-SECOND``) when present, else ``frame_rate``, else
+    :data:`~motiontheater.motion.DEFAULT_FRAME_RATE` (120, that of CMU and
+    HDM05); a ``frame_rate`` that contradicts the header raises ValueError.
+    Values stay in the skeleton's units.  Bad input raises a
+    :class:`~mtcore.errors.FormatError` subclass naming the file, the line and
+    what was expected; an AMC of another skeleton fails on its first unknown
+    or missing bone.
+    """
+    data, name = read_source(source)
+    header, body, header_lines = _split_header(data)
+    try:
+        rate = _header_rate(header, lambda i: i + 1)
+        _check_angle_unit(header, skeleton)
+    except FormatError as e:
+        raise e.at(name) from None
+    if rate is not None and frame_rate is not None and rate != frame_rate:
+        raise ValueError(f"{name}: the header says {rate:g} frames per second, frame_rate={frame_rate:g}")
+    joints = skeleton.joint_names
+    keys, offsets, counts = _layout(skeleton, joints)
+    try:
+        values, first = scan_frames(data, keys, offsets, counts, len(skeleton.channels),
+                                    start=body, noun="bone")
+    except FormatError as e:
+        raise e.at(name, header_lines) from None
+    values.flags.writeable = False
+    return Motion(
+        skeleton=skeleton,
+        values=values,
+        frame_rate=rate or frame_rate or DEFAULT_FRAME_RATE,
+        first_frame=first if len(values) else 1,
+        header=tuple(header),
+        line_order=_first_frame_order(data, body, set(joints)),
+    )
+
+
+def _check_angle_unit(header: list[str], skeleton: Skeleton) -> None:
+    for i, line in enumerate(header):
+        word = line.strip().upper()
+        said = {":DEGREES": "deg", ":RADIANS": "rad"}.get(word)
+        if said is not None and said != skeleton.angle_unit:
+            raise FormatError(
+                f"the AMC says {word} but its skeleton's angles are in {skeleton.angle_unit}", i + 1
+            )
+
+
+def _first_frame_order(data: bytes, body: int, joints: set[str]) -> tuple[str, ...]:
+    """The bone lines of the first frame, in order."""
+    order, started = [], False
+    pos = body
+    while pos < len(data):
+        end = min((x for x in (data.find(b"\n", pos), data.find(b"\r", pos)) if x != -1), default=len(data))
+        words = data[pos:end].split()
+        pos = end + 1
+        if not words or words[0].startswith(b"#"):
+            continue
+        if words[0].isdigit() and len(words) == 1:
+            if started:
+                break
+            started = True
+            continue
+        name = decode(words[0])
+        if name in joints:
+            order.append(name)
+    return tuple(order)
+
+
+def write_amc(motion: Motion, target: Source) -> None:
+    """Write a motion as AMC text to a path (atomically) or a binary file object.
+
+    The header is the motion's (its rate line updated, or added when the rate
+    is not the default); bone lines follow the motion's ``line_order`` when it
+    has one, else the root and the bones with dofs in skeleton order.  Every
+    number is the shortest text that reads back to exactly the same float64.
+    """
+    skeleton = motion.skeleton
+    if motion.line_order is not None:
+        joints = list(motion.line_order)
+        joints += [j for j in skeleton.joint_names if j not in joints and skeleton.dofs(j)]
+    else:
+        joints = [j for j in skeleton.joint_names if skeleton.dofs(j)]
+    keys, offsets, counts = _layout(skeleton, joints)
+    with output(target) as f:
+        f.write(encode("".join(line + "\n" for line in _header_lines(motion))))
+        format_frames(motion.values, motion.first_frame, keys, offsets, counts, f.write)
+
+
+def _header_lines(motion: Motion) -> list[str]:
+    lines, rate_written = [], False
+    for line in motion.header:
+        words = line.split()
+        if words and words[0].upper() in _RATE_KEYS:
+            line = f"{words[0]} {format_number(motion.frame_rate)}"
+            rate_written = True
+        lines.append(line)
+    if not rate_written and motion.frame_rate != DEFAULT_FRAME_RATE:
+        lines.append(f":SAMPLES-PER-SECOND {format_number(motion.frame_rate)}")
+    return lines
+

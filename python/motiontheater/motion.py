@@ -1,0 +1,120 @@
+"""Motions: a skeleton's channels over frames."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from mtcore.errors import UnknownNameError
+
+from .skeleton import ROTATIONS, TRANSLATIONS, Skeleton
+
+DEFAULT_FRAME_RATE = 120.0
+"""Frames per second assumed for an AMC without a rate (CMU and HDM05 record at 120 Hz)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Motion:
+    """Channel values of a skeleton over consecutive frames, in file units.
+
+    ``values`` is float64 of shape (frames, channels), its columns in the
+    canonical layout ``skeleton.channels``: the root's channels in its order,
+    then each bone's dofs in bone order.  It is read-only: operations return
+    new motions (a writeable array given here is copied first).  Frames are
+    numbered from ``first_frame`` at ``frame_rate`` per second.  ``header``
+    and ``line_order`` are what the AMC file had (its header lines, and the
+    order of the bone lines in a frame), so that it is written back as found.
+    """
+
+    skeleton: Skeleton
+    values: np.ndarray
+    frame_rate: float = DEFAULT_FRAME_RATE
+    first_frame: int = 1
+    header: tuple[str, ...] = (":FULLY-SPECIFIED", ":DEGREES")
+    line_order: tuple[str, ...] | None = None
+
+    def __post_init__(self) -> None:
+        values = self.values
+        if not isinstance(values, np.ndarray) or values.dtype != np.float64 or values.flags.writeable:
+            values = np.array(values, dtype=np.float64)
+            values.flags.writeable = False
+        channels = len(self.skeleton.channels)
+        if values.ndim != 2 or values.shape[1] != channels:
+            raise ValueError(f"values must have shape (frames, {channels}) for this skeleton, got {values.shape}")
+        if not self.frame_rate > 0:
+            raise ValueError(f"frame_rate must be positive, got {self.frame_rate}")
+        object.__setattr__(self, "values", values)
+
+    def __repr__(self) -> str:
+        return (f"Motion(skeleton={self.skeleton.name!r}, frames={self.frames} from {self.first_frame}, "
+                f"channels={self.values.shape[1]}, frame_rate={self.frame_rate:g})")
+
+    @property
+    def frames(self) -> int:
+        return self.values.shape[0]
+
+    @property
+    def channels(self) -> tuple[tuple[str, str], ...]:
+        """(joint, dof) of each column of ``values``."""
+        return self.skeleton.channels
+
+    @property
+    def times(self) -> np.ndarray:
+        """Seconds of each frame from the first."""
+        return np.arange(self.frames) / self.frame_rate
+
+    def columns(self, joint: str, dofs: str | tuple[str, ...] | None = None) -> list[int]:
+        """Column indices of a joint's channels ("root" or a bone), all or the named dofs."""
+        available = self.skeleton.dofs(joint)
+        wanted = available if dofs is None else ((dofs,) if isinstance(dofs, str) else tuple(dofs))
+        start = self.channels.index((joint, available[0])) if available else 0
+        result = []
+        for dof in wanted:
+            dof = dof.lower()
+            if dof not in available:
+                raise UnknownNameError(f"joint '{joint}' has no channel '{dof}' (it has {', '.join(available) or 'none'})")
+            result.append(start + available.index(dof))
+        return result
+
+    def channel(self, joint: str, dof: str) -> np.ndarray:
+        """One channel over all frames (a read-only view)."""
+        return self.values[:, self.columns(joint, dof)[0]]
+
+    def replace(self, **changes) -> Motion:
+        """A new motion with some fields changed (values are copied if writeable)."""
+        return replace(self, **changes)
+
+    def with_units(self, *, length_factor: float = 1.0, length: str | None = None,
+                   angle: str | None = None) -> Motion:
+        """Lengths times ``length_factor`` (unit text ``length``) and angles in ``angle``
+        ("deg" or "rad"), for the skeleton and the values alike."""
+        skeleton = self.skeleton.with_units(length_factor=length_factor, length=length, angle=angle)
+        angle_factor = 1.0
+        if angle is not None and angle != self.skeleton.angle_unit:
+            angle_factor = np.pi / 180 if angle == "rad" else 180 / np.pi
+        factors = np.array([angle_factor if dof in ROTATIONS else length_factor if dof in (*TRANSLATIONS, "l") else 1.0
+                            for _, dof in self.channels])
+        values = self.values * factors
+        values.flags.writeable = False
+        header = tuple(_angle_header(line, skeleton.angle_unit) for line in self.header)
+        return replace(self, skeleton=skeleton, values=values, header=header)
+
+    def to_meters(self) -> Motion:
+        """Lengths in metres (CMU and HDM05: file value / 0.45 * 0.0254).  The
+        skeleton's ``:units length`` becomes 0.0254, which the Acclaim convention
+        reads as metres, so that files written from the result say what they hold."""
+        return self.with_units(length_factor=self.skeleton.meters_per_unit, length="0.0254")
+
+    def to_radians(self) -> Motion:
+        return self.with_units(angle="rad")
+
+    def to_degrees(self) -> Motion:
+        return self.with_units(angle="deg")
+
+
+def _angle_header(line: str, unit: str) -> str:
+    word = line.strip().upper()
+    if word in (":DEGREES", ":RADIANS"):
+        return ":RADIANS" if unit == "rad" else ":DEGREES"
+    return line
