@@ -119,7 +119,7 @@ struct mt_scan_report {
     long long expected;    /* numbers or frame number expected */
 };
 
-/* An upper bound on the number of lines of text (for sizing the output of mt_scan_frames). */
+/* Line breaks (LF, CRLF or CR) in text, plus one: sizes the output of mt_scan_frames. */
 size_t mt_count_lines(const char *text, size_t len);
 
 /* Scans frame text into values (max_frames x channels, row-major). */

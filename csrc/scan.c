@@ -109,10 +109,12 @@ static int parse_number(const char *p, const char *end, double *out)
 
 size_t mt_count_lines(const char *text, size_t len)
 {
-    size_t lines = 1;
-    for (size_t i = 0; i < len; i++)
-        lines += (text[i] == '\n') + (text[i] == '\r');
-    return lines;
+    if (len == 0)
+        return 1;
+    size_t lines = 1 + (text[len - 1] == '\r');
+    for (size_t i = 0; i + 1 < len; i++) /* LF, and CR not followed by LF */
+        lines += (text[i] == '\n') + (text[i] == '\r' && text[i + 1] != '\n');
+    return lines + (text[len - 1] == '\n');
 }
 
 /* A line holding one token of digits only: the frame number, or -1. */

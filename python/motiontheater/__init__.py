@@ -26,7 +26,7 @@ from mtcore.errors import (
     UnknownNameError,
 )
 
-from .amc import read_amc, write_amc
+from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Bone, Root, Skeleton
@@ -52,6 +52,7 @@ __all__ = [
     "pascal_weights",
     "read_amc",
     "read_asf",
+    "skeleton_path_for",
     "uniform_filter1d",
     "write_amc",
     "write_asf",

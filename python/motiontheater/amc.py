@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 from mtcore import format_frames, format_number, scan_frames
 from mtcore.errors import FormatError
 
@@ -10,6 +13,26 @@ from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Skeleton
 
 _RATE_KEYS = (":SAMPLES-PER-SECOND", ":SAMPLES_PER_SECOND", ":FRAME-RATE")
+
+
+def skeleton_path_for(amc_path: str | os.PathLike) -> Path:
+    """The ASF beside an AMC by the naming conventions of the big databases:
+    CMU ``01_02.amc`` -> ``01.asf`` (or ``01-walk.asf``), HDM05
+    ``HDM_bd_squat_003_120.amc`` -> ``HDM_bd.asf``, ``take.amc`` -> ``take.asf``.
+    The longest matching name wins; FileNotFoundError when none matches."""
+    amc = Path(amc_path)
+    best = None
+    for asf in amc.parent.iterdir():
+        if asf.suffix.lower() != ".asf":
+            continue
+        stem = asf.stem.split("-")[0]
+        rest = amc.stem[len(stem):]
+        if amc.stem.startswith(stem) and (rest == "" or rest[0] in "_-."):
+            if best is None or len(stem) > len(best.stem.split("-")[0]):
+                best = asf
+    if best is None:
+        raise FileNotFoundError(f"no skeleton (.asf) for {amc} in {amc.parent}")
+    return best
 
 
 def _layout(skeleton: Skeleton, joints) -> tuple[list[bytes], list[int], list[int]]:
