@@ -245,6 +245,7 @@ static int scan_text(const char *text, const char *end, struct scan *s, double *
             r->offset = (size_t)(p - text);
         }
     }
+    r->offset = (size_t)(end - text); /* a frame cut short here is a truncated file */
     if (frames > 0 && (r->key = missing_key(s, frames)) >= 0)
         return MT_EMISSING;
     r->frames = frames;

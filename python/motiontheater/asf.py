@@ -72,6 +72,7 @@ def read_asf(source: Source) -> Skeleton:
 def _parse(lines: _Lines) -> Skeleton:
     fields: dict = {"units": (), "documentation": ()}
     bones: list[Bone] = []
+    bone_lines: list[int] = []
     pairs: list[tuple[str, tuple[str, ...]]] = []
     root = None
     hierarchy_line = None
@@ -101,7 +102,9 @@ def _parse(lines: _Lines) -> Skeleton:
         elif keyword == ":root":
             root = _parse_root(lines, number)
         elif keyword == ":bonedata":
-            bones.extend(_parse_bones(lines))
+            for bone, line in _parse_bones(lines):
+                bones.append(bone)
+                bone_lines.append(line)
         elif keyword == ":hierarchy":
             hierarchy_line = number
             pairs.extend(_parse_hierarchy(lines, number))
@@ -111,11 +114,11 @@ def _parse(lines: _Lines) -> Skeleton:
         raise MissingError("no :root section")
     if bones and hierarchy_line is None:
         raise MissingError("no :hierarchy section (is the file truncated?)", lines.items[-1][0])
-    names = set()
-    for bone in bones:
-        if bone.name in names:
-            raise DuplicateError(f"bone '{bone.name}' is defined twice")
-        names.add(bone.name)
+    first_line: dict[str, int] = {}
+    for bone, line in zip(bones, bone_lines):
+        if bone.name in first_line:
+            raise DuplicateError(f"bone '{bone.name}' is defined twice (first at line {first_line[bone.name]})", line)
+        first_line[bone.name] = line
     try:
         return Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs), root=root, **fields)
     except FormatError as e:
@@ -144,17 +147,16 @@ def _parse_root(lines: _Lines, line: int) -> Root:
     return Root(**values)
 
 
-def _parse_bones(lines: _Lines) -> list[Bone]:
-    bones = []
+def _parse_bones(lines: _Lines):
+    """(bone, line of its name) for each bone block."""
     while lines.more_in_section():
         n, text, toks = lines.next()
         if toks[0].lower() != "begin":
             raise FormatError(f"expected 'begin' of a bone, found '{text[:40]}'", n)
-        bones.append(_parse_bone(lines, n))
-    return bones
+        yield _parse_bone(lines, n)
 
 
-def _parse_bone(lines: _Lines, begin: int) -> Bone:
+def _parse_bone(lines: _Lines, begin: int) -> tuple[Bone, int]:
     values: dict = {}
     extra = []
     limit_text, limit_line = None, begin
@@ -170,7 +172,7 @@ def _parse_bone(lines: _Lines, begin: int) -> Bone:
         elif key == "name":
             if len(args) != 1:
                 raise CountError(f"a bone name is one word, found {len(args)}", n)
-            values["name"] = args[0]
+            values["name"], name_line = args[0], n
         elif key == "direction":
             values["direction"] = _numbers(args, 3, n, "direction")
         elif key == "length":
@@ -201,7 +203,7 @@ def _parse_bone(lines: _Lines, begin: int) -> Bone:
                              f"but {len(found)} limits", limit_line)
         values["limits"] = tuple((_number(lo, limit_line, "a limit"), _number(hi, limit_line, "a limit"))
                                  for lo, hi in found)
-    return Bone(extra=tuple(extra), **values)
+    return Bone(extra=tuple(extra), **values), name_line
 
 
 def _parse_hierarchy(lines: _Lines, line: int):

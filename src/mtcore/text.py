@@ -95,7 +95,9 @@ def _describer(text: bytes, start: int, table: _KeyTable, report, noun: str) -> 
         line = _line_text(text, start + report.offset)
         key = table.keys[report.key].decode("utf-8", "replace") if report.key >= 0 else None
         frame = report.first_frame + report.frames - 1
-        truncated = False
+        rest = text[start + report.offset:]
+        # An error in a last line that has no line break: the file was cut there.
+        truncated = not rest.strip() or not any(c in rest for c in b"\r\n")
         if status == lib.MT_ESYNTAX:
             tokens = line.split()
             token = tokens[report.found + 1] if report.found + 1 < len(tokens) else ""
@@ -110,14 +112,13 @@ def _describer(text: bytes, start: int, table: _KeyTable, report, noun: str) -> 
         elif status == lib.MT_EDUPLICATE:
             reason = f"{noun} '{key}' appears twice in frame {frame}"
         elif status == lib.MT_EMISSING:
-            truncated = not text[start + report.offset:].strip()
-            reason = f"frame {frame} has no line for {noun} '{key}'" + (
-                " (the file ends there: truncated?)" if truncated else ""
-            )
+            reason = f"frame {frame} has no line for {noun} '{key}'"
         elif report.expected == -1:
             reason = f"expected a frame number, found '{line[:80]}'"
         else:
             reason = f"frame number {report.found} out of sequence: expected {report.expected}"
+        if truncated:
+            reason += " (the file ends there: truncated?)"
         return reason, int(report.line), truncated
 
     return describe
