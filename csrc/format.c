@@ -90,12 +90,12 @@ static int shortest_slow(double a, char *digits, int *e10)
 size_t mt_format_double(double value, char *buf)
 {
     char *out = buf;
-    if (isnan(value)) {
-        memcpy(out, "nan", 3);
-        return 3;
-    }
     if (signbit(value))
         *out++ = '-';
+    if (isnan(value)) { /* the sign survives text; a NaN's payload does not */
+        memcpy(out, "nan", 3);
+        return (size_t)(out - buf) + 3;
+    }
     double a = fabs(value);
     if (isinf(a)) {
         memcpy(out, "inf", 3);

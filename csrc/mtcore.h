@@ -130,7 +130,8 @@ int mt_scan_frames(const char *text, size_t len, const char *const *keys, const 
 /*
  * Writes the shortest decimal text that reads back as exactly `value` into
  * buf (at least MT_NUMBER_MAX bytes, not NUL-terminated); returns its length.
- * Style of printf %g and Python repr: 17.8693, 1.23246e-13, 3, -0, nan, inf.
+ * Style of printf %g and Python repr: 17.8693, 1.23246e-13, 3, -0, -nan, inf;
+ * a NaN keeps its sign but not its payload.
  */
 size_t mt_format_double(double value, char *buf);
 

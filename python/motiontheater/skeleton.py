@@ -75,6 +75,10 @@ class Skeleton:
     def __post_init__(self) -> None:
         index: dict[str, int] = {}
         for i, bone in enumerate(self.bones):
+            name = bone.name
+            if not name or name.split() != [name] or name[0] in "#:" or name.isdigit():
+                raise ValueError(f"bone name {name!r} cannot be written to ASF/AMC: it must be one word, "
+                                 "not all digits, not starting with '#' or ':'")
             if bone.name == "root":
                 raise DuplicateError("a bone may not be called 'root': the name belongs to the root")
             if bone.name in index:
