@@ -1,27 +1,29 @@
 """Collects every benchmark's timing and prints the ratio table at the end of the run.
 
-Each case (a shape, a filter, a size, an output style) is measured for mtcore
-and for its references in the same run; the table gives throughput and the
-ratios the issues set as targets.  Ratios use each benchmark's fastest round,
-the figure least disturbed by other load on a shared machine.
+Each case (a shape, a filter, a size, a file) is measured for mtcore and for
+its references in the same run; the table gives throughput and the ratios
+the issues set as targets.  Ratios use each benchmark's fastest round, the
+figure least disturbed by other load on a shared machine.
 """
 
 from collections import defaultdict
 
 import pytest
 
-RESULTS: dict[str, dict[str, tuple[float, int]]] = defaultdict(dict)
+RESULTS: dict[str, dict[str, tuple[float, float, str]]] = defaultdict(dict)
 CEILING: dict[str, str] = {}  # case -> the case holding its memory-copy reference
 TARGETS: dict[str, str] = {}
+NOTES: list[str] = []  # measured facts that are not timings (peak memory)
 
 
 @pytest.fixture
 def record(benchmark):
     """File this test's fastest round under ``case`` as measured for ``who``
-    ("mtcore", "scipy" or "copy") over ``values`` values."""
+    ("mtcore", "copy" or a peer's name) over ``amount`` of ``unit`` (values or MB)."""
 
-    def _record(case: str, who: str, values: int, ceiling: str = "", target: str = "") -> None:
-        RESULTS[case][who] = (benchmark.stats.stats.min, values)
+    def _record(case: str, who: str, amount: float, ceiling: str = "", target: str = "",
+                unit: str = "M values") -> None:
+        RESULTS[case][who] = (benchmark.stats.stats.min, amount, unit)
         if ceiling:
             CEILING[case] = ceiling
         if target:
@@ -30,9 +32,13 @@ def record(benchmark):
     return _record
 
 
-def _rate(entry):
-    seconds, values = entry
-    return values / seconds
+def _rate(entry) -> float:
+    seconds, amount, _ = entry
+    return amount / seconds
+
+
+def _time(seconds: float) -> str:
+    return f"{seconds * 1e6:.1f} us" if seconds < 1e-3 else f"{seconds * 1e3:.1f} ms"
 
 
 def pytest_terminal_summary(terminalreporter):
@@ -40,22 +46,20 @@ def pytest_terminal_summary(terminalreporter):
         return
     write = terminalreporter.write_line
     write("")
-    write("| case | mtcore | M values/s | vs copy | vs scipy | target |")
-    write("|---|---:|---:|---:|---:|---|")
+    write("| case | mtcore | rate | vs copy | vs peers | target |")
+    write("|---|---:|---:|---:|---|---|")
     for case, whos in RESULTS.items():
         if case in CEILING.values():
-            seconds, values = whos["copy"]
-            write(f"| {case} | {seconds * 1e3:.1f} ms | {values / seconds / 1e6:.0f} | 100% | - | ceiling |")
+            entry = whos["copy"]
+            write(f"| {case} | {_time(entry[0])} | {_rate(entry) / 1e6:.0f} {entry[2]}/s | 100% | - | ceiling |")
             continue
         ours = whos.get("mtcore")
         if ours is None:
             continue
         ref = RESULTS.get(CEILING.get(case, ""), {}).get("copy")
-        sci = whos.get("scipy")
-        t = ours[0]
-        time_text = f"{t * 1e6:.1f} us" if t < 1e-3 else f"{t * 1e3:.1f} ms"
         vs_copy = f"{_rate(ours) / _rate(ref):.0%}" if ref else "-"
-        vs_scipy = f"{sci[0] / t:.0f}x" if sci else "-"
-        write(
-            f"| {case} | {time_text} | {_rate(ours) / 1e6:.0f} | {vs_copy} | {vs_scipy} | {TARGETS.get(case, '')} |"
-        )
+        peers = ", ".join(f"{who} {_rate(ours) / _rate(e):.0f}x" for who, e in whos.items() if who != "mtcore")
+        write(f"| {case} | {_time(ours[0])} | {_rate(ours) / 1e6:.0f} {ours[2]}/s | {vs_copy} | "
+              f"{peers or '-'} | {TARGETS.get(case, '')} |")
+    for note in NOTES:
+        write(note)

@@ -119,9 +119,6 @@ struct mt_scan_report {
     long long expected;    /* numbers or frame number expected */
 };
 
-/* Line breaks (LF, CRLF or CR) in text, plus one: sizes the output of mt_scan_frames. */
-size_t mt_count_lines(const char *text, size_t len);
-
 /* Scans frame text into values (max_frames x channels, row-major). */
 int mt_scan_frames(const char *text, size_t len, const char *const *keys, const size_t *key_lens,
                    const size_t *offsets, const size_t *counts, size_t nkeys, double *values,

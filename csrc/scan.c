@@ -107,16 +107,6 @@ static int parse_number(const char *p, const char *end, double *out)
     return 1;
 }
 
-size_t mt_count_lines(const char *text, size_t len)
-{
-    if (len == 0)
-        return 1;
-    size_t lines = 1 + (text[len - 1] == '\r');
-    for (size_t i = 0; i + 1 < len; i++) /* LF, and CR not followed by LF */
-        lines += (text[i] == '\n') + (text[i] == '\r' && text[i + 1] != '\n');
-    return lines + (text[len - 1] == '\n');
-}
-
 /* A line holding one token of digits only: the frame number, or -1. */
 static long long frame_number(const char *tok, const char *tok_end, const char *line_rest,
                               const char *end)

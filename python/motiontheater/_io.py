@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import mmap
 import os
 import re
 import tempfile
@@ -23,6 +24,17 @@ def read_source(source: Source) -> tuple[bytes, str | None]:
     if isinstance(data, str):
         data = data.encode("utf-8", "surrogateescape")
     return data, getattr(source, "name", None)
+
+
+@contextlib.contextmanager
+def mapped_source(source: Source) -> Iterator[tuple[bytes | mmap.mmap, str | None]]:
+    """Like :func:`read_source`, but a file named by path is memory-mapped, not
+    copied: large takes are scanned straight from the page cache."""
+    if not isinstance(source, (str, os.PathLike)) or os.path.getsize(source) == 0:
+        yield read_source(source)
+        return
+    with open(source, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
+        yield mapped, os.fspath(source)
 
 
 def decode(data: bytes) -> str:

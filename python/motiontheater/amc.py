@@ -8,7 +8,7 @@ from pathlib import Path
 from mtcore import format_frames, format_number, scan_frames
 from mtcore.errors import FormatError
 
-from ._io import Source, decode, encode, output, read_source
+from ._io import Source, decode, encode, mapped_source, output
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Skeleton
 
@@ -89,7 +89,11 @@ def read_amc(source: Source, skeleton: Skeleton, frame_rate: float | None = None
     what was expected; an AMC of another skeleton fails on its first unknown
     or missing bone.
     """
-    data, name = read_source(source)
+    with mapped_source(source) as (data, name):
+        return _read(data, name, skeleton, frame_rate)
+
+
+def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None) -> Motion:
     header, body, header_lines = _split_header(data)
     try:
         rate = _header_rate(header, lambda i: i + 1)

@@ -70,23 +70,26 @@ def scan_frames(
     table = _KeyTable(keys, offsets, counts, channels)
     if not 0 <= start <= len(text):
         raise ValueError(f"start must be within the text's {len(text)} bytes, got {start}")
-    required = sum(1 for c in counts if c > 0)
     size = len(text) - start
+    # A frame takes at least a digit and, for each key with numbers, the key and
+    # a digit and a blank per number.  Pages past the frames found are never
+    # touched, so the excess costs address space, not memory.
+    least = 1 + sum(len(k) + 2 * c for k, c in zip(keys, counts) if c > 0)
+    capacity = size // least + 1
+    values = np.empty((capacity, channels))
     report = ffi.new("struct mt_scan_report *")
     with ffi.from_buffer(text) as c_text:
-        # Every frame takes its number line and one line per key with numbers.
-        capacity = lib.mt_count_lines(c_text + start, size) // (1 + required) + 1
-        values = np.empty((capacity, channels))
-        if sum(table.counts) < channels:
-            values.fill(np.nan)
         with ffi.from_buffer("double[]", values) as c_values:
             status = lib.mt_scan_frames(
                 c_text + start, size, table.c_keys, table.c_lens, table.c_offsets, table.c_counts,
                 table.n, c_values, capacity, channels, report,
             )
     check(status, "mt_scan_frames", _describer(text, start, table, report, noun))
-    # Shrinks in place (realloc); the pages past the frames were never touched.
-    values.resize((report.frames, channels), refcheck=False)
+    values.resize((report.frames, channels), refcheck=False)  # in place: realloc
+    covered = np.zeros(channels, bool)
+    for offset, count in zip(offsets, counts):
+        covered[offset:offset + count] = True
+    values[:, ~covered] = np.nan
     return values, int(report.first_frame)
 
 
