@@ -55,56 +55,66 @@ static int parse_slow(const char *p, const char *end, double *out)
     return n > 0 && stop == buf + n;
 }
 
-/* Parses the token [p, end) as a number; 0 if it is not one. */
-static int parse_number(const char *p, const char *end, double *out)
+/* Appends the digits at p to *mantissa, two per step to halve the multiply chain. */
+static const char *take_digits(const char *p, const char *end, uint64_t *mantissa)
+{
+    uint64_t m = *mantissa;
+    while (p + 1 < end && is_digit(p[0]) && is_digit(p[1])) {
+        m = m * 100 + (uint64_t)((p[0] - '0') * 10 + (p[1] - '0'));
+        p += 2;
+    }
+    if (p < end && is_digit(*p))
+        m = m * 10 + (uint64_t)(*p++ - '0');
+    *mantissa = m;
+    return p;
+}
+
+/*
+ * Parses the number that starts at p, before end; returns the end of its
+ * token, or NULL if the token is not a number.  One pass for the usual
+ * decimals; other tokens are measured and handed to strtod.
+ */
+static const char *parse_number(const char *p, const char *end, double *out)
 {
     const char *start = p;
     int negative = 0;
     if (p < end && (*p == '-' || *p == '+'))
         negative = *p++ == '-';
+    /* Digits go into the mantissa unchecked; more than 19 of them (leading
+       zeros included, which is rare) take the slow path below. */
     uint64_t mantissa = 0;
-    int significant = 0, exp10 = 0, digits = 0;
-    for (; p < end && is_digit(*p); p++, digits++) {
-        if (significant < 19) {
-            mantissa = mantissa * 10 + (uint64_t)(*p - '0');
-            significant += mantissa != 0;
-        } else {
-            exp10++;
-        }
-    }
+    const char *first = p;
+    p = take_digits(p, end, &mantissa);
+    int digits = (int)(p - first), exp10 = 0;
     if (p < end && *p == '.') {
-        for (p++; p < end && is_digit(*p); p++, digits++) {
-            if (significant < 19) {
-                mantissa = mantissa * 10 + (uint64_t)(*p - '0');
-                significant += mantissa != 0;
-                exp10--;
-            } else if (*p != '0') {
-                return parse_slow(start, end, out); /* digits beyond what the fast path keeps */
-            }
+        const char *fraction = ++p;
+        p = take_digits(p, end, &mantissa);
+        exp10 = -(int)(p - fraction);
+        digits -= exp10;
+    }
+    const int exact = digits <= 19;
+    if (p < end && (*p == 'e' || *p == 'E') && digits > 0) {
+        const char *e = p + 1;
+        int eneg = 0, evalue = 0;
+        if (e < end && (*e == '-' || *e == '+'))
+            eneg = *e++ == '-';
+        if (e < end && is_digit(*e)) {
+            for (; e < end && is_digit(*e); e++)
+                if (evalue < 100000)
+                    evalue = evalue * 10 + (*e - '0');
+            exp10 += eneg ? -evalue : evalue;
+            p = e;
         }
     }
-    if (digits == 0)
-        return parse_slow(start, end, out); /* inf, nan or not a number */
-    if (p < end && (*p == 'e' || *p == 'E')) {
-        ++p;
-        int eneg = 0, evalue = 0;
-        if (p < end && (*p == '-' || *p == '+'))
-            eneg = *p++ == '-';
-        if (p == end || !is_digit(*p))
-            return parse_slow(start, end, out);
-        for (; p < end && is_digit(*p); p++)
-            if (evalue < 100000)
-                evalue = evalue * 10 + (*p - '0');
-        exp10 += eneg ? -evalue : evalue;
+    if (digits > 0 && exact && (p == end || is_blank(*p) || is_eol(*p)) &&
+        mantissa <= ((uint64_t)1 << 53) && exp10 >= -22 && exp10 <= 22) {
+        double v = (double)mantissa;
+        v = exp10 < 0 ? v / exact_pow10[-exp10] : v * exact_pow10[exp10];
+        *out = negative ? -v : v;
+        return p;
     }
-    if (p != end)
-        return parse_slow(start, end, out);
-    if (mantissa > ((uint64_t)1 << 53) || exp10 < -22 || exp10 > 22)
-        return parse_slow(start, end, out);
-    double v = (double)mantissa;
-    v = exp10 < 0 ? v / exact_pow10[-exp10] : v * exact_pow10[exp10];
-    *out = negative ? -v : v;
-    return 1;
+    const char *stop = token_end(start, end); /* inf, nan, long or odd forms */
+    return parse_slow(start, stop, out) ? stop : NULL;
 }
 
 /* A line holding one token of digits only: the frame number, or -1. */
@@ -134,15 +144,24 @@ struct scan {
     size_t norder;
 };
 
+/* Keys are a few bytes long: an inline loop beats a call to memcmp. */
+static int same_key(const struct scan *s, size_t k, const char *tok, size_t n)
+{
+    if (s->key_lens[k] != n)
+        return 0;
+    const char *key = s->keys[k];
+    for (size_t i = 0; i < n; i++)
+        if (key[i] != tok[i])
+            return 0;
+    return 1;
+}
+
 static long long find_key(const struct scan *s, const char *tok, size_t n, size_t position)
 {
-    if (position < s->norder) {
-        size_t k = s->order[position];
-        if (s->key_lens[k] == n && memcmp(s->keys[k], tok, n) == 0)
-            return (long long)k;
-    }
+    if (position < s->norder && same_key(s, s->order[position], tok, n))
+        return (long long)s->order[position];
     for (size_t k = 0; k < s->nkeys; k++)
-        if (s->key_lens[k] == n && memcmp(s->keys[k], tok, n) == 0)
+        if (same_key(s, k, tok, n))
             return (long long)k;
     return -1;
 }
@@ -212,8 +231,12 @@ static int scan_text(const char *text, const char *end, struct scan *s, double *
                         p++;
                     if (p == end || is_eol(*p))
                         break;
-                    const char *stop = token_end(p, end);
-                    if (i < count && !parse_number(p, stop, &dst[i])) {
+                    if (i >= count) { /* too many: count them for the report */
+                        p = token_end(p, end);
+                        continue;
+                    }
+                    const char *stop = parse_number(p, end, &dst[i]);
+                    if (stop == NULL) {
                         r->found = (long long)i;
                         return MT_ESYNTAX;
                     }

@@ -8,12 +8,16 @@ and columns.
 
 from __future__ import annotations
 
+import operator
+import re
 from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from ._mtcore import ffi, lib
+from ._parallel import cpu_count, run_all
 from ._status import check
+from .errors import SequenceError
 
 __all__ = ["scan_frames", "format_frames", "format_number"]
 
@@ -59,46 +63,97 @@ def scan_frames(
     *,
     start: int = 0,
     noun: str = "key",
+    workers: int | None = None,
 ) -> tuple[np.ndarray, int]:
     """Scan the frame text ``text[start:]`` into a new (frames, channels) float64 array.
 
     Returns the array and the number of the first frame (0 when there are
     none).  Columns that no key fills are NaN.  Raises a
     :class:`~mtcore.errors.FormatError` subclass whose ``line`` counts from 1 at
-    ``text[start]`` and whose message calls keys ``noun``.
+    ``text[start]`` and whose message calls keys ``noun``.  Texts of several
+    megabytes are cut at frame lines and scanned on all cores (``workers``
+    as for the filters: None for automatic, 1 for the calling thread only).
     """
     table = _KeyTable(keys, offsets, counts, channels)
     if not 0 <= start <= len(text):
         raise ValueError(f"start must be within the text's {len(text)} bytes, got {start}")
-    size = len(text) - start
     # A frame takes at least a digit and, for each key with numbers, the key and
     # a digit and a blank per number.  Pages past the frames found are never
     # touched, so the excess costs address space, not memory.
     least = 1 + sum(len(k) + 2 * c for k, c in zip(keys, counts) if c > 0)
-    capacity = size // least + 1
-    values = np.empty((capacity, channels))
-    report = ffi.new("struct mt_scan_report *")
-    with ffi.from_buffer(text) as c_text:
-        with ffi.from_buffer("double[]", values) as c_values:
-            status = lib.mt_scan_frames(
-                c_text + start, size, table.c_keys, table.c_lens, table.c_offsets, table.c_counts,
-                table.n, c_values, capacity, channels, report,
+    pieces = _pieces(text, start, _piece_count(workers, len(text) - start))
+    capacities = [(stop - begin) // least + 1 for begin, stop in pieces]
+    bases = np.cumsum([0, *capacities]).tolist()
+    values = np.empty((bases[-1], channels))
+    reports = [ffi.new("struct mt_scan_report *") for _ in pieces]
+    with ffi.from_buffer(text) as c_text, ffi.from_buffer("double[]", values) as c_values:
+
+        def piece(i: int):
+            begin, stop = pieces[i]
+            return lambda: lib.mt_scan_frames(
+                c_text + begin, stop - begin, table.c_keys, table.c_lens, table.c_offsets, table.c_counts,
+                table.n, c_values + bases[i] * channels, capacities[i], channels, reports[i],
             )
-    check(status, "mt_scan_frames", _describer(text, start, table, report, noun))
-    values.resize((report.frames, channels), refcheck=False)  # in place: realloc
+
+        statuses = run_all([piece(i) for i in range(len(pieces))])
+    frames = 0
+    for (begin, _), base, report, status in zip(pieces, bases, reports, statuses):
+        check(status, "mt_scan_frames", _describer(text, start, begin, table, report, noun))
+        if frames and report.frames and report.first_frame != first + frames:
+            raise SequenceError(f"frame number {report.first_frame} out of sequence: expected {first + frames}",
+                                _line_breaks(text, start, begin) + 1)
+        if not frames:
+            first = report.first_frame
+        values[frames:frames + report.frames] = values[base:base + report.frames]
+        frames += report.frames
+    values.resize((frames, channels), refcheck=False)  # in place: realloc
     covered = np.zeros(channels, bool)
     for offset, count in zip(offsets, counts):
         covered[offset:offset + count] = True
     values[:, ~covered] = np.nan
-    return values, int(report.first_frame)
+    return values, int(first) if frames else 0
 
 
-def _describer(text: bytes, start: int, table: _KeyTable, report, noun: str) -> Callable[[int], tuple[str, int, bool]]:
+_PIECE_BYTES = 4 << 20  # below this a text is scanned in one piece
+_FRAME_LINE = re.compile(rb"[\r\n][ \t]*\d+[ \t]*(?=[\r\n])")
+
+
+def _piece_count(workers: int | None, size: int) -> int:
+    wanted = cpu_count() if workers is None else (cpu_count() if workers == -1 else operator.index(workers))
+    if wanted < 1:
+        raise ValueError(f"workers must be a positive integer, -1 (every core) or None, got {wanted}")
+    return max(1, min(wanted, size // _PIECE_BYTES))
+
+
+def _pieces(text: bytes, start: int, count: int) -> list[tuple[int, int]]:
+    """Byte ranges that together cover text[start:], each beginning at a frame line."""
+    bounds = [start]
+    for i in range(1, count):
+        target = start + (len(text) - start) * i // count
+        match = _FRAME_LINE.search(text, max(target, bounds[-1]))
+        if match is None:
+            break
+        bounds.append(match.start() + 1)
+    bounds.append(len(text))
+    return list(zip(bounds, bounds[1:]))
+
+
+def _line_breaks(text: bytes, begin: int, end: int) -> int:
+    if begin == end:
+        return 0
+    part = text[begin:end]
+    return part.count(b"\n") + part.count(b"\r") - part.count(b"\r\n")
+
+
+def _describer(text: bytes, start: int, begin: int, table: _KeyTable, report,
+               noun: str) -> Callable[[int], tuple[str, int, bool]]:
+    """What went wrong in the piece of text that starts at ``begin`` (line numbers from ``start``)."""
+
     def describe(status: int) -> tuple[str, int, bool]:
-        line = _line_text(text, start + report.offset)
+        line = _line_text(text, begin + report.offset)
         key = table.keys[report.key].decode("utf-8", "replace") if report.key >= 0 else None
         frame = report.first_frame + report.frames - 1
-        rest = text[start + report.offset:]
+        rest = text[begin + report.offset:]
         # An error in a last line that has no line break: the file was cut there.
         truncated = not rest.strip() or not any(c in rest for c in b"\r\n")
         if status == lib.MT_ESYNTAX:
@@ -122,7 +177,7 @@ def _describer(text: bytes, start: int, table: _KeyTable, report, noun: str) -> 
             reason = f"frame number {report.found} out of sequence: expected {report.expected}"
         if truncated:
             reason += " (the file ends there: truncated?)"
-        return reason, int(report.line), truncated
+        return reason, _line_breaks(text, start, begin) + int(report.line), truncated
 
     return describe
 
