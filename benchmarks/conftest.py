@@ -58,7 +58,7 @@ def pytest_terminal_summary(terminalreporter):
             continue
         ref = RESULTS.get(CEILING.get(case, ""), {}).get("copy")
         vs_copy = f"{_rate(ours) / _rate(ref):.0%}" if ref else "-"
-        peers = ", ".join(f"{who} {_rate(ours) / _rate(e):.0f}x" for who, e in whos.items() if who != "mtcore")
+        peers = ", ".join(f"{who} {_rate(ours) / _rate(e):.1f}x" for who, e in whos.items() if who != "mtcore")
         write(f"| {case} | {_time(ours[0])} | {_rate(ours) / 1e6:.0f} {ours[2]}/s | {vs_copy} | "
               f"{peers or '-'} | {TARGETS.get(case, '')} |")
     for note in NOTES:

@@ -75,7 +75,8 @@ def _header_rate(header: list[str], line_of) -> float | None:
     return None
 
 
-def read_amc(source: Source, skeleton: Skeleton, frame_rate: float | None = None) -> Motion:
+def read_amc(source: Source, skeleton: Skeleton, frame_rate: float | None = None, *,
+             workers: int | None = None) -> Motion:
     """Read an AMC file (path or file object) of ``skeleton`` into a :class:`Motion`.
 
     Bones may come in any order within a frame (and in another order than
@@ -87,13 +88,15 @@ def read_amc(source: Source, skeleton: Skeleton, frame_rate: float | None = None
     Values stay in the skeleton's units.  Bad input raises a
     :class:`~mtcore.errors.FormatError` subclass naming the file, the line and
     what was expected; an AMC of another skeleton fails on its first unknown
-    or missing bone.
+    or missing bone.  Files of several megabytes are scanned on all cores;
+    ``workers=1`` keeps to the calling thread (as batch jobs in processes should).
     """
     with mapped_source(source) as (data, name):
-        return _read(data, name, skeleton, frame_rate)
+        return _read(data, name, skeleton, frame_rate, workers)
 
 
-def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None) -> Motion:
+def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None,
+          workers: int | None) -> Motion:
     header, body, header_lines = _split_header(data)
     try:
         rate = _header_rate(header, lambda i: i + 1)
@@ -106,7 +109,7 @@ def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float |
     keys, offsets, counts = _layout(skeleton, joints)
     try:
         values, first = scan_frames(data, keys, offsets, counts, len(skeleton.channels),
-                                    start=body, noun="bone")
+                                    start=body, noun="bone", workers=workers)
     except FormatError as e:
         raise e.at(name, header_lines) from None
     values.flags.writeable = False
