@@ -172,8 +172,14 @@ def test_frame_rate_from_header_argument_or_default(tmp_path):
 
 def test_angle_unit_contradiction(tmp_path):
     skeleton = mt.read_asf(write(tmp_path, "t.asf", ASF))
-    with pytest.raises(mt.FormatError, match=r"r.amc, line 2: the AMC says :RADIANS but its skeleton's angles are in deg"):
-        mt.read_amc(write(tmp_path, "r.amc", AMC.replace(b":DEGREES", b":RADIANS")), skeleton)
+    with pytest.raises(mt.FormatError, match=r"r.amc, line 4: the AMC says :RADIANS but its skeleton's angles are in deg"):
+        mt.read_amc(write(tmp_path, "r.amc", AMC.replace(b":DEGREES", b"\n\n:RADIANS")), skeleton)
+
+
+def test_bad_rate_line(tmp_path):
+    skeleton = mt.read_asf(write(tmp_path, "t.asf", ASF))
+    with pytest.raises(mt.FormatError, match=r"q.amc, line 3: expected a number of frames per second after :SAMPLES-PER-SECOND"):
+        mt.read_amc(write(tmp_path, "q.amc", AMC.replace(b":DEGREES", b"\n:SAMPLES-PER-SECOND fast")), skeleton)
 
 
 def test_failed_write_leaves_no_file(tmp_path, monkeypatch):

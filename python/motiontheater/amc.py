@@ -45,33 +45,31 @@ def _layout(skeleton: Skeleton, joints) -> tuple[list[bytes], list[int], list[in
     return keys, [start[j] for j in joints], [len(skeleton.dofs(j)) for j in joints]
 
 
-def _split_header(data: bytes) -> tuple[list[str], int, int]:
-    """Header lines (comments and ':' keywords), the byte offset of the body and its line count."""
+def _split_header(data: bytes) -> tuple[list[tuple[int, str]], int, int]:
+    """(line number, text) of the header lines (comments and ':' keywords),
+    the byte offset of the body and the number of lines before it."""
     header, pos, lines = [], 0, 0
     while pos < len(data):
-        end = len(data)
-        for stop in (b"\n", b"\r"):
-            found = data.find(stop, pos, pos + 65536)
-            if found != -1:
-                end = min(end, found)
+        ends = [i for i in (data.find(b"\n", pos), data.find(b"\r", pos)) if i != -1]
+        end = min(ends, default=len(data))
         line = data[pos:end].strip()
         if line and not line.startswith((b"#", b":")):
             break
-        if line:
-            header.append(decode(line))
-        pos = end + (2 if data[end:end + 2] == b"\r\n" else 1)
         lines += 1
+        if line:
+            header.append((lines, decode(line)))
+        pos = end + (2 if data[end:end + 2] == b"\r\n" else 1)
     return header, pos, lines
 
 
-def _header_rate(header: list[str], line_of) -> float | None:
-    for i, line in enumerate(header):
+def _header_rate(header: list[tuple[int, str]]) -> float | None:
+    for number, line in header:
         words = line.split()
         if words and words[0].upper() in _RATE_KEYS:
             try:
                 return float(words[1])
             except (IndexError, ValueError):
-                raise FormatError(f"expected a number of frames per second after {words[0]}", line_of(i)) from None
+                raise FormatError(f"expected a number of frames per second after {words[0]}", number) from None
     return None
 
 
@@ -99,7 +97,7 @@ def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float |
           workers: int | None) -> Motion:
     header, body, header_lines = _split_header(data)
     try:
-        rate = _header_rate(header, lambda i: i + 1)
+        rate = _header_rate(header)
         _check_angle_unit(header, skeleton)
     except FormatError as e:
         raise e.at(name) from None
@@ -118,19 +116,17 @@ def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float |
         values=values,
         frame_rate=rate or frame_rate or DEFAULT_FRAME_RATE,
         first_frame=first if len(values) else 1,
-        header=tuple(header),
+        header=tuple(text for _, text in header),
         line_order=_first_frame_order(data, body, set(joints)),
     )
 
 
-def _check_angle_unit(header: list[str], skeleton: Skeleton) -> None:
-    for i, line in enumerate(header):
+def _check_angle_unit(header: list[tuple[int, str]], skeleton: Skeleton) -> None:
+    for number, line in header:
         word = line.strip().upper()
         said = {":DEGREES": "deg", ":RADIANS": "rad"}.get(word)
         if said is not None and said != skeleton.angle_unit:
-            raise FormatError(
-                f"the AMC says {word} but its skeleton's angles are in {skeleton.angle_unit}", i + 1
-            )
+            raise FormatError(f"the AMC says {word} but its skeleton's angles are in {skeleton.angle_unit}", number)
 
 
 def _first_frame_order(data: bytes, body: int, joints: set[str]) -> tuple[str, ...]:
