@@ -149,6 +149,14 @@ def test_bad_asf(tmp_path, change, error, where, words):
     assert str(caught.value).startswith(f"{path}, line {line_of(bad, where)}: {words}")
 
 
+def test_unknown_sections_are_kept(tmp_path):
+    asf = ASF + b":skin\n  skin.obj\n  scale 2\n"
+    skeleton = mt.read_asf(write(tmp_path, "s.asf", asf))
+    assert skeleton.sections == ((":skin", ("skin.obj", "scale 2")),)
+    mt.write_asf(skeleton, tmp_path / "again.asf")
+    assert mt.read_asf(tmp_path / "again.asf") == skeleton
+
+
 def test_truncated_asf(tmp_path):
     for cut in (ASF.index(b"  end") - 3, ASF.index(b":hierarchy") - 1, len(ASF) - 6):
         path = write(tmp_path, "cut.asf", ASF[:cut])

@@ -71,6 +71,7 @@ def read_asf(source: Source) -> Skeleton:
 
 def _parse(lines: _Lines) -> Skeleton:
     fields: dict = {"units": (), "documentation": ()}
+    sections: list[tuple[str, tuple[str, ...]]] = []
     bones: list[Bone] = []
     bone_lines: list[int] = []
     pairs: list[tuple[str, tuple[str, ...]]] = []
@@ -109,7 +110,10 @@ def _parse(lines: _Lines) -> Skeleton:
             hierarchy_line = number
             pairs.extend(_parse_hierarchy(lines, number))
         else:
-            raise FormatError(f"unknown section '{tokens[0]}'", number)
+            body = []
+            while lines.more_in_section():
+                body.append(lines.next()[1])
+            sections.append((text, tuple(body)))
     if root is None:
         raise MissingError("no :root section")
     if bones and hierarchy_line is None:
@@ -120,7 +124,8 @@ def _parse(lines: _Lines) -> Skeleton:
             raise DuplicateError(f"bone '{bone.name}' is defined twice (first at line {first_line[bone.name]})", line)
         first_line[bone.name] = line
     try:
-        return Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs), root=root, **fields)
+        return Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs), root=root,
+                        sections=tuple(sections), **fields)
     except FormatError as e:
         e.line = e.line or hierarchy_line
         raise
@@ -268,5 +273,8 @@ def _asf_lines(s: Skeleton):
     yield "  begin"
     yield from (f"    {parent} {' '.join(children)}" for parent, children in s.hierarchy)
     yield "  end"
+    for keyword, body in s.sections:
+        yield keyword
+        yield from (f"  {line}" for line in body)
 
 

@@ -58,8 +58,11 @@ class Skeleton:
     ``bones`` are in ``:bonedata`` order; ``hierarchy`` lists (parent,
     children) with the root first and then the bones in ``bones`` order,
     children as the file lists them.  ``units`` keeps every ``:units`` key
-    with its text, unknown ones included.  Lengths and angles are in the
-    file's units (see :attr:`angle_unit` and :attr:`meters_per_unit`).
+    with its text, unknown ones included, and ``sections`` every section
+    this library does not interpret (``:skin`` and the like: keyword with
+    its line, then its lines), so that they are written back.  Lengths and
+    angles are in the file's units (see :attr:`angle_unit` and
+    :attr:`meters_per_unit`).
     """
 
     bones: tuple[Bone, ...]
@@ -69,6 +72,7 @@ class Skeleton:
     version: str = "1.10"
     units: tuple[tuple[str, str], ...] = (("mass", "1.0"), ("length", "1.0"), ("angle", "deg"))
     documentation: tuple[str, ...] = ()
+    sections: tuple[tuple[str, tuple[str, ...]], ...] = ()
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
     _parents: dict[str, str] = field(init=False, repr=False, compare=False)
 
