@@ -14,6 +14,7 @@
  * values wide; the driver then gathers TILE_LINES lines side by side into a
  * small tile, so that they become the channels, and scatters the results back.
  */
+#include "clones.h"
 #include "mtcore.h"
 
 #include <math.h>
@@ -34,17 +35,6 @@ enum {
 #define MT_IVDEP _Pragma("GCC ivdep")
 #else
 #define MT_IVDEP
-#endif
-
-/*
- * Kernels are compiled for the baseline and for newer x86-64 levels (AVX2,
- * AVX-512), and the loader picks the best the CPU has: portable wheels
- * without -march=native, at the speed of a native build.
- */
-#if defined(__x86_64__) && defined(__GNUC__) && defined(__ELF__) && !defined(MT_NO_CLONES)
-#define MT_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define MT_CLONES
 #endif
 
 /* Index into 0..n-1 of position r of the extended line, or -1 for the fill value. */

@@ -145,6 +145,56 @@ int mt_format_frames(const double *values, size_t frames, size_t channels, long 
 size_t mt_format_bound(size_t frames, const size_t *key_lens, const size_t *counts, size_t nkeys);
 
 enum { MT_NUMBER_MAX = 32 };
+
+/* Channels of a joint: rotations about, and translations along, its x, y, z; and stretch. */
+enum mt_dof {
+    MT_DOF_RX = 0,
+    MT_DOF_RY = 1,
+    MT_DOF_RZ = 2,
+    MT_DOF_TX = 3,
+    MT_DOF_TY = 4,
+    MT_DOF_TZ = 5,
+    MT_DOF_L = 6 /* translation along the bone's direction */
+};
+
+/*
+ * The rotation (3x3, row-major) of `count` rotations about the axes
+ * axes[i] (MT_DOF_RX .. RZ) by angles[i] * scale radians, applied in that
+ * order about fixed axes: R = R[count-1] ... R[1] R[0].
+ */
+int mt_axis_rotations(const int *axes, const double *angles, size_t count, double scale,
+                      double *out);
+
+/*
+ * Forward kinematics of a tree of joints over frames, ASF/AMC semantics.
+ *
+ * Joint j has parent[j] (-1 for a root); order[] lists every joint once,
+ * each after its parent.  Its rest data: axis[9j..] the orthonormal frame C
+ * of its channels (row-major), direction[3j..] its unit direction and
+ * segment[3j..] its bone vector (direction times length; for a root, its
+ * rest position).  Its channels are dof_kind[c] at column dof_column[c] of
+ * a frame's row of `channels` values, for c = dof_start[j] .. dof_start[j+1]-1.
+ *
+ * Per frame: M is the rotation of the joint's rotation channels, applied in
+ * their order about fixed axes (angles times angle_scale radians); its
+ * local rotation L = C M C^T; its world rotation W = W[parent] L (L for a
+ * root).  A root is at segment + t, t its translation channels in world
+ * axes; any other joint ends at the end of its parent plus
+ * W (segment + direction * l + C t), l its stretch and t its translations.
+ *
+ * Writes, for frames begin .. end-1, positions (frames x joints x 3) and,
+ * where not NULL, world and local (frames x joints x 9).  NaN in a channel
+ * gives NaN in that joint and its descendants.
+ */
+int mt_forward_kinematics(const double *values, size_t frames, size_t channels, size_t joints,
+                          const long long *parent, const long long *order, const double *axis,
+                          const double *direction, const double *segment, const size_t *dof_start,
+                          const int *dof_kind, const size_t *dof_column, double angle_scale,
+                          size_t begin, size_t end, double *positions, double *world,
+                          double *local);
+
+/* Unit quaternions (w, x, y, z), w >= 0, of n rotation matrices (3x3, row-major). */
+int mt_rotations_to_quaternions(const double *matrices, size_t n, double *quaternions);
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

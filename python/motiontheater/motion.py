@@ -7,7 +7,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from mtcore.errors import UnknownNameError
+from mtcore.kinematics import forward_kinematics, rotations_to_quaternions
 
+from .kinematics import joint_tree
 from .skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 
 DEFAULT_FRAME_RATE = 120.0
@@ -80,6 +82,29 @@ class Motion:
     def channel(self, joint: str, dof: str) -> np.ndarray:
         """One channel over all frames (a read-only view)."""
         return self.values[:, self.columns(joint, dof)[0]]
+
+    def positions(self, *, start: bool = False, meters: bool = False, workers: int | None = None) -> np.ndarray:
+        """World positions (frames, joints, 3) by forward kinematics, joints in
+        ``skeleton.joint_names`` order: the root's position, then each bone's end
+        point (its start point, the end of its parent, with ``start=True``).
+        In file length units, or metres with ``meters=True``.  NaN in a channel
+        gives NaN for that joint and the joints below it."""
+        tree = joint_tree(self.skeleton)
+        positions, _, _ = forward_kinematics(self.values, tree, workers=workers)
+        if start:
+            positions = positions[:, np.maximum(tree.parent, 0)]
+        return positions * self.skeleton.meters_per_unit if meters else positions
+
+    def rotations(self, *, local: bool = False, quaternions: bool = False,
+                  workers: int | None = None) -> np.ndarray:
+        """Each joint's rotation per frame: (frames, joints, 3, 3) matrices, or
+        (frames, joints, 4) unit quaternions (w, x, y, z), w >= 0.  World
+        rotations by default; ``local=True`` gives C M C^T, a joint's own
+        rotation in world-aligned axes (what the HDM05 toolbox stores)."""
+        _, world, own = forward_kinematics(self.values, joint_tree(self.skeleton), world=not local, local=local,
+                                           workers=workers)
+        matrices = own if local else world
+        return rotations_to_quaternions(matrices) if quaternions else matrices
 
     def replace(self, **changes) -> Motion:
         """A new motion with some fields changed (values are copied if writeable)."""

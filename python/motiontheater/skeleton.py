@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+import numpy as np
+
 from mtcore.errors import DuplicateError, HierarchyError, UnknownNameError
 
 Vec3 = tuple[float, float, float]
@@ -126,6 +128,18 @@ class Skeleton:
         """The canonical layout of motion values: (joint, dof) for the root's
         channels in its order, then each bone's dofs in bone order."""
         return tuple((j, d) for j in self.joint_names for d in self.dofs(j))
+
+    def rest_positions(self, *, start: bool = False) -> np.ndarray:
+        """The calibration pose: (joints, 3) positions in ``joint_names`` order,
+        the root at ``:root position`` and each bone's end point (start point
+        with ``start=True``), p = p(parent) + direction * length, in file units."""
+        from mtcore.kinematics import forward_kinematics  # kinematics builds on this module
+
+        from .kinematics import joint_tree
+
+        tree = joint_tree(self)
+        positions = forward_kinematics(np.zeros((1, len(self.channels))), tree)[0][0]
+        return positions[np.maximum(tree.parent, 0)] if start else positions
 
     def unit(self, key: str) -> str | None:
         return dict(self.units).get(key)

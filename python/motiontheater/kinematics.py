@@ -1,0 +1,55 @@
+"""Forward kinematics of skeletons and motions: joint positions and rotations.
+
+ASF/AMC semantics (those of the HDM05 toolbox, which the tests reproduce to
+1e-13): a joint's local rotation is C M C^T, C from its ``axis`` angles
+applied in their order letters, M from its rotation dofs applied in the
+order the ASF lists them, both about fixed axes; world rotations chain from
+the root; a bone ends at its parent's end plus its world rotation times its
+unit direction times its length.  The root is at ``:root position`` plus its
+translation channels.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from mtcore.kinematics import DOFS, JointTree, axis_rotations
+
+from .skeleton import Skeleton
+
+
+@functools.lru_cache(maxsize=64)
+def joint_tree(skeleton: Skeleton) -> JointTree:
+    """The C kernel's tables for a skeleton: joints in ``skeleton.joint_names`` order."""
+    names = skeleton.joint_names
+    index = {name: i for i, name in enumerate(names)}
+    scale = math.pi / 180 if skeleton.angle_unit == "deg" else 1.0
+    parent = [-1] + [index[skeleton.parent(b)] for b in skeleton.bone_names]
+    order, queue = [], ["root"]
+    while queue:  # breadth first from the root: parents before children, whatever the bone order
+        name = queue.pop(0)
+        order.append(index[name])
+        queue.extend(skeleton.children(name))
+    root = skeleton.root
+    axis = [axis_rotations(root.axis, root.orientation, scale)]
+    direction, segment = [np.zeros(3)], [np.asarray(root.position, float)]
+    for bone in skeleton.bones:
+        axis.append(axis_rotations(bone.axis_order, bone.axis, scale))
+        d = np.asarray(bone.direction, float)
+        norm = np.linalg.norm(d)
+        unit = d / norm if norm > 0 else np.zeros(3)
+        direction.append(unit)
+        segment.append(unit * bone.length)
+    dof_start, dof_kind, dof_column = [0], [], []
+    column = 0
+    for name in names:
+        for dof in skeleton.dofs(name):
+            dof_kind.append(DOFS[dof])
+            dof_column.append(column)
+            column += 1
+        dof_start.append(len(dof_kind))
+    return JointTree(parent=parent, order=order, axis=axis, direction=direction, segment=segment,
+                     dof_start=dof_start, dof_kind=dof_kind, dof_column=dof_column, angle_scale=scale)

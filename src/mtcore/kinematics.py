@@ -1,0 +1,128 @@
+"""Forward kinematics of joint trees over frames, in C (see ``mt_forward_kinematics``).
+
+Array level: joints are indices; motiontheater builds the tables from a skeleton.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._mtcore import ffi, lib
+from ._parallel import cpu_count, run_all
+from ._status import check
+
+__all__ = ["JointTree", "axis_rotations", "forward_kinematics", "rotations_to_quaternions", "DOFS"]
+
+DOFS = {"rx": lib.MT_DOF_RX, "ry": lib.MT_DOF_RY, "rz": lib.MT_DOF_RZ, "tx": lib.MT_DOF_TX,
+        "ty": lib.MT_DOF_TY, "tz": lib.MT_DOF_TZ, "l": lib.MT_DOF_L}
+_PARALLEL_MIN_TRANSFORMS = 200_000  # frames x joints below which one thread is faster
+
+
+def _doubles(a) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+@dataclass(frozen=True, eq=False)
+class JointTree:
+    """The rest data of a joint tree, as the C kernel takes it (see mtcore.h).
+
+    ``parent`` (joints,) int, -1 for a root; ``order`` visits parents first;
+    ``axis`` (joints, 3, 3); ``direction`` and ``segment`` (joints, 3);
+    ``dof_start`` (joints + 1,) into ``dof_kind`` / ``dof_column``.
+    """
+
+    parent: np.ndarray
+    order: np.ndarray
+    axis: np.ndarray
+    direction: np.ndarray
+    segment: np.ndarray
+    dof_start: np.ndarray
+    dof_kind: np.ndarray
+    dof_column: np.ndarray
+    angle_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        n = len(self.parent)
+        fields = dict(
+            parent=(np.int64, (n,)), order=(np.int64, (n,)), axis=(np.float64, (n, 3, 3)),
+            direction=(np.float64, (n, 3)), segment=(np.float64, (n, 3)), dof_start=(np.uintp, (n + 1,)),
+            dof_kind=(np.intc, None), dof_column=(np.uintp, None),
+        )
+        for name, (dtype, shape) in fields.items():
+            array = np.ascontiguousarray(getattr(self, name), dtype=dtype)
+            if shape is not None and array.shape != shape:
+                raise ValueError(f"{name} must have shape {shape}, got {array.shape}")
+            array.flags.writeable = False
+            object.__setattr__(self, name, array)
+        if len(self.dof_kind) != len(self.dof_column) or (n and self.dof_start[-1] != len(self.dof_kind)):
+            raise ValueError("dof_start must end at the length of dof_kind and dof_column")
+
+    @property
+    def joints(self) -> int:
+        return len(self.parent)
+
+
+def forward_kinematics(values: np.ndarray, tree: JointTree, *, world: bool = False, local: bool = False,
+                       workers: int | None = None) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """Positions (frames, joints, 3) of each joint's end, and optionally world and
+    local rotations (frames, joints, 3, 3), for values (frames, channels).
+    Frames are split over the cores for large motions (``workers`` as for the filters)."""
+    values = _doubles(values)
+    if values.ndim != 2:
+        raise ValueError(f"values must be (frames, channels), got shape {values.shape}")
+    frames, channels = values.shape
+    if len(tree.dof_column) and tree.dof_column.max() >= channels:
+        raise ValueError(f"the tree reads column {tree.dof_column.max()} but values have {channels} channels")
+    n = tree.joints
+    positions = np.empty((frames, n, 3))
+    world_out = np.empty((frames, n, 3, 3)) if world else None
+    local_out = np.empty((frames, n, 3, 3)) if local else None
+    wanted = (cpu_count() if frames * n >= _PARALLEL_MIN_TRANSFORMS else 1) if workers is None else (
+        cpu_count() if workers == -1 else workers)
+    if wanted < 1:
+        raise ValueError(f"workers must be a positive integer, -1 (every core) or None, got {wanted}")
+    threads = max(1, min(wanted, frames))
+    bounds = [frames * i // threads for i in range(threads + 1)]
+
+    def ptr(a, kind="double[]"):
+        return ffi.NULL if a is None else ffi.from_buffer(kind, a)
+
+    args = (
+        ptr(values), frames, channels, n, ptr(tree.parent, "long long[]"), ptr(tree.order, "long long[]"),
+        ptr(tree.axis), ptr(tree.direction), ptr(tree.segment), ptr(tree.dof_start, "size_t[]"),
+        ptr(tree.dof_kind, "int[]"), ptr(tree.dof_column, "size_t[]"), tree.angle_scale,
+    )
+    outs = (ptr(positions), ptr(world_out), ptr(local_out))
+
+    def part(begin: int, end: int):
+        return lambda: lib.mt_forward_kinematics(*args, begin, end, *outs)
+
+    for status in run_all([part(b, e) for b, e in zip(bounds, bounds[1:])]):
+        check(status, "mt_forward_kinematics")
+    return positions, world_out, local_out
+
+
+def axis_rotations(axes: str, angles, scale: float = 1.0) -> np.ndarray:
+    """The 3x3 rotation of rotations about ``axes`` (letters such as "XYZ") by
+    ``angles`` times ``scale`` radians, applied in that order about fixed axes."""
+    codes = [DOFS["r" + a.lower()] for a in axes]
+    angles = _doubles(angles)
+    if len(codes) != len(angles):
+        raise ValueError(f"{len(codes)} axes but {len(angles)} angles")
+    out = np.empty((3, 3))
+    check(lib.mt_axis_rotations(ffi.new("int[]", codes), ffi.from_buffer("double[]", angles), len(codes),
+                                scale, ffi.from_buffer("double[]", out)), "mt_axis_rotations")
+    return out
+
+
+def rotations_to_quaternions(matrices: np.ndarray) -> np.ndarray:
+    """Unit quaternions (..., 4) as (w, x, y, z) with w >= 0, of rotation matrices (..., 3, 3)."""
+    m = _doubles(matrices)
+    if m.shape[-2:] != (3, 3):
+        raise ValueError(f"matrices must have shape (..., 3, 3), got {m.shape}")
+    q = np.empty(m.shape[:-2] + (4,))
+    check(lib.mt_rotations_to_quaternions(ffi.from_buffer("double[]", m), m.size // 9,
+                                          ffi.from_buffer("double[]", q)), "mt_rotations_to_quaternions")
+    return q
