@@ -12,7 +12,10 @@ import numpy as np
 import mtcore
 
 from . import __version__
+from .amc import read_amc
+from .asf import read_asf
 from .examples import noisy_rotations
+from .export import FORMATS, write_positions
 
 _FILTERS = {
     "median": mtcore.median_filter1d,
@@ -50,6 +53,15 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _positions(args: argparse.Namespace) -> int:
+    motion = read_amc(args.motion, read_asf(args.skeleton), frame_rate=args.frame_rate)
+    written = write_positions(motion, args.output, meters=args.meters, format=args.format)
+    unit = "metres" if args.meters else "file units"
+    print(f"wrote {motion.frames} frames x {len(motion.skeleton.joint_names)} joints ({unit}, {written}) "
+          f"to {args.output}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="motiontheater",
@@ -73,6 +85,24 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--seconds", type=float, default=10.0, help="length of the capture (default 10)")
     demo.add_argument("--seed", type=int, default=0, help="random seed of the synthetic data")
     demo.set_defaults(run=_demo)
+
+    positions = verbs.add_parser(
+        "positions",
+        help="export the world position of every joint per frame (CSV, NPZ or TRC)",
+        description=(
+            "Compute every joint's world position per frame by forward kinematics (the root, then "
+            "each bone's end point) and write them as CSV (frame, time, joint.x/.y/.z columns), "
+            "NumPy .npz or TRC (OpenSim markers). Example: motiontheater positions 01.asf 01_01.amc "
+            "-o 01_01.trc --meters"
+        ),
+    )
+    positions.add_argument("skeleton", help="the ASF file")
+    positions.add_argument("motion", help="the AMC file")
+    positions.add_argument("-o", "--output", required=True, help="output file: .csv, .npz or .trc")
+    positions.add_argument("--format", choices=FORMATS, help="output format (default: from the suffix)")
+    positions.add_argument("--meters", action="store_true", help="lengths in metres (default: file units)")
+    positions.add_argument("--frame-rate", type=float, help="frames per second when the AMC does not say")
+    positions.set_defaults(run=_positions)
     return parser
 
 
@@ -84,7 +114,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     try:
         return args.run(args)
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, OSError) as exc:
         print(f"motiontheater {args.verb}: {exc}", file=sys.stderr)
         return 2
 

@@ -1,0 +1,79 @@
+"""Joint positions out: CSV, NumPy .npz and TRC (the marker format of OpenSim)."""
+
+from __future__ import annotations
+
+import io
+import os
+
+import numpy as np
+
+from ._io import Source, output
+from .motion import Motion
+
+FORMATS = ("csv", "npz", "trc")
+_NAMED_UNITS = {1.0: "m", 0.01: "cm", 0.001: "mm", 0.0254: "in"}
+
+
+def length_unit_name(motion: Motion, meters: bool) -> str | None:
+    """"m" with meters, else the name of the skeleton's unit if it has one (None for
+    the Acclaim convention's inch / L units of CMU and HDM05)."""
+    return "m" if meters else _NAMED_UNITS.get(motion.skeleton.meters_per_unit)
+
+
+def write_positions(motion: Motion, target: Source, *, meters: bool = False, format: str | None = None,
+                    workers: int | None = None) -> str:
+    """Write the world position of every joint (``Motion.positions()``) to a file.
+
+    ``format`` is "csv", "npz" or "trc" (default: the target's suffix).  CSV:
+    one row per frame, columns ``frame, time, <joint>.x, <joint>.y,
+    <joint>.z`` in ``joint_names`` order, 10 significant digits.  NPZ:
+    ``positions`` (frames, joints, 3) exact, ``joint_names``, ``frames``,
+    ``times``, ``frame_rate``, ``meters_per_unit``.  TRC needs a named unit
+    (m, cm, mm, in): use ``meters=True`` for CMU and HDM05.  Lengths are in
+    file units, or metres with ``meters``.  A path is written atomically.
+    Returns the format written.
+    """
+    if format is None:
+        suffix = os.path.splitext(os.fspath(target) if isinstance(target, (str, os.PathLike)) else "")[1]
+        format = suffix.lstrip(".").lower()
+    if format not in FORMATS:
+        raise ValueError(f"format must be one of {', '.join(FORMATS)} (or a target ending in one), got {format!r}")
+    unit = length_unit_name(motion, meters)
+    if format == "trc" and unit is None:
+        raise ValueError(f"TRC needs a named length unit, and this skeleton's unit is "
+                         f"{motion.skeleton.meters_per_unit:.6g} m: write it in metres (meters=True, --meters)")
+    positions = motion.positions(meters=meters, workers=workers)
+    frames = motion.first_frame + np.arange(motion.frames)
+    names = motion.skeleton.joint_names
+    with output(target) as f:
+        if format == "npz":
+            np.savez(f, positions=positions, joint_names=np.array(names), frames=frames, times=motion.times,
+                     frame_rate=motion.frame_rate,
+                     meters_per_unit=1.0 if meters else motion.skeleton.meters_per_unit)
+        else:
+            text = io.StringIO()
+            table = np.column_stack([frames, motion.times, positions.reshape(motion.frames, -1)])
+            if format == "csv":
+                header = ",".join(["frame", "time", *(f"{n}.{a}" for n in names for a in "xyz")])
+                np.savetxt(text, table, delimiter=",", fmt=["%d", "%.10g"] + ["%.10g"] * (3 * len(names)),
+                           header=header, comments="")
+            else:
+                text.write(_trc_header(motion, names, unit, target))
+                np.savetxt(text, table, delimiter="\t", fmt=["%d", "%.10g"] + ["%.10g"] * (3 * len(names)))
+            f.write(text.getvalue().encode())
+    return format
+
+
+def _trc_header(motion: Motion, names, unit: str, target) -> str:
+    rate = f"{motion.frame_rate:g}"
+    name = os.path.basename(os.fspath(target)) if isinstance(target, (str, os.PathLike)) else "positions.trc"
+    markers = "\t".join(f"{n}\t\t" for n in names)
+    axes = "\t".join(f"X{i}\tY{i}\tZ{i}" for i in range(1, len(names) + 1))
+    return (
+        f"PathFileType\t4\t(X/Y/Z)\t{name}\n"
+        "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames\n"
+        f"{rate}\t{rate}\t{motion.frames}\t{len(names)}\t{unit}\t{rate}\t{motion.first_frame}\t{motion.frames}\n"
+        f"Frame#\tTime\t{markers}\n"
+        f"\t\t{axes}\n"
+        "\n"
+    )
