@@ -28,6 +28,7 @@ from mtcore.errors import (
 
 from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
+from .export import write_positions
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Bone, Root, Skeleton
 
@@ -56,4 +57,5 @@ __all__ = [
     "uniform_filter1d",
     "write_amc",
     "write_asf",
+    "write_positions",
 ]

@@ -2,7 +2,7 @@
 
 ASF/AMC semantics (those of the HDM05 toolbox, which the tests reproduce to
 1e-13): a joint's local rotation is C M C^T, C from its ``axis`` angles
-applied in their order letters, M from its rotation dofs applied in the
+about x, y and z applied in the order of its letters, M from its rotation dofs applied in the
 order the ASF lists them, both about fixed axes; world rotations chain from
 the root; a bone ends at its parent's end plus its world rotation times its
 unit direction times its length.  The root is at ``:root position`` plus its
@@ -21,6 +21,11 @@ from mtcore.kinematics import DOFS, JointTree, axis_rotations
 from .skeleton import Skeleton
 
 
+def _frame(order: str, angles, scale: float) -> np.ndarray:
+    """C of an ASF ``axis``: the angles are about x, y and z, applied in ``order`` (e.g. "ZYX")."""
+    return axis_rotations(order, [angles["XYZ".index(letter)] for letter in order.upper()], scale)
+
+
 @functools.lru_cache(maxsize=64)
 def joint_tree(skeleton: Skeleton) -> JointTree:
     """The C kernel's tables for a skeleton: joints in ``skeleton.joint_names`` order."""
@@ -34,10 +39,10 @@ def joint_tree(skeleton: Skeleton) -> JointTree:
         order.append(index[name])
         queue.extend(skeleton.children(name))
     root = skeleton.root
-    axis = [axis_rotations(root.axis, root.orientation, scale)]
+    axis = [_frame(root.axis, root.orientation, scale)]
     direction, segment = [np.zeros(3)], [np.asarray(root.position, float)]
     for bone in skeleton.bones:
-        axis.append(axis_rotations(bone.axis_order, bone.axis, scale))
+        axis.append(_frame(bone.axis_order, bone.axis, scale))
         d = np.asarray(bone.direction, float)
         norm = np.linalg.norm(d)
         unit = d / norm if norm > 0 else np.zeros(3)

@@ -25,8 +25,9 @@ _METERS_PER_NAMED_UNIT = {"m": 1.0, "meter": 1.0, "meters": 1.0, "metre": 1.0, "
 class Bone:
     """One ASF bone, in file units.
 
-    ``direction`` need not be unit length; ``axis`` holds the angles of the
-    bone's local frame, applied in ``axis_order`` (e.g. "XYZ"); ``dofs`` are
+    ``direction`` need not be unit length (forward kinematics uses its unit
+    vector times ``length``); ``axis`` holds the angles of the bone's local
+    frame about x, y and z, applied in ``axis_order`` (e.g. "XYZ"); ``dofs`` are
     its motion channels in AMC order, from rx ry rz tx ty tz l; ``limits``
     has one (low, high) pair per dof (empty when the file gives none).
     ``extra`` keeps other keys of the bone block (bodymass, cofmass, ...) as text.

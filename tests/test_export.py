@@ -1,0 +1,67 @@
+"""Position export: CSV, NPZ and TRC files and the positions command."""
+
+import numpy as np
+import pytest
+
+import motiontheater as mt
+from motiontheater.cli import main
+
+
+@pytest.fixture
+def motion(data_dir):
+    return mt.read_amc(data_dir / "cmu" / "02_01.amc", mt.read_asf(data_dir / "cmu" / "02.asf"))
+
+
+def test_csv(motion, tmp_path):
+    mt.write_positions(motion, tmp_path / "p.csv")
+    lines = (tmp_path / "p.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    assert header[:5] == ["frame", "time", "root.x", "root.y", "root.z"]
+    assert header[-1] == f"{motion.skeleton.bone_names[-1]}.z"
+    table = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
+    assert table.shape == (motion.frames, 2 + 3 * 31)
+    np.testing.assert_array_equal(table[:, 0], np.arange(1, motion.frames + 1))
+    np.testing.assert_allclose(table[:, 1], np.arange(motion.frames) / 120, rtol=1e-9)
+    np.testing.assert_allclose(table[:, 2:].reshape(-1, 31, 3), motion.positions(), rtol=1e-9, atol=1e-9)
+
+
+def test_npz_is_exact(motion, tmp_path):
+    mt.write_positions(motion, tmp_path / "p.npz", meters=True)
+    data = np.load(tmp_path / "p.npz")
+    np.testing.assert_array_equal(data["positions"], motion.positions(meters=True))
+    assert list(data["joint_names"]) == list(motion.skeleton.joint_names)
+    assert data["frame_rate"] == 120 and data["meters_per_unit"] == 1.0
+
+
+def test_trc(motion, tmp_path):
+    mt.write_positions(motion, tmp_path / "p.trc", meters=True)
+    lines = (tmp_path / "p.trc").read_text().split("\n")
+    assert lines[0] == "PathFileType\t4\t(X/Y/Z)\tp.trc"
+    assert lines[2].split("\t") == ["120", "120", str(motion.frames), "31", "m", "120", "1", str(motion.frames)]
+    assert lines[3].split("\t")[:5] == ["Frame#", "Time", "root", "", ""]
+    assert lines[4].split("\t")[2:5] == ["X1", "Y1", "Z1"] and lines[5] == ""
+    table = np.loadtxt(tmp_path / "p.trc", skiprows=6)
+    np.testing.assert_allclose(table[:, 2:].reshape(-1, 31, 3), motion.positions(meters=True), rtol=1e-9, atol=1e-12)
+
+
+def test_trc_needs_a_named_unit(motion, tmp_path):
+    with pytest.raises(ValueError, match="TRC needs a named length unit"):
+        mt.write_positions(motion, tmp_path / "p.trc")
+    assert not (tmp_path / "p.trc").exists()
+
+
+def test_positions_command(data_dir, tmp_path, capsys):
+    out = tmp_path / "walk.npz"
+    assert main(["positions", str(data_dir / "cmu" / "02.asf"), str(data_dir / "cmu" / "02_01.amc"),
+                 "-o", str(out), "--meters"]) == 0
+    assert capsys.readouterr().out.strip() == f"wrote 343 frames x 31 joints (metres, npz) to {out}"
+    assert np.load(out)["positions"].shape == (343, 31, 3)
+
+
+def test_positions_command_fails_cleanly(data_dir, tmp_path, capsys):
+    out = tmp_path / "bad.csv"
+    assert main(["positions", str(data_dir / "cmu" / "01.asf"), str(data_dir / "edge" / "test.amc"),
+                 "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("motiontheater positions: ") and "test.amc, line 4: unknown bone 'Head'" in err
+    assert not out.exists() and list(tmp_path.iterdir()) == []

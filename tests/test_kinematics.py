@@ -1,0 +1,155 @@
+"""Forward kinematics against the HDM05 toolbox, a numpy twin, and invariances."""
+
+import re
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import motiontheater as mt
+from conftest import ids, real_files
+from fk_twin import forward_kinematics as twin
+from mtcore.kinematics import JointTree, forward_kinematics, rotations_to_quaternions
+
+REFS = real_files("hdm05/*.ref.npz")
+AMCS = real_files("*/*.amc")
+
+
+def load(amc):
+    return mt.read_amc(amc, mt.read_asf(mt.skeleton_path_for(amc)))
+
+
+@pytest.mark.parametrize("ref", REFS, ids=ids(REFS))
+def test_hdm05_toolbox_positions_and_rotations(ref):
+    expected = np.load(ref)
+    motion = load(ref.with_name(ref.name.replace(".ref.npz", ".amc")))
+    assert list(expected["bone_names"]) == list(motion.skeleton.joint_names)
+    # The toolbox's units: ASF lengths and root translation divided by :units length.
+    positions = motion.positions() / 0.45
+    np.testing.assert_allclose(positions, expected["positions"], rtol=0, atol=1e-9)
+    quaternions = motion.rotations(local=True, quaternions=True)
+    reference = expected["rotation_quat_wxyz"]
+    valid = ~np.isnan(reference[..., 0])  # the toolbox leaves bones without dofs NaN
+    assert valid.sum() == reference.shape[0] * 29
+    closest = np.minimum(np.abs(quaternions - reference).max(-1), np.abs(quaternions + reference).max(-1))
+    assert closest[valid].max() < 1e-9
+
+
+@pytest.mark.parametrize("amc", AMCS, ids=ids(AMCS))
+def test_c_kernel_equals_numpy_twin(amc):
+    motion = load(amc)
+    positions, local, world = twin(motion)
+    scale = max(1.0, np.abs(positions).max())
+    np.testing.assert_allclose(motion.positions(), positions, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(motion.rotations(), world, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(motion.rotations(local=True), local, rtol=0, atol=1e-12)
+    starts = motion.positions(start=True)
+    np.testing.assert_array_equal(starts[:, 0], motion.positions()[:, 0])
+    parent = motion.skeleton.joint_names.index(motion.skeleton.parent(motion.skeleton.bone_names[-1]))
+    np.testing.assert_array_equal(starts[:, -1], motion.positions()[:, parent])
+
+
+def test_rest_pose_is_parent_plus_direction_times_length(data_dir):
+    for asf in sorted(data_dir.glob("*/*.asf")):
+        skeleton = mt.read_asf(asf)
+        rest = skeleton.rest_positions()
+        names = skeleton.joint_names
+        np.testing.assert_array_equal(rest[0], skeleton.root.position)
+        for bone in skeleton.bones:
+            d = np.asarray(bone.direction)
+            expected = rest[names.index(skeleton.parent(bone.name))] + d / np.linalg.norm(d) * bone.length
+            np.testing.assert_allclose(rest[names.index(bone.name)], expected, rtol=0, atol=1e-9, err_msg=bone.name)
+        np.testing.assert_array_equal(skeleton.rest_positions(start=True)[names.index(skeleton.bone_names[0])],
+                                      rest[names.index(skeleton.parent(skeleton.bone_names[0]))])
+
+
+@pytest.fixture
+def cmu(data_dir):
+    return load(data_dir / "cmu" / "01_01.amc")
+
+
+def test_positions_invariant_to_angle_unit(cmu):
+    np.testing.assert_allclose(cmu.to_radians().positions(), cmu.positions(), rtol=0, atol=1e-9)
+
+
+def test_positions_in_meters_scale_by_the_unit(cmu):
+    factor = 0.0254 / 0.45
+    np.testing.assert_allclose(cmu.to_meters().positions(), cmu.positions() * factor, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(cmu.positions(meters=True), cmu.positions() * factor, rtol=0, atol=1e-12)
+
+
+def test_positions_invariant_to_axis_order(data_dir, tmp_path):
+    """Every bone's axis written in ZYX order with the angles rewritten: the same positions."""
+    asf = (data_dir / "cmu" / "01.asf").read_bytes()
+
+    def rewrite(match):
+        angles = [float(x) for x in match.group(1).split()]
+        zyx = Rotation.from_euler("xyz", angles, degrees=True).as_euler("zyx", degrees=True)
+        return b"axis " + b" ".join(repr(float(a)).encode() for a in zyx[::-1]) + b" ZYX"
+
+    (tmp_path / "zyx.asf").write_bytes(re.sub(rb"axis ([-\d.e+ ]+?)\s+XYZ", rewrite, asf))
+    original = load(data_dir / "cmu" / "01_01.amc")
+    rewritten = mt.read_amc(data_dir / "cmu" / "01_01.amc", mt.read_asf(tmp_path / "zyx.asf"))
+    assert rewritten.skeleton.bone("lfemur").axis_order == "ZYX"
+    np.testing.assert_allclose(rewritten.positions(), original.positions(), rtol=0, atol=1e-9)
+
+
+def test_nan_reaches_the_joint_and_its_descendants_only(cmu):
+    values = cmu.values.copy()
+    values[10, cmu.columns("lfemur", "ry")[0]] = np.nan
+    positions = cmu.replace(values=values).positions()
+    names = cmu.skeleton.joint_names
+    below = {"lfemur", "ltibia", "lfoot", "ltoes"}
+    for i, name in enumerate(names):
+        assert np.isnan(positions[10, i]).all() == (name in below), name
+    assert not np.isnan(positions[[9, 11]]).any()
+
+
+def test_result_does_not_depend_on_workers(cmu):
+    one = cmu.positions(workers=1)
+    for workers in (2, 3, -1):
+        np.testing.assert_array_equal(cmu.positions(workers=workers), one)
+
+
+def test_motion_of_another_skeleton_is_refused(data_dir, cmu):
+    other = mt.read_asf(data_dir / "edge" / "test.asf")
+    with pytest.raises(ValueError, match=r"values must have shape \(frames, 60\) for this skeleton, got \(2751, 62\)"):
+        cmu.replace(skeleton=other)
+
+
+def single_joint(kind, scale=1.0):
+    return JointTree(parent=[-1], order=[0], axis=[np.eye(3)], direction=[np.zeros(3)], segment=[np.zeros(3)],
+                     dof_start=[0, 1], dof_kind=[kind], dof_column=[0], angle_scale=scale)
+
+
+def test_sin_and_cos_to_an_ulp(rng):
+    """The kernel's own sin/cos (vectorised over frames) against libm, large angles included."""
+    x = np.concatenate([rng.uniform(-10, 10, 20000), rng.uniform(-1e6, 1e6, 20000), np.linspace(-7, 7, 10001),
+                        [0.0, -0.0, np.pi / 4, np.pi / 2, np.pi, 2.0**30, 2.0**31, 1e300, 5e-324]])
+    _, _, local = forward_kinematics(x[:, None], single_joint(2), local=True)
+    np.testing.assert_allclose(local[:, 0, 0, 0], np.cos(x), rtol=0, atol=2.3e-16)
+    np.testing.assert_allclose(local[:, 0, 1, 0], np.sin(x), rtol=0, atol=2.3e-16)
+    special = np.array([[np.inf], [-np.inf], [np.nan]])
+    assert np.isnan(forward_kinematics(special, single_joint(0), local=True)[2]).any(axis=(1, 2, 3)).all()
+
+
+def test_quaternions_equal_scipy(rng):
+    rotations = Rotation.random(5000, random_state=1)
+    matrices = np.concatenate([rotations.as_matrix(), Rotation.from_rotvec([[np.pi, 0, 0], [0, np.pi, 0],
+                                                                            [0, 0, np.pi], [0, 0, 0]]).as_matrix()])
+    q = rotations_to_quaternions(matrices)
+    expected = Rotation.from_matrix(matrices).as_quat(scalar_first=True)
+    assert (q[:, 0] >= 0).all()
+    np.testing.assert_allclose(np.minimum(np.abs(q - expected).max(-1), np.abs(q + expected).max(-1)), 0, atol=1e-12)
+
+
+def test_bad_tables_are_refused():
+    with pytest.raises(ValueError, match=r"order must have shape \(2,\), got \(1,\)"):
+        JointTree(parent=[-1, 0], order=[0], axis=[np.eye(3)] * 2, direction=np.zeros((2, 3)),
+                  segment=np.zeros((2, 3)), dof_start=[0, 0, 0], dof_kind=[], dof_column=[])
+    tree = JointTree(parent=[1, -1], order=[0, 1], axis=[np.eye(3)] * 2, direction=np.zeros((2, 3)),
+                     segment=np.zeros((2, 3)), dof_start=[0, 0, 0], dof_kind=[], dof_column=[])
+    with pytest.raises(ValueError, match="mt_forward_kinematics: an argument is outside its documented range"):
+        forward_kinematics(np.zeros((3, 1)), tree)  # a child before its parent
+    with pytest.raises(ValueError, match="reads column 0 but values have 0 channels"):
+        forward_kinematics(np.zeros((3, 0)), single_joint(0))
