@@ -17,7 +17,7 @@ __all__ = ["JointTree", "axis_rotations", "forward_kinematics", "rotations_to_qu
 
 DOFS = {"rx": lib.MT_DOF_RX, "ry": lib.MT_DOF_RY, "rz": lib.MT_DOF_RZ, "tx": lib.MT_DOF_TX,
         "ty": lib.MT_DOF_TY, "tz": lib.MT_DOF_TZ, "l": lib.MT_DOF_L}
-_PARALLEL_MIN_TRANSFORMS = 200_000  # frames x joints below which one thread is faster
+_PARALLEL_MIN_TRANSFORMS = 20_000  # frames x joints below which one thread is faster
 
 
 def _doubles(a) -> np.ndarray:

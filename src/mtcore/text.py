@@ -114,7 +114,7 @@ def scan_frames(
     return values, int(first) if frames else 0
 
 
-_PIECE_BYTES = 4 << 20  # below this a text is scanned in one piece
+_PIECE_BYTES = 1 << 20  # below this a text is scanned in one piece
 _FRAME_LINE = re.compile(rb"[\r\n][ \t]*\d+[ \t]*(?=[\r\n])")
 
 
