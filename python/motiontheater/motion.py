@@ -106,6 +106,13 @@ class Motion:
         matrices = own if local else world
         return rotations_to_quaternions(matrices) if quaternions else matrices
 
+    def filter(self, kind: str, size: int, joints=None, *, translation: bool = True, mode: str = "nearest",
+               workers: int | None = None) -> Motion:
+        """Smoothed over frames: see :func:`motiontheater.filtering.filter_motion`."""
+        from .filtering import filter_motion  # filtering builds on Motion
+
+        return filter_motion(self, kind, size, joints, translation=translation, mode=mode, workers=workers)
+
     def replace(self, **changes) -> Motion:
         """A new motion with some fields changed (values are copied if writeable)."""
         return replace(self, **changes)
