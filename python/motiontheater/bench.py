@@ -120,7 +120,7 @@ def measure(scene: np.ndarray | None = None, source: str = "synthetic", hour_fra
                    "mtcore_output": best_time(lambda: OURS[kind](hour, size, 0, out, mode="nearest"), repeat)}
             for name, peer in available.items():
                 row[name] = None if peer is None or peer(kind, hour[:10], size) is None else best_time(
-                    lambda: peer(kind, hour, size), max(1, repeat // 3))
+                    lambda: peer(kind, hour, size), max(2, repeat // 2))
             hour_rows.append(row)
     return {
         "scene": {"source": source, "shape": list(scene.shape), "rows": scene_rows},
