@@ -195,6 +195,31 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
 
 /* Unit quaternions (w, x, y, z), w >= 0, of n rotation matrices (3x3, row-major). */
 int mt_rotations_to_quaternions(const double *matrices, size_t n, double *quaternions);
+
+/*
+ * The per-frame loop of the motion combiner: output frame f of `channels`
+ * values from rows of an old and a new motion (both frames x channels).
+ *
+ *   new' = new[new_row[f]]                                 when ramp[f] == 0
+ *        = (1 - ramp[f]) new[new_row[f]] + ramp[f] new[next_row[f]]   otherwise
+ *   out  = old[old_row[f]]                   where u = weight[f] == 0 or the
+ *                                            channel is not selected
+ *        = new'                              where u == 1
+ *        = (1 - u) old[old_row[f]] + u new'  otherwise
+ *
+ * then, when offset_row[f] >= 0, offsets[offset_row[f]][j] is added to
+ * channel offset_channel[j], j < noffsets.  A row index of -1 means the
+ * motion has no frame there: then the weight must say not to use it (and
+ * unselected channels need an old row).  Pure frames are copied, never
+ * multiplied, so that they equal their source bit for bit.  Writes frames
+ * begin .. end-1.
+ */
+int mt_combine(const double *old_values, size_t old_frames, const double *new_values,
+               size_t new_frames, size_t channels, size_t out_frames, const long long *old_row,
+               const long long *new_row, const long long *next_row, const double *ramp,
+               const double *weight, const unsigned char *selected, const long long *offset_row,
+               const double *offsets, size_t offset_rows, const size_t *offset_channel,
+               size_t noffsets, size_t begin, size_t end, double *out);
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

@@ -1,0 +1,357 @@
+"""The motion combiner of MotionTheater (thesis ch. 4.2): a new motion laid over an old one.
+
+A piece of the new motion (``cut``) is laid onto frames of the result
+(``scale``), cross-faded with the old motion at its borders (``blend``),
+kept continuous at the root (``preserve``), applied to chosen joints only,
+and its repeated frames re-interpolated.  Python works out the borders,
+depths and the frame map (:func:`plan`); the per-frame loop is C
+(:func:`mtcore.combine.combine_frames`).  Frame numbers, not indices, as in
+the thesis.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from mtcore.combine import combine_frames
+
+from . import _euler
+from .motion import Motion
+from .skeleton import ROTATIONS, TRANSLATIONS
+
+PRESERVE = (None, "literal", "ground")
+ROTATION_BLENDS = ("slerp", "linear")
+UP_AXES = ("x", "y", "z")
+
+
+@dataclass(frozen=True)
+class Border:
+    """A border of the piece where it meets old frames: at its start (g1) or end (g2)."""
+
+    side: str  # "start" or "end"
+    frame: int  # g1 or g2
+    left: int  # blend frames before (start: old side) or up to (end: piece side) the border
+    right: int
+    step: float  # the weight step of the cross-fade, 1 / (left + right + 2)
+
+    @property
+    def window(self) -> tuple[int, int] | None:
+        """First and last frame of the cross-fade, or None when there is none."""
+        if self.left == self.right == 0:
+            return None
+        return (self.frame - self.left, self.frame + self.right)
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """Which frames of the old and new motions every output frame takes, and how.
+
+    ``frames`` are the output frame numbers; ``old_row``/``new_row`` the rows
+    of ``old.values``/``new.values`` they read (-1 for none), ``weight`` the
+    new motion's share, ``next_row``/``ramp`` the re-interpolation of repeated
+    frames.  ``piece`` is the output range the cut lands on, ``source`` the
+    new motion's frames it reads (blend extensions included), ``borders``
+    the cross-fades, ``gap`` the frames between old and piece.
+    """
+
+    frames: np.ndarray
+    old_row: np.ndarray
+    new_row: np.ndarray
+    next_row: np.ndarray
+    ramp: np.ndarray
+    weight: np.ndarray
+    piece: tuple[int, int]
+    source: tuple[int, int]
+    borders: tuple[Border, ...]
+    gap: tuple[int, int] | None
+    blend: int
+    preserve: str | None
+
+    def describe(self) -> str:
+        """The frame map and borders in words (``motiontheater combine --dry-run``)."""
+        lines = [f"output frames {self.frames[0]}..{self.frames[-1]}" if len(self.frames) else "no output frames",
+                 f"piece {self.piece[0]}..{self.piece[1]} from source frames {self.source[0]}..{self.source[1]}"]
+        for b in self.borders:
+            window = b.window
+            lines.append(f"{b.side} border at {b.frame}: " + (
+                f"blend {window[0]}..{window[1]} (depth {b.left} + {b.right}, step 1/{round(1 / b.step)})"
+                if window else "no blend"))
+        if self.gap:
+            lines.append(f"gap {self.gap[0]}..{self.gap[1]}: " + (
+                "smooth transition" if self.blend else "holds the last pose before it"))
+        if self.preserve:
+            lines.append(f"root preserved ({self.preserve})")
+        return "\n".join(lines)
+
+
+def _half_up(numerator, denominator):
+    """numerator / denominator rounded to the nearest integer, halves up (exact, integers)."""
+    return (2 * numerator + denominator) // (2 * denominator)
+
+
+def _pair(value, name: str) -> tuple[int, int] | None:
+    if value is None:
+        return None
+    try:
+        first, last = (int(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a pair of frame numbers (first, last), got {value!r}") from None
+    if (first, last) == (0, 0):  # the thesis's "not set"
+        return None
+    return first, last
+
+
+def plan(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserve: str | None = None,
+         discard_old: bool = False, interpolate: bool = False) -> Plan:
+    """The frame map of :func:`combine` (see there for the arguments)."""
+    if new.skeleton.channels != old.skeleton.channels:
+        raise ValueError("new: a motion of another skeleton (its channels differ from the old motion's)")
+    n1, n2 = new.first_frame, new.first_frame + new.frames - 1
+    o1, o2 = old.first_frame, old.first_frame + old.frames - 1
+    cut, scale = _pair(cut, "cut"), _pair(scale, "scale")
+    cf, ct = cut or (n1, n2)
+    if new.frames == 0 or not n1 <= cf <= ct <= n2:
+        raise ValueError(f"cut=({cf}, {ct}) is outside the new motion's frames {n1}..{n2}")
+    if scale is not None and scale[0] >= scale[1]:
+        raise ValueError(f"scale=({scale[0]}, {scale[1]}) needs its first frame before its last")
+    sf, st = scale or (cf, ct)
+    if isinstance(blend, bool) or not isinstance(blend, (int, np.integer)) or blend < 0:
+        raise ValueError(f"blend must be a depth of 0 frames or more, got {blend!r}")
+    if preserve not in PRESERVE:
+        raise ValueError(f"preserve must be one of {PRESERVE}, got {preserve!r}")
+    if blend and preserve:
+        warnings.warn("blend and preserve exclude each other: blending is off (blend=0), the root is preserved",
+                      stacklevel=3)
+        blend = 0
+    old_present = not discard_old and old.frames > 0
+
+    def source(i):
+        """Source frame of output frame(s) i: cf + (i - sf) / (st - sf) * (ct - cf), halves up."""
+        if st == sf:
+            return np.full_like(i, cf) if isinstance(i, np.ndarray) else cf
+        return _half_up(cf * (st - sf) + (i - sf) * (ct - cf), st - sf)
+
+    borders = []
+    start_depth = end_depth = (0, 0)
+    if old_present and blend and o1 <= sf - 1 <= o2:
+        needed = source(sf - blend)
+        depth = blend if needed >= n1 else _half_up((cf - n1) * blend, cf - needed)
+        start_depth = (min(depth, sf - o1), min(blend, o2 - sf, st - sf))
+    if old_present and blend and o1 <= st + 1 <= o2:
+        needed = source(st + blend)
+        depth = blend if needed <= n2 else _half_up((n2 - ct) * blend, needed - ct)
+        end_depth = (min(blend, st - o1, st - sf - start_depth[1] - 1 if start_depth != (0, 0) else st - sf),
+                     min(depth, o2 - st))
+        end_depth = (max(end_depth[0], 0), end_depth[1])
+    for side, frame, (left, right) in (("start", sf, start_depth), ("end", st, end_depth)):
+        if old_present and (o1 <= frame - 1 <= o2 if side == "start" else o1 <= frame + 1 <= o2):
+            borders.append(Border(side, frame, left, right, 1.0 / (left + right + 2)))
+
+    first, last = (sf, st) if not old_present else (min(o1, sf), max(o2, st))
+    frames = np.arange(first, last + 1, dtype=np.int64)
+    x = source(frames)
+    in_piece = (frames >= sf) & (frames <= st)
+    weight = in_piece.astype(np.float64)
+    old_row = np.clip(frames - o1, 0, old.frames - 1) if old_present else np.full(len(frames), -1, np.int64)
+
+    gap = None
+    if old_present and sf > o2 + 1:  # the piece after the old motion
+        gap = (o2 + 1, sf - 1)
+        g = (frames >= gap[0]) & (frames <= gap[1])
+        weight[g] = (frames[g] - o2) / (sf - o2) if blend else 0.0
+        x[g] = source(sf)
+    elif old_present and st < o1 - 1:  # the piece before the old motion
+        gap = (st + 1, o1 - 1)
+        g = (frames >= gap[0]) & (frames <= gap[1])
+        weight[g] = 1.0 - (frames[g] - st) / (o1 - st) if blend else 1.0
+        x[g] = source(st)
+    for border in borders:
+        if border.window is None:
+            continue
+        w0, w1 = border.window
+        k = np.arange(w1 - w0 + 1)
+        rise = (k + 1) * border.step
+        weight[(frames >= w0) & (frames <= w1)] = rise if border.side == "start" else 1.0 - rise
+
+    used = weight > 0
+    new_row = np.where(used, np.clip(x - n1, 0, new.frames - 1), -1)
+    next_row, ramp = new_row.copy(), np.zeros(len(frames))
+    if interpolate and st - sf > ct - cf:
+        _ramps(x, in_piece, n1, next_row, ramp)
+    xs = x[used]
+    return Plan(frames=frames, old_row=old_row, new_row=new_row, next_row=next_row, ramp=ramp, weight=weight,
+                piece=(sf, st), source=(int(xs.min()), int(xs.max())) if len(xs) else (cf, ct),
+                borders=tuple(borders), gap=gap, blend=blend, preserve=preserve)
+
+
+def _ramps(x: np.ndarray, in_piece: np.ndarray, n1: int, next_row: np.ndarray, ramp: np.ndarray) -> None:
+    """Runs of repeated source frames in the piece become linear ramps towards the next source frame."""
+    piece = np.flatnonzero(in_piece)
+    if len(piece) < 2:
+        return
+    xp = x[piece]
+    starts = np.flatnonzero(np.r_[True, xp[1:] != xp[:-1]])
+    lengths = np.diff(np.r_[starts, len(xp)])
+    for_run = np.repeat(np.arange(len(starts)), lengths)
+    position = np.arange(len(xp)) - starts[for_run]
+    has_next = for_run + 1 < len(starts)
+    following = np.where(has_next, xp[starts[np.minimum(for_run + 1, len(starts) - 1)]], xp)
+    next_row[piece] = following - n1
+    ramp[piece] = np.where(has_next, position / lengths[for_run], 0.0)
+
+
+def combine(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserve: str | None = None,
+            joints: Iterable[str] | None = None, discard_old: bool = False, interpolate: bool = False,
+            rotation_blend: str = "slerp", up: str = "y", workers: int | None = None) -> Motion:
+    """Lay ``new`` over ``old``: a new Motion (the inputs are not modified).
+
+    - ``cut=(cf, ct)``: use frames cf..ct of ``new`` (default all of it).
+    - ``scale=(sf, st)``: lay the piece onto frames sf..st; output frame i takes
+      source frame cf + (i - sf) / (st - sf) * (ct - cf), halves rounded up.
+      Without it the piece keeps its frame numbers.
+    - ``blend=b``: cross-fade over g-b..g+b where the piece meets old frames
+      (weights in steps of 1 / (2b + 2)), with the depth cut down on either
+      side to the frames the old and new motions have, the new side's depth
+      rescaled as in the thesis (eq. 4.18-4.19).  Between motions that do not
+      touch, b > 0 fills the gap with a transition, b = 0 holds the last pose.
+    - ``preserve``: keep the root continuous at the borders.  "literal" is the
+      thesis's rule (the root's stored translation and rotation at g1-1 are
+      added to the piece, taken relative to its first frame, and at g2 to
+      the frames after it); "ground" moves the following trajectory rigidly on
+      the ground plane and turns it about the ``up`` axis, so position and
+      heading continue.  Blend and preserve exclude each other: both warns,
+      and the blend is dropped.
+    - ``joints``: only these joints' channels take the new motion.
+    - ``discard_old``: the result is the piece alone.
+    - ``interpolate``: where the piece is scaled longer than its source, runs
+      of repeated frames become linear ramps to the next source frame.
+    - ``rotation_blend``: "slerp" (quaternions, for joints with three rotation
+      channels) or "linear" on the stored Euler angles (the thesis).
+    Raises ValueError naming the argument at fault.
+    """
+    if rotation_blend not in ROTATION_BLENDS:
+        raise ValueError(f"rotation_blend must be one of {ROTATION_BLENDS}, got {rotation_blend!r}")
+    if up not in UP_AXES:
+        raise ValueError(f"up must be one of {UP_AXES}, got {up!r}")
+    skeleton = old.skeleton
+    chosen = skeleton.joint_names if joints is None or discard_old else tuple(joints)
+    for joint in chosen:
+        if joint not in skeleton.joint_names:
+            raise ValueError(f"joints: no joint '{joint}' in skeleton '{skeleton.name}'")
+    p = plan(old, new, cut, scale, blend, preserve, discard_old, interpolate)
+    selected = np.zeros(len(skeleton.channels), np.uint8)
+    for joint in chosen:
+        selected[old.columns(joint)] = 1
+    offset_row, offsets, offset_channels = None, None, ()
+    if p.preserve and "root" in chosen and not discard_old:
+        offset_row, offsets, offset_channels = _root_offsets(old, new, p, up)
+    values = combine_frames(None if discard_old else old.values, new.values, p.old_row, p.new_row, p.weight,
+                            next_row=p.next_row, ramp=p.ramp, selected=selected, offset_row=offset_row,
+                            offsets=offsets, offset_channels=offset_channels, workers=workers)
+    if rotation_blend == "slerp":
+        _slerp_blends(values, old, new, p, chosen)
+    values.flags.writeable = False
+    return old.replace(values=values, first_frame=int(p.frames[0]) if len(p.frames) else 1)
+
+
+def _slerp_blends(values: np.ndarray, old: Motion, new: Motion, p: Plan, joints) -> None:
+    """Cross-faded frames of joints with three rotation channels, again, by SLERP."""
+    frames = np.flatnonzero((p.weight > 0) & (p.weight < 1))
+    if not len(frames):
+        return
+    skeleton = old.skeleton
+    scale = math.pi / 180 if skeleton.angle_unit == "deg" else 1.0
+    period = 2 * math.pi / scale
+    u = p.weight[frames]
+    for joint in joints:
+        dofs = [d for d in skeleton.dofs(joint) if d in ROTATIONS]
+        if len(dofs) != 3:
+            continue  # no unique rotation to interpolate: the linear blend stands
+        columns = old.columns(joint, tuple(dofs))
+        axes = "".join(d[1] for d in dofs)
+        a = old.values[p.old_row[frames]][:, columns] * scale
+        fresh = new.values[p.new_row[frames]][:, columns]
+        nxt = new.values[p.next_row[frames]][:, columns]
+        b = (fresh + p.ramp[frames, None] * (nxt - fresh)) * scale
+        q = _euler.slerp(_euler.quaternions(_euler.matrices(a, axes)), _euler.quaternions(_euler.matrices(b, axes)),
+                         u)
+        angles = _euler.angles(_euler.quaternion_matrices(q), axes) / scale
+        linear = values[np.ix_(frames, columns)]
+        values[np.ix_(frames, columns)] = _euler.nearest_equivalent(angles, linear, period)
+
+
+def _root_rotation_axes(old: Motion) -> tuple[list[int], str]:
+    root = old.skeleton.root
+    dofs = [d for d in root.order if d in ROTATIONS]
+    if len(dofs) != 3:
+        raise ValueError("preserve='ground' needs a root with three rotation channels")
+    return old.columns("root", tuple(dofs)), "".join(d[1] for d in dofs)
+
+
+def _root_offsets(old: Motion, new: Motion, p: Plan, up: str):
+    """Per output frame, what to add to the root channels so that the root continues at each border."""
+    skeleton = old.skeleton
+    o1, o2 = old.first_frame, old.first_frame + old.frames - 1
+    sf, st = p.piece
+    frames = p.frames
+    root_cols = old.columns("root")
+    raw = np.zeros((len(frames), len(root_cols)))
+    uses_new = p.weight > 0
+    raw[uses_new] = new.values[p.new_row[uses_new]][:, root_cols]
+    raw[~uses_new] = old.values[p.old_row[~uses_new]][:, root_cols]
+    target = raw.copy()
+    before = sf - 1 if o1 <= sf - 1 <= o2 else (o2 if o2 < sf else None)
+    after = st + 1 if o1 <= st + 1 <= o2 else None
+    piece = (frames >= sf) & (frames <= st) | (uses_new & (frames > st))
+    follow = (frames > st) & ~uses_new
+    at = {int(f): i for i, f in enumerate(frames)}
+    if p.preserve == "literal":
+        if before is not None:
+            target[piece] += old.values[before - o1, root_cols] - raw[at[sf]]
+        if after is not None:
+            target[follow] += target[at[st]] - raw[at[after]]
+    else:
+        if before is not None:
+            target[piece] = _ground_moved(old, target[piece], target[at[sf]], old.values[before - o1, root_cols], up)
+        if after is not None:
+            target[follow] = _ground_moved(old, target[follow], raw[at[after]], target[at[st]], up)
+    return np.arange(len(frames)), target - raw, root_cols
+
+
+def _ground_moved(motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: np.ndarray, up: str) -> np.ndarray:
+    """Root channel rows moved rigidly so that ``start`` lands on ``anchor``: translated on the
+    ground plane, turned about the ``up`` axis to the anchor's heading."""
+    skeleton = motion.skeleton
+    order = skeleton.root.order
+    t_cols = [order.index(d) for d in TRANSLATIONS if d in order]
+    rot_cols, axes = _root_rotation_axes(motion)
+    r_cols = [list(motion.columns("root")).index(c) for c in rot_cols]
+    scale = math.pi / 180 if skeleton.angle_unit == "deg" else 1.0
+    u = "xyz".index(up)
+    ground = [i for i in range(3) if i != u]
+
+    def heading(row):
+        m = _euler.matrices(row[r_cols] * scale, axes)
+        forward = m[:, ground[1]] if up != "z" else m[:, 0]  # the root's forward, on the ground
+        return math.atan2(forward[ground[0]], forward[ground[1]])
+
+    turn = heading(anchor) - heading(start)
+    spin = _euler.matrices(np.array([turn]), up)
+    out = rows.copy()
+    if len(t_cols) == 3:
+        position = rows[:, t_cols] - start[t_cols]
+        moved = position @ spin.T
+        moved[:, u] = position[:, u] + start[t_cols][u]  # heights keep their own values
+        for g in ground:
+            moved[:, g] += anchor[t_cols][g]
+        out[:, t_cols] = moved
+    rotations = spin @ _euler.matrices(rows[:, r_cols] * scale, axes)
+    angles = _euler.angles(rotations, axes) / scale
+    period = 2 * math.pi / scale
+    out[:, r_cols] = _euler.nearest_equivalent(np.unwrap(angles, period=period, axis=0), rows[:, r_cols], period)
+    return out

@@ -1,0 +1,78 @@
+"""The motion combiner's per-frame loop, in C (see ``mt_combine`` in mtcore.h).
+
+Array level: motiontheater.combine works out the frame map; this runs it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._mtcore import ffi, lib
+from ._parallel import cpu_count, run_all
+from ._status import check
+
+__all__ = ["combine_frames"]
+
+_PARALLEL_MIN_VALUES = 1 << 20
+
+
+def combine_frames(old: np.ndarray | None, new: np.ndarray | None, old_row, new_row, weight, *,
+                   next_row=None, ramp=None, selected=None, offset_row=None, offsets=None,
+                   offset_channels=(), workers: int | None = None) -> np.ndarray:
+    """Output frames (len(weight), channels) from rows of ``old`` and ``new`` (see mt_combine).
+
+    Per output frame: ``old_row`` and ``new_row`` index the motions (-1: none),
+    ``weight`` is the new motion's share, ``next_row``/``ramp`` interpolate the
+    new motion between two rows, ``offset_row`` picks a row of ``offsets``
+    (columns ``offset_channels``) to add.  ``selected`` marks the channels
+    that take the new motion.  The C loop checks that every row it reads exists.
+    """
+    channels = (old if old is not None else new).shape[1]
+    frames = len(weight)
+
+    def ints(a, fill):
+        return np.full(frames, fill, np.int64) if a is None else np.ascontiguousarray(a, np.int64)
+
+    def doubles(a, fill):
+        return np.full(frames, fill, np.float64) if a is None else np.ascontiguousarray(a, np.float64)
+
+    old = None if old is None else np.ascontiguousarray(old, np.float64)
+    new = None if new is None else np.ascontiguousarray(new, np.float64)
+    for name, motion in (("old", old), ("new", new)):
+        if motion is not None and (motion.ndim != 2 or motion.shape[1] != channels):
+            raise ValueError(f"{name} must be (frames, {channels}), got {motion.shape}")
+    old_row, new_row, offset_row = ints(old_row, -1), ints(new_row, -1), ints(offset_row, -1)
+    next_row = new_row if next_row is None else ints(next_row, -1)
+    weight, ramp = doubles(weight, 0.0), doubles(ramp, 0.0)
+    for name, a in (("old_row", old_row), ("new_row", new_row), ("next_row", next_row), ("ramp", ramp),
+                    ("offset_row", offset_row)):
+        if a.shape != (frames,):
+            raise ValueError(f"{name} must have one entry per output frame ({frames}), got shape {a.shape}")
+    selected = np.ones(channels, np.uint8) if selected is None else np.ascontiguousarray(selected, np.uint8)
+    offset_channels = np.ascontiguousarray(offset_channels, np.uintp)
+    offsets = np.zeros((0, len(offset_channels))) if offsets is None else np.ascontiguousarray(offsets, np.float64)
+    if offsets.ndim != 2 or offsets.shape[1] != len(offset_channels):
+        raise ValueError(f"offsets must have one column per offset channel ({len(offset_channels)})")
+    out = np.empty((frames, channels))
+    wanted = (cpu_count() if out.size >= _PARALLEL_MIN_VALUES else 1) if workers is None else (
+        cpu_count() if workers == -1 else workers)
+    threads = max(1, min(wanted, frames))
+    bounds = [frames * i // threads for i in range(threads + 1)]
+
+    def buf(a, kind="double[]"):
+        return ffi.NULL if a is None or a.size == 0 else ffi.from_buffer(kind, a)
+
+    args = (
+        buf(old), 0 if old is None else len(old), buf(new), 0 if new is None else len(new), channels, frames,
+        buf(old_row, "long long[]"), buf(new_row, "long long[]"), buf(next_row, "long long[]"), buf(ramp),
+        buf(weight), buf(selected, "unsigned char[]"), buf(offset_row, "long long[]"), buf(offsets),
+        len(offsets), buf(offset_channels, "size_t[]"), len(offset_channels),
+    )
+    out_buf = buf(out)
+
+    def part(begin: int, end: int):
+        return lambda: lib.mt_combine(*args, begin, end, out_buf)
+
+    for status in run_all([part(b, e) for b, e in zip(bounds, bounds[1:])]):
+        check(status, "mt_combine")
+    return out
