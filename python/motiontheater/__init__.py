@@ -28,6 +28,8 @@ from mtcore.errors import (
 
 from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
+from .combine import combine
+from .scene import Scene, Track, read_recipe
 from .export import write_positions
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Bone, Root, Skeleton
@@ -49,6 +51,10 @@ __all__ = [
     "UnknownNameError",
     "__version__",
     "binomial_filter1d",
+    "combine",
+    "Scene",
+    "Track",
+    "read_recipe",
     "median_filter1d",
     "pascal_weights",
     "read_amc",

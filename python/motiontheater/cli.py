@@ -93,6 +93,24 @@ def _bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _combine(args: argparse.Namespace) -> int:
+    from .scene import read_recipe
+
+    scene = read_recipe(args.recipe)
+    if args.dry_run:
+        for track, plan in scene.plans():
+            print(f"{track.name}:")
+            print("  " + plan.describe().replace("\n", "\n  "))
+        return 0
+    if not args.output:
+        raise ValueError("give -o OUT.amc (or --dry-run)")
+    result = scene.render()
+    write_amc(result, args.output)
+    print(f"{len(scene.tracks)} track(s) over {scene.base.frames} frames: wrote {result.frames} frames "
+          f"({result.first_frame}..{result.first_frame + result.frames - 1}) to {args.output}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="motiontheater",
@@ -157,6 +175,21 @@ def build_parser() -> argparse.ArgumentParser:
     smooth.add_argument("--mode", default="nearest", help="edge mode: nearest, reflect, mirror, wrap, constant")
     smooth.add_argument("--frame-rate", type=float, help="frames per second when the AMC does not say")
     smooth.set_defaults(run=_filter)
+
+    recipe = verbs.add_parser(
+        "combine",
+        help="lay motion tracks over a base motion, as a TOML recipe says, and write an AMC",
+        description=(
+            "Combine motions as the MotionTheater thesis's MotionCombiner does: each track of the "
+            "recipe is cut, time-scaled, blended or root-preserved and applied to chosen joints over "
+            "the scene so far. --dry-run prints every track's frame map and borders instead. See "
+            "motiontheater.scene.read_recipe for the recipe's keys."
+        ),
+    )
+    recipe.add_argument("recipe", help="the TOML recipe")
+    recipe.add_argument("-o", "--output", help="the AMC file to write")
+    recipe.add_argument("--dry-run", action="store_true", help="print the frame maps and borders, write nothing")
+    recipe.set_defaults(run=_combine)
 
     timing = verbs.add_parser(
         "bench",

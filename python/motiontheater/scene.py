@@ -1,0 +1,120 @@
+"""Scenes of tracks: motions laid one after another over a base motion, and their recipe files."""
+
+from __future__ import annotations
+
+import os
+import sys
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from .amc import read_amc, skeleton_path_for
+from .asf import read_asf
+from .combine import Plan, combine, plan
+from .motion import Motion
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+TRACK_OPTIONS = ("cut", "scale", "blend", "preserve", "joints", "discard_old", "interpolate", "rotation_blend", "up")
+
+
+@dataclass(frozen=True)
+class Track:
+    """A motion and the :func:`~motiontheater.combine.combine` options that lay it over the scene."""
+
+    motion: Motion
+    options: dict = field(default_factory=dict)
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A base motion and tracks applied over it in order (the thesis's MotionCombiner tracks).
+
+    Scenes are values: :meth:`add` returns a new scene.  :meth:`render`
+    combines every track into one Motion.
+    """
+
+    base: Motion
+    tracks: tuple[Track, ...] = ()
+
+    def add(self, motion: Motion, name: str = "", **options) -> Scene:
+        unknown = set(options) - set(TRACK_OPTIONS)
+        if unknown:
+            raise ValueError(f"unknown track option(s) {', '.join(sorted(unknown))}; expected {', '.join(TRACK_OPTIONS)}")
+        return replace(self, tracks=(*self.tracks, Track(motion, dict(options), name)))
+
+    def render(self, workers: int | None = None) -> Motion:
+        steps = self._apply(workers)
+        return steps[-1][2] if steps else self.base
+
+    def plans(self) -> list[tuple[Track, Plan]]:
+        """Each track's frame map, against the scene as it stands before it."""
+        return [(track, p) for track, p, _ in self._apply(None)]
+
+    def _apply(self, workers) -> list[tuple[Track, Plan, Motion]]:
+        """(track, its frame map, the scene after it) for every track; errors name the track."""
+        steps, result = [], self.base
+        for n, track in enumerate(self.tracks, start=1):
+            options = {k: v for k, v in track.options.items() if k in ("cut", "scale", "blend", "preserve",
+                                                                         "discard_old", "interpolate")}
+            try:
+                frame_map = plan(result, track.motion, **options)
+                result = combine(result, track.motion, workers=workers, **track.options)
+            except ValueError as e:
+                raise ValueError(f"{track.name or f'track {n}'}: {e}") from None
+            steps.append((track, frame_map, result))
+        return steps
+
+
+def read_recipe(path: str | os.PathLike) -> Scene:
+    """A scene from a TOML recipe; paths in it are relative to the recipe's folder::
+
+        skeleton = "02.asf"            # optional: else the ASF beside the base motion
+        frame_rate = 120               # optional: for AMCs that do not say
+        [base]
+        motion = "02_01.amc"
+        [[track]]
+        motion = "02_02.amc"
+        joints = ["lowerback", "upperback", "thorax"]
+        cut = [1, 55]
+        scale = [1, 66]
+        [[track]]
+        motion = "02_01.amc"
+        joints = ["lowerback", "upperback", "thorax"]
+        cut = [67, 113]
+        blend = 10
+    """
+    path = Path(path)
+    with open(path, "rb") as f:
+        try:
+            recipe = tomllib.load(f)
+        except tomllib.TOMLDecodeError as e:
+            raise ValueError(f"{path}: not a valid TOML recipe: {e}") from None
+    folder = path.parent
+
+    def where(name: str, key: str) -> Path:
+        if not isinstance(name, str):
+            raise ValueError(f"{path}: {key} must be a file name, got {name!r}")
+        return folder / name
+
+    base = recipe.get("base", {}).get("motion")
+    if base is None:
+        raise ValueError(f"{path}: the recipe needs [base] with motion = \"FILE.amc\"")
+    skeleton_file = where(recipe["skeleton"], "skeleton") if "skeleton" in recipe else skeleton_path_for(
+        where(base, "base.motion"))
+    skeleton = read_asf(skeleton_file)
+    rate = recipe.get("frame_rate")
+    scene = Scene(read_amc(where(base, "base.motion"), skeleton, frame_rate=rate))
+    for n, track in enumerate(recipe.get("track", []), start=1):
+        if "motion" not in track:
+            raise ValueError(f"{path}: track {n} needs motion = \"FILE.amc\"")
+        options = {k: v for k, v in track.items() if k != "motion"}
+        try:
+            scene = scene.add(read_amc(where(track["motion"], f"track {n} motion"), skeleton, frame_rate=rate),
+                              name=f"track {n} ({track['motion']})", **options)
+        except ValueError as e:
+            raise ValueError(f"{path}: track {n}: {e}") from None
+    return scene
