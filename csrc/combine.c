@@ -24,10 +24,10 @@ static MT_CLONES void combine_frames(const double *old_values, const double *new
 {
     for (size_t f = begin; f < end; f++) {
         double *o = out + f * channels;
-        const double u = weight[f], a = ramp[f];
+        const double u = weight[f], a = ramp ? ramp[f] : 0.0;
         const double *po = old_row[f] >= 0 ? old_values + (size_t)old_row[f] * channels : NULL;
         const double *pn = new_row[f] >= 0 ? new_values + (size_t)new_row[f] * channels : NULL;
-        const double *pm = next_row[f] >= 0 ? new_values + (size_t)next_row[f] * channels : pn;
+        const double *pm = next_row && next_row[f] >= 0 ? new_values + (size_t)next_row[f] * channels : pn;
         if (u == 0.0) {
             for (size_t c = 0; c < channels; c++)
                 o[c] = po[c];
@@ -60,7 +60,7 @@ int mt_combine(const double *old_values, size_t old_frames, const double *new_va
         return MT_EINVAL;
     if (begin == end || channels == 0)
         return MT_OK;
-    if (!old_row || !new_row || !next_row || !ramp || !weight || !selected || !offset_row || !out ||
+    if (!old_row || !new_row || (!next_row) != (!ramp) || !weight || !selected || !offset_row || !out ||
         (noffsets > 0 && (!offsets || !offset_channel)))
         return MT_EINVAL;
     for (size_t j = 0; j < noffsets; j++)
@@ -71,7 +71,7 @@ int mt_combine(const double *old_values, size_t old_frames, const double *new_va
         any_unselected |= !selected[c];
     /* Every row a frame will read must exist: checked here, not trusted. */
     for (size_t f = begin; f < end; f++) {
-        const double u = weight[f], a = ramp[f];
+        const double u = weight[f], a = ramp ? ramp[f] : 0.0;
         const int needs_old = u != 1.0 || any_unselected, needs_new = u != 0.0;
         if (!(u >= 0.0 && u <= 1.0) || !(a >= 0.0 && a <= 1.0))
             return MT_EINVAL;

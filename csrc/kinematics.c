@@ -275,6 +275,62 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
     return status;
 }
 
+static MT_CLONES void euler_block(const double *angles, size_t n, const int *axes, size_t count,
+                                  double scale, double *out)
+{
+    for (size_t f0 = 0; f0 < n; f0 += BLOCK) {
+        const size_t m = n - f0 < BLOCK ? n - f0 : BLOCK;
+        double r[9][BLOCK], v[BLOCK], sn[BLOCK], cs[BLOCK];
+        for (int e = 0; e < 9; e++)
+            for (int f = 0; f < BLOCK; f++)
+                r[e][f] = identity[e];
+        for (size_t a = 0; a < count; a++) {
+            for (int f = 0; f < BLOCK; f++)
+                v[f] = angles[(f0 + ((size_t)f < m ? (size_t)f : m - 1)) * count + a] * scale;
+            sincos_block(v, sn, cs);
+            rotate_left_block(r, axes[a], sn, cs);
+        }
+        for (size_t f = 0; f < m; f++)
+            for (int e = 0; e < 9; e++)
+                out[(f0 + f) * 9 + e] = r[e][f];
+    }
+}
+
+int mt_euler_to_matrices(const double *angles, size_t n, const int *axes, size_t count, double scale,
+                         double *out)
+{
+    if (n == 0)
+        return MT_OK;
+    if (!out || (count > 0 && (!angles || !axes)))
+        return MT_EINVAL;
+    for (size_t a = 0; a < count; a++)
+        if (axes[a] < MT_DOF_RX || axes[a] > MT_DOF_RZ)
+            return MT_EINVAL;
+    euler_block(angles, n, axes, count, scale, out);
+    return MT_OK;
+}
+
+int mt_matrices_to_euler(const double *m, size_t n, const int *axes, double scale, double *angles)
+{
+    if (n > 0 && (!m || !axes || !angles))
+        return MT_EINVAL;
+    if (n == 0)
+        return MT_OK;
+    const int i = axes[0], j = axes[1], k = axes[2];
+    if (i < MT_DOF_RX || i > MT_DOF_RZ || j < MT_DOF_RX || j > MT_DOF_RZ || k < MT_DOF_RX ||
+        k > MT_DOF_RZ || i == j || j == k || i == k)
+        return MT_EINVAL;
+    /* R = R_k(c) R_j(b) R_i(a); e is the parity of the axis permutation. */
+    const double e = (j - i + 3) % 3 == 1 ? 1.0 : -1.0;
+    for (size_t f = 0; f < n; f++, m += 9, angles += 3) {
+        const double s = -e * m[3 * k + i];
+        angles[1] = asin(s > 1.0 ? 1.0 : s < -1.0 ? -1.0 : s) / scale;
+        angles[0] = atan2(e * m[3 * k + j], m[3 * k + k]) / scale;
+        angles[2] = atan2(e * m[3 * j + i], m[3 * i + i]) / scale;
+    }
+    return MT_OK;
+}
+
 int mt_rotations_to_quaternions(const double *m, size_t n, double *q)
 {
     if (n > 0 && (m == NULL || q == NULL))

@@ -193,6 +193,21 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
                           size_t begin, size_t end, double *positions, double *world,
                           double *local);
 
+/*
+ * n rotation matrices (n x 9) of angles (n x count, times scale radians)
+ * about axes[0..count-1] (MT_DOF_RX .. RZ), applied in that order about
+ * fixed axes: the vectorised mt_axis_rotations.
+ */
+int mt_euler_to_matrices(const double *angles, size_t n, const int *axes, size_t count, double scale,
+                         double *out);
+
+/*
+ * The angles (n x 3, in units of 1/scale radians) about three distinct
+ * axes applied in that order about fixed axes, of n rotation matrices; the
+ * middle angle in [-90, 90] degrees.
+ */
+int mt_matrices_to_euler(const double *matrices, size_t n, const int *axes, double scale, double *angles);
+
 /* Unit quaternions (w, x, y, z), w >= 0, of n rotation matrices (3x3, row-major). */
 int mt_rotations_to_quaternions(const double *matrices, size_t n, double *quaternions);
 
@@ -208,7 +223,8 @@ int mt_rotations_to_quaternions(const double *matrices, size_t n, double *quater
  *        = (1 - u) old[old_row[f]] + u new'  otherwise
  *
  * then, when offset_row[f] >= 0, offsets[offset_row[f]][j] is added to
- * channel offset_channel[j], j < noffsets.  A row index of -1 means the
+ * channel offset_channel[j], j < noffsets.  next_row and ramp may be NULL
+ * (no ramps: next_row = new_row, ramp = 0).  A row index of -1 means the
  * motion has no frame there: then the weight must say not to use it (and
  * unselected channels need an old row).  Pure frames are copied, never
  * multiplied, so that they equal their source bit for bit.  Writes frames

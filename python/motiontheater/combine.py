@@ -62,8 +62,8 @@ class Plan:
     frames: np.ndarray
     old_row: np.ndarray
     new_row: np.ndarray
-    next_row: np.ndarray
-    ramp: np.ndarray
+    next_row: np.ndarray | None
+    ramp: np.ndarray | None
     weight: np.ndarray
     piece: tuple[int, int]
     source: tuple[int, int]
@@ -71,6 +71,7 @@ class Plan:
     gap: tuple[int, int] | None
     blend: int
     preserve: str | None
+    blend_rows: np.ndarray  # indices of the output frames that are cross-faded
 
     def describe(self) -> str:
         """The frame map and borders in words (``motiontheater combine --dry-run``)."""
@@ -153,56 +154,80 @@ def plan(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserv
             borders.append(Border(side, frame, left, right, 1.0 / (left + right + 2)))
 
     first, last = (sf, st) if not old_present else (min(o1, sf), max(o2, st))
+    count = last - first + 1
     frames = np.arange(first, last + 1, dtype=np.int64)
-    x = source(frames)
-    in_piece = (frames >= sf) & (frames <= st)
-    weight = in_piece.astype(np.float64)
-    old_row = np.clip(frames - o1, 0, old.frames - 1) if old_present else np.full(len(frames), -1, np.int64)
 
-    gap = None
+    def at(frame: int) -> int:
+        return frame - first  # output frames are consecutive: index arithmetic, no masks
+
+    weight = np.zeros(count)
+    weight[at(sf):at(st) + 1] = 1.0
+    if old_present:  # each output frame's old row, held at the ends: one pass
+        old_row = np.concatenate([np.zeros(max(0, o1 - first), np.int64),
+                                  np.arange(max(0, first - o1), min(old.frames, last - o1 + 1), dtype=np.int64),
+                                  np.full(max(0, last - o2), old.frames - 1, np.int64)])
+    else:
+        old_row = np.full(count, -1, np.int64)
+    lo, hi = sf, st  # the frames that read the new motion: piece, blends, gap
+    gap, gap_pose = None, None
     if old_present and sf > o2 + 1:  # the piece after the old motion
-        gap = (o2 + 1, sf - 1)
-        g = (frames >= gap[0]) & (frames <= gap[1])
-        weight[g] = (frames[g] - o2) / (sf - o2) if blend else 0.0
-        x[g] = source(sf)
+        gap, gap_pose = (o2 + 1, sf - 1), sf
+        k = np.arange(1, sf - o2)
+        weight[at(gap[0]):at(gap[1]) + 1] = k / (sf - o2) if blend else 0.0
+        lo = gap[0] if blend else sf
     elif old_present and st < o1 - 1:  # the piece before the old motion
-        gap = (st + 1, o1 - 1)
-        g = (frames >= gap[0]) & (frames <= gap[1])
-        weight[g] = 1.0 - (frames[g] - st) / (o1 - st) if blend else 1.0
-        x[g] = source(st)
+        gap, gap_pose = (st + 1, o1 - 1), st
+        k = np.arange(1, o1 - st)
+        weight[at(gap[0]):at(gap[1]) + 1] = 1.0 - k / (o1 - st) if blend else 1.0
+        hi = gap[1]
+    blends = [np.arange(at(gap[0]), at(gap[1]) + 1)] if gap and blend else []
     for border in borders:
         if border.window is None:
             continue
         w0, w1 = border.window
-        k = np.arange(w1 - w0 + 1)
-        rise = (k + 1) * border.step
-        weight[(frames >= w0) & (frames <= w1)] = rise if border.side == "start" else 1.0 - rise
+        rise = np.arange(1, w1 - w0 + 2) * border.step
+        weight[at(w0):at(w1) + 1] = rise if border.side == "start" else 1.0 - rise
+        blends.append(np.arange(at(w0), at(w1) + 1))
+        lo, hi = min(lo, w0), max(hi, w1)
 
-    used = weight > 0
-    new_row = np.where(used, np.clip(x - n1, 0, new.frames - 1), -1)
-    next_row, ramp = new_row.copy(), np.zeros(len(frames))
+    x = frames[at(lo):at(hi) + 1] - sf  # source frames of lo..hi, in place: halves up
+    if st == sf:
+        x[:] = cf
+    else:
+        x *= ct - cf
+        x += cf * (st - sf)
+        x *= 2
+        x += st - sf
+        x //= 2 * (st - sf)
+    if gap_pose is not None:
+        x[at(max(gap[0], lo)) - at(lo):at(min(gap[1], hi)) - at(lo) + 1] = source(gap_pose)
+    new_row = np.full(count, -1, np.int64)
+    x -= n1
+    new_row[at(lo):at(hi) + 1] = np.clip(x, 0, new.frames - 1, out=x)
+    x += n1
+    next_row = ramp = None
     if interpolate and st - sf > ct - cf:
-        _ramps(x, in_piece, n1, next_row, ramp)
-    xs = x[used]
+        next_row, ramp = new_row.copy(), np.zeros(count)
+        piece = slice(at(sf), at(st) + 1)
+        _ramps(new_row[piece], next_row[piece], ramp[piece])
     return Plan(frames=frames, old_row=old_row, new_row=new_row, next_row=next_row, ramp=ramp, weight=weight,
-                piece=(sf, st), source=(int(xs.min()), int(xs.max())) if len(xs) else (cf, ct),
-                borders=tuple(borders), gap=gap, blend=blend, preserve=preserve)
+                piece=(sf, st), source=(int(x.min()), int(x.max())), borders=tuple(borders), gap=gap,
+                blend=blend, preserve=preserve,
+                blend_rows=np.concatenate(blends) if blends else np.zeros(0, np.int64))
 
 
-def _ramps(x: np.ndarray, in_piece: np.ndarray, n1: int, next_row: np.ndarray, ramp: np.ndarray) -> None:
-    """Runs of repeated source frames in the piece become linear ramps towards the next source frame."""
-    piece = np.flatnonzero(in_piece)
-    if len(piece) < 2:
+def _ramps(rows: np.ndarray, next_row: np.ndarray, ramp: np.ndarray) -> None:
+    """Runs of repeated source rows in the piece become linear ramps towards the next source row
+    (written into next_row and ramp, views of the piece)."""
+    if len(rows) < 2:
         return
-    xp = x[piece]
-    starts = np.flatnonzero(np.r_[True, xp[1:] != xp[:-1]])
-    lengths = np.diff(np.r_[starts, len(xp)])
+    starts = np.flatnonzero(np.r_[True, rows[1:] != rows[:-1]])
+    lengths = np.diff(np.r_[starts, len(rows)])
     for_run = np.repeat(np.arange(len(starts)), lengths)
-    position = np.arange(len(xp)) - starts[for_run]
+    position = np.arange(len(rows)) - starts[for_run]
     has_next = for_run + 1 < len(starts)
-    following = np.where(has_next, xp[starts[np.minimum(for_run + 1, len(starts) - 1)]], xp)
-    next_row[piece] = following - n1
-    ramp[piece] = np.where(has_next, position / lengths[for_run], 0.0)
+    next_row[:] = np.where(has_next, rows[starts[np.minimum(for_run + 1, len(starts) - 1)]], rows)
+    ramp[:] = np.where(has_next, position / lengths[for_run], 0.0)
 
 
 def combine(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserve: str | None = None,
@@ -261,7 +286,7 @@ def combine(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, pres
 
 def _slerp_blends(values: np.ndarray, old: Motion, new: Motion, p: Plan, joints) -> None:
     """Cross-faded frames of joints with three rotation channels, again, by SLERP."""
-    frames = np.flatnonzero((p.weight > 0) & (p.weight < 1))
+    frames = p.blend_rows
     if not len(frames):
         return
     skeleton = old.skeleton
@@ -275,9 +300,10 @@ def _slerp_blends(values: np.ndarray, old: Motion, new: Motion, p: Plan, joints)
         columns = old.columns(joint, tuple(dofs))
         axes = "".join(d[1] for d in dofs)
         a = old.values[p.old_row[frames]][:, columns] * scale
-        fresh = new.values[p.new_row[frames]][:, columns]
-        nxt = new.values[p.next_row[frames]][:, columns]
-        b = (fresh + p.ramp[frames, None] * (nxt - fresh)) * scale
+        b = new.values[p.new_row[frames]][:, columns]
+        if p.ramp is not None:
+            b = b + p.ramp[frames, None] * (new.values[p.next_row[frames]][:, columns] - b)
+        b = b * scale
         q = _euler.slerp(_euler.quaternions(_euler.matrices(a, axes)), _euler.quaternions(_euler.matrices(b, axes)),
                          u)
         angles = _euler.angles(_euler.quaternion_matrices(q), axes) / scale
@@ -293,39 +319,60 @@ def _root_rotation_axes(old: Motion) -> tuple[list[int], str]:
     return old.columns("root", tuple(dofs)), "".join(d[1] for d in dofs)
 
 
-def _root_offsets(old: Motion, new: Motion, p: Plan, up: str):
-    """Per output frame, what to add to the root channels so that the root continues at each border."""
-    skeleton = old.skeleton
+def _root_offsets(old: Motion, new: Motion, p: Plan, up: str, rotations=_euler):
+    """(offset_row, offsets, channels): what to add to the root channels of each output frame
+    so that the root continues at each border.  The piece (with any gap frames that hold its
+    pose) is moved to continue from the old frame before it, and the old frames after it to
+    continue from the moved piece."""
     o1, o2 = old.first_frame, old.first_frame + old.frames - 1
     sf, st = p.piece
-    frames = p.frames
-    root_cols = old.columns("root")
-    raw = np.zeros((len(frames), len(root_cols)))
-    uses_new = p.weight > 0
-    raw[uses_new] = new.values[p.new_row[uses_new]][:, root_cols]
-    raw[~uses_new] = old.values[p.old_row[~uses_new]][:, root_cols]
-    target = raw.copy()
+    first = int(p.frames[0])
+    end = p.gap[1] if p.gap and st < o1 else st  # the last frame that holds the piece
     before = sf - 1 if o1 <= sf - 1 <= o2 else (o2 if o2 < sf else None)
-    after = st + 1 if o1 <= st + 1 <= o2 else None
-    piece = (frames >= sf) & (frames <= st) | (uses_new & (frames > st))
-    follow = (frames > st) & ~uses_new
-    at = {int(f): i for i, f in enumerate(frames)}
+    after = end + 1 if o1 <= end + 1 <= o2 else None
+    root = np.array(old.columns("root"))
+
+    def raw(lo: int, hi: int) -> np.ndarray:
+        """Root channels of output frames lo..hi as combined, before any preserving
+        (rows and columns gathered together: only the root's columns are read)."""
+        i = slice(lo - first, hi - first + 1)
+        uses_new = p.weight[i] > 0
+        if uses_new.all():
+            return new.values[p.new_row[i][:, None], root]
+        if not uses_new.any():
+            return old.values[p.old_row[i][:, None], root]
+        return np.where(uses_new[:, None], new.values[np.maximum(p.new_row[i], 0)[:, None], root],
+                        old.values[np.maximum(p.old_row[i], 0)[:, None], root])
+
+    def old_root(frame: int) -> np.ndarray:
+        return old.values[frame - o1, root]
+
+    offset_row = np.full(len(p.frames), -1, np.int64)
+    piece_rows, follow_rows = slice(sf - first, end - first + 1), slice(end + 1 - first, len(p.frames))
     if p.preserve == "literal":
-        if before is not None:
-            target[piece] += old.values[before - o1, root_cols] - raw[at[sf]]
+        shift = old_root(before) - raw(sf, sf)[0] if before is not None else np.zeros(len(root))
+        rows = [shift]
+        offset_row[piece_rows] = 0
         if after is not None:
-            target[follow] += target[at[st]] - raw[at[after]]
-    else:
-        if before is not None:
-            target[piece] = _ground_moved(old, target[piece], target[at[sf]], old.values[before - o1, root_cols], up)
-        if after is not None:
-            target[follow] = _ground_moved(old, target[follow], raw[at[after]], target[at[st]], up)
-    return np.arange(len(frames)), target - raw, root_cols
+            rows.append(raw(end, end)[0] + shift - old_root(after))
+            offset_row[follow_rows] = 1
+        return offset_row, np.array(rows), root.tolist()
+    piece = raw(sf, end)
+    moved = _ground_moved(old, piece, piece[0], old_root(before), up, rotations) if before is not None else piece
+    tables = [moved - piece]
+    offset_row[piece_rows] = np.arange(len(piece))
+    if after is not None:
+        follow = raw(end + 1, int(p.frames[-1]))
+        tables.append(_ground_moved(old, follow, follow[0], moved[-1], up, rotations) - follow)
+        offset_row[follow_rows] = len(piece) + np.arange(len(follow))
+    return offset_row, np.concatenate(tables), root.tolist()
 
 
-def _ground_moved(motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: np.ndarray, up: str) -> np.ndarray:
+def _ground_moved(motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: np.ndarray, up: str,
+                  rotations) -> np.ndarray:
     """Root channel rows moved rigidly so that ``start`` lands on ``anchor``: translated on the
-    ground plane, turned about the ``up`` axis to the anchor's heading."""
+    ground plane, turned about the ``up`` axis to the anchor's heading.  ``rotations`` converts
+    Euler angles and matrices (``matrices``, ``angles``)."""
     skeleton = motion.skeleton
     order = skeleton.root.order
     t_cols = [order.index(d) for d in TRANSLATIONS if d in order]
@@ -336,12 +383,12 @@ def _ground_moved(motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: n
     ground = [i for i in range(3) if i != u]
 
     def heading(row):
-        m = _euler.matrices(row[r_cols] * scale, axes)
+        m = rotations.matrices(row[r_cols] * scale, axes)
         forward = m[:, ground[1]] if up != "z" else m[:, 0]  # the root's forward, on the ground
         return math.atan2(forward[ground[0]], forward[ground[1]])
 
     turn = heading(anchor) - heading(start)
-    spin = _euler.matrices(np.array([turn]), up)
+    spin = rotations.matrices(np.array([turn]), up)
     out = rows.copy()
     if len(t_cols) == 3:
         position = rows[:, t_cols] - start[t_cols]
@@ -350,8 +397,9 @@ def _ground_moved(motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: n
         for g in ground:
             moved[:, g] += anchor[t_cols][g]
         out[:, t_cols] = moved
-    rotations = spin @ _euler.matrices(rows[:, r_cols] * scale, axes)
-    angles = _euler.angles(rotations, axes) / scale
+    # the turn about the up axis is one more rotation about a fixed axis, applied last
+    turned = rotations.matrices(np.column_stack([rows[:, r_cols] * scale, np.full(len(rows), turn)]), axes + up)
+    angles = rotations.angles(turned, axes) / scale
     period = 2 * math.pi / scale
     out[:, r_cols] = _euler.nearest_equivalent(np.unwrap(angles, period=period, axis=0), rows[:, r_cols], period)
     return out

@@ -13,7 +13,8 @@ from ._mtcore import ffi, lib
 from ._parallel import cpu_count, run_all
 from ._status import check
 
-__all__ = ["JointTree", "axis_rotations", "forward_kinematics", "rotations_to_quaternions", "DOFS"]
+__all__ = ["JointTree", "axis_rotations", "euler_angles", "euler_matrices", "forward_kinematics",
+           "rotations_to_quaternions", "DOFS"]
 
 DOFS = {"rx": lib.MT_DOF_RX, "ry": lib.MT_DOF_RY, "rz": lib.MT_DOF_RZ, "tx": lib.MT_DOF_TX,
         "ty": lib.MT_DOF_TY, "tz": lib.MT_DOF_TZ, "l": lib.MT_DOF_L}
@@ -114,6 +115,39 @@ def axis_rotations(axes: str, angles, scale: float = 1.0) -> np.ndarray:
     out = np.empty((3, 3))
     check(lib.mt_axis_rotations(ffi.new("int[]", codes), ffi.from_buffer("double[]", angles), len(codes),
                                 scale, ffi.from_buffer("double[]", out)), "mt_axis_rotations")
+    return out
+
+
+def _axis_codes(axes: str) -> list[int]:
+    try:
+        return [DOFS["r" + a.lower()] for a in axes]
+    except KeyError:
+        raise ValueError(f"axes must be letters x, y, z, got {axes!r}") from None
+
+
+def euler_matrices(angles: np.ndarray, axes: str) -> np.ndarray:
+    """(..., 3, 3) rotations of angles (..., len(axes)) in radians about ``axes``
+    (letters such as "xyz"), applied in that order about fixed axes."""
+    codes = _axis_codes(axes)
+    angles = _doubles(angles)
+    if angles.shape[-1:] != (len(codes),):
+        raise ValueError(f"angles must end in an axis of {len(codes)} (one per axis), got shape {angles.shape}")
+    out = np.empty(angles.shape[:-1] + (3, 3))
+    check(lib.mt_euler_to_matrices(ffi.from_buffer("double[]", angles), out.size // 9, ffi.new("int[]", codes),
+                                   len(codes), 1.0, ffi.from_buffer("double[]", out)), "mt_euler_to_matrices")
+    return out
+
+
+def euler_angles(matrices: np.ndarray, axes: str) -> np.ndarray:
+    """The angles (..., 3) in radians about three distinct ``axes`` applied in order
+    of rotations (..., 3, 3); the middle angle in [-pi/2, pi/2]."""
+    codes = _axis_codes(axes)
+    if len(codes) != 3 or len(set(codes)) != 3:
+        raise ValueError(f"axes must be three distinct letters, got {axes!r}")
+    m = _doubles(matrices)
+    out = np.empty(m.shape[:-2] + (3,))
+    check(lib.mt_matrices_to_euler(ffi.from_buffer("double[]", m), m.size // 9, ffi.new("int[]", codes), 1.0,
+                                   ffi.from_buffer("double[]", out)), "mt_matrices_to_euler")
     return out
 
 
