@@ -323,8 +323,8 @@ int mt_matrices_to_euler(const double *m, size_t n, const int *axes, double scal
     /* R = R_k(c) R_j(b) R_i(a); e is the parity of the axis permutation. */
     const double e = (j - i + 3) % 3 == 1 ? 1.0 : -1.0;
     for (size_t f = 0; f < n; f++, m += 9, angles += 3) {
-        const double s = -e * m[3 * k + i];
-        angles[1] = asin(s > 1.0 ? 1.0 : s < -1.0 ? -1.0 : s) / scale;
+        /* atan2 against the cosine, not asin: accurate up to gimbal lock */
+        angles[1] = atan2(-e * m[3 * k + i], hypot(m[3 * k + j], m[3 * k + k])) / scale;
         angles[0] = atan2(e * m[3 * k + j], m[3 * k + k]) / scale;
         angles[2] = atan2(e * m[3 * j + i], m[3 * i + i]) / scale;
     }

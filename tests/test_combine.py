@@ -214,3 +214,16 @@ def test_inputs_untouched(take):
         combine(old, new, cut=(50, 113), scale=(50, 140), blend=5)
     np.testing.assert_array_equal(old.values, before[0])
     np.testing.assert_array_equal(new.values, before[1])
+
+
+def test_c_loop_checks_every_row_it_reads():
+    from mtcore.combine import combine_frames
+
+    old, new = np.zeros((5, 3)), np.ones((4, 3))
+    with pytest.raises(ValueError, match="mt_combine: an argument is outside its documented range"):
+        combine_frames(old, new, [0, 1], [0, 9], [1.0, 1.0])  # new row 9 of 4
+    with pytest.raises(ValueError, match="mt_combine"):
+        combine_frames(old, new, [0, -1], [0, 0], [0.0, 0.5])  # a blend without an old row
+    with pytest.raises(ValueError, match="mt_combine"):
+        combine_frames(old, new, [0, 1], [0, 0], [0.0, 1.5])  # a weight above 1
+    np.testing.assert_array_equal(combine_frames(old, new, [0, 1], [0, 0], [0.0, 1.0]), [[0, 0, 0], [1, 1, 1]])

@@ -153,3 +153,30 @@ def test_bad_tables_are_refused():
         forward_kinematics(np.zeros((3, 1)), tree)  # a child before its parent
     with pytest.raises(ValueError, match="reads column 0 but values have 0 channels"):
         forward_kinematics(np.zeros((3, 0)), single_joint(0))
+
+
+@pytest.mark.parametrize("axes", ["xyz", "xzy", "yxz", "yzx", "zxy", "zyx", "xy", "z", "xyzy"])
+def test_euler_conversions_equal_scipy_and_the_numpy_twin(rng, axes):
+    import euler_twin
+    from mtcore.kinematics import euler_angles, euler_matrices
+
+    angles = rng.uniform(-np.pi, np.pi, (997, len(axes)))
+    matrices = euler_matrices(angles, axes)
+    np.testing.assert_allclose(matrices, euler_twin.matrices(angles, axes), rtol=0, atol=1e-15)
+    if len(set(axes)) == len(axes):  # scipy needs distinct consecutive axes
+        np.testing.assert_allclose(matrices, Rotation.from_euler(axes, angles).as_matrix(), rtol=0, atol=1e-15)
+    if len(axes) == 3:
+        back = euler_angles(matrices, axes)
+        assert (np.abs(back[:, 1]) <= np.pi / 2).all()
+        np.testing.assert_allclose(euler_matrices(back, axes), matrices, rtol=0, atol=1e-14)
+
+
+def test_euler_conversions_refuse_bad_axes():
+    from mtcore.kinematics import euler_angles, euler_matrices
+
+    with pytest.raises(ValueError, match="axes must be letters x, y, z, got 'xw'"):
+        euler_matrices(np.zeros((2, 2)), "xw")
+    with pytest.raises(ValueError, match="axes must be three distinct letters, got 'xyx'"):
+        euler_angles(np.zeros((2, 3, 3)), "xyx")
+    with pytest.raises(ValueError, match="angles must end in an axis of 3"):
+        euler_matrices(np.zeros((2, 2)), "xyz")
