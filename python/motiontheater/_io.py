@@ -13,6 +13,7 @@ from typing import IO, Union
 Source = Union[str, os.PathLike, IO[bytes], IO[str]]
 
 LINE_BREAK = re.compile(r"\r\n|\r|\n")  # as the C scanner: CRLF, lone CR and LF each end a line
+PARTIAL_PREFIX = ".mt-partial-"  # files being written; a killed run may leave them, the next removes them
 
 
 def read_source(source: Source) -> tuple[bytes, str | None]:
@@ -56,7 +57,7 @@ def output(target: Source) -> Iterator[IO[bytes]]:
         yield target.buffer if hasattr(target, "buffer") else target
         return
     directory = os.path.dirname(os.path.abspath(target))
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix="-" + os.path.basename(target), dir=directory)
+    fd, tmp = tempfile.mkstemp(prefix=PARTIAL_PREFIX, suffix="-" + os.path.basename(target), dir=directory)
     try:
         with os.fdopen(fd, "wb") as f:
             yield f

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -64,11 +65,48 @@ def _positions(args: argparse.Namespace) -> int:
     return 0
 
 
-def _filter(args: argparse.Namespace) -> int:
+def _chosen_filter(args: argparse.Namespace) -> tuple[str, int]:
     chosen = [(kind, getattr(args, kind)) for kind in FILTERS if getattr(args, kind) is not None]
     if len(chosen) != 1:
         raise ValueError("give exactly one of --median N, --mean N, --binomial N")
-    (kind, size), = chosen
+    return chosen[0]
+
+
+def _filter_options(parser: argparse.ArgumentParser) -> None:
+    """The filter flags shared by filter and batch."""
+    for kind, what in (("median", "moving median"), ("mean", "moving average"),
+                       ("binomial", "Pascal-weighted average (1 2 1 / 4 for 3)")):
+        parser.add_argument(f"--{kind}", type=int, metavar="N", help=f"{what} over N frames (odd)")
+    parser.add_argument("--asf", help="the skeleton (default: the ASF beside each take, by the CMU/HDM05 naming)")
+    parser.add_argument("--joints", help="comma-separated joints to smooth (default: all)")
+    parser.add_argument("--no-translation", action="store_true", help="leave the root's translation alone")
+    parser.add_argument("--mode", default="nearest", help="edge mode: nearest, reflect, mirror, wrap, constant")
+    parser.add_argument("--frame-rate", type=float, help="frames per second when the AMC does not say")
+
+
+def _batch(args: argparse.Namespace) -> int:
+    from . import batch
+
+    kind, size = _chosen_filter(args)
+    recipe = batch.Recipe(kind, size, tuple(args.joints.split(",")) if args.joints else None,
+                          not args.no_translation, args.mode)
+    recipe.smoother(read_asf(args.asf)) if args.asf else None  # bad joints fail before any work
+    jobs, settled = batch.plan_jobs(args.inputs, args.output, recipe, skeleton=args.asf,
+                                    frame_rate=args.frame_rate, resume=args.resume,
+                                    stream_above=int(args.stream_above * 1e6))
+    progress = batch.Progress(len(jobs), sum(os.path.getsize(j.input) for j in jobs),
+                              enabled=False if args.quiet or args.json else None)
+    summary = batch.run(jobs, settled, workers=args.jobs, scheduler=args.scheduler, dask_local=args.dask,
+                        progress=progress, out=args.output)
+    if args.json:
+        print(batch.report_json(summary))
+    elif not args.quiet or summary.failed:
+        print(summary.text(), file=sys.stderr if summary.failed else sys.stdout)
+    return 1 if summary.failed else 0
+
+
+def _filter(args: argparse.Namespace) -> int:
+    kind, size = _chosen_filter(args)
     skeleton_path = args.asf or skeleton_path_for(args.input)
     motion = read_amc(args.input, read_asf(skeleton_path), frame_rate=args.frame_rate)
     joints = args.joints.split(",") if args.joints else None
@@ -164,17 +202,37 @@ def build_parser() -> argparse.ArgumentParser:
             "--asf 01.asf -o smooth.amc"
         ),
     )
-    for kind, what in (("median", "moving median"), ("mean", "moving average"),
-                       ("binomial", "Pascal-weighted average (1 2 1 / 4 for 3)")):
-        smooth.add_argument(f"--{kind}", type=int, metavar="N", help=f"{what} over N frames (odd)")
+    _filter_options(smooth)
     smooth.add_argument("input", help="the AMC file")
-    smooth.add_argument("--asf", help="its skeleton (default: the ASF beside it, by the CMU/HDM05 naming)")
     smooth.add_argument("-o", "--output", required=True, help="the AMC file to write")
-    smooth.add_argument("--joints", help="comma-separated joints to smooth (default: all)")
-    smooth.add_argument("--no-translation", action="store_true", help="leave the root's translation alone")
-    smooth.add_argument("--mode", default="nearest", help="edge mode: nearest, reflect, mirror, wrap, constant")
-    smooth.add_argument("--frame-rate", type=float, help="frames per second when the AMC does not say")
     smooth.set_defaults(run=_filter)
+
+    many = verbs.add_parser(
+        "batch",
+        help="filter whole capture databases: folders, globs, all cores or a Dask cluster",
+        description=(
+            "Apply a filter to every AMC under the inputs (files, folders searched recursively, "
+            "globs), writing into an output folder that mirrors the input tree, with each take's "
+            "skeleton found by the CMU/HDM05 naming (or --asf). Runs on all cores (--jobs), or on a "
+            "Dask cluster (--dask for a local one, --scheduler tcp://HOST:PORT). Each output is "
+            "written under a temporary name and renamed when complete; --resume skips outputs newer "
+            "than their inputs; a bad take is reported and the others go on; the exit status is 1 "
+            "when any take failed. Takes above --stream-above MB are streamed in chunks. Example: "
+            "motiontheater batch --median 5 --jobs 2 captures/ -o smoothed/"
+        ),
+    )
+    _filter_options(many)
+    many.add_argument("inputs", nargs="+", help="AMC files, folders or globs")
+    many.add_argument("-o", "--output", required=True, help="the output folder")
+    many.add_argument("--jobs", type=int, default=0, help="processes (default: every core)")
+    many.add_argument("--resume", action="store_true", help="skip takes whose output is newer than the input")
+    many.add_argument("--quiet", action="store_true", help="no progress bar or summary (failures still reported)")
+    many.add_argument("--json", action="store_true", help="print a JSON summary")
+    many.add_argument("--dask", action="store_true", help="run on a local Dask cluster of --jobs workers")
+    many.add_argument("--scheduler", help="run on the Dask cluster at this address (tcp://HOST:PORT)")
+    many.add_argument("--stream-above", type=float, default=256.0, metavar="MB",
+                      help="stream takes larger than this many MB in chunks (default 256)")
+    many.set_defaults(run=_batch)
 
     recipe = verbs.add_parser(
         "combine",
@@ -216,7 +274,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     try:
         return args.run(args)
-    except (ValueError, TypeError, OSError) as exc:
+    except (ValueError, TypeError, OSError, RuntimeError) as exc:
         print(f"motiontheater {args.verb}: {exc}", file=sys.stderr)
         return 2
 

@@ -1,0 +1,213 @@
+"""Batch processing: the corpus on 2 processes and on Dask, kills and resumes, failures, streaming."""
+
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+import motiontheater as mt
+from motiontheater import batch
+from motiontheater.cli import main
+
+
+def expected_bytes(take: Path, kind="median", size=5) -> bytes:
+    """The take filtered alone, in memory, as write_amc writes it."""
+    motion = mt.read_amc(take, mt.read_asf(mt.skeleton_path_for(take)))
+    out = Path(os.environ.get("TMPDIR", "/tmp")) / f"expected-{os.getpid()}.amc"
+    mt.write_amc(motion.filter(kind, size), out)
+    data = out.read_bytes()
+    out.unlink()
+    return data
+
+
+@pytest.fixture(scope="module")
+def corpus_expected(data_dir):
+    return {take.relative_to(data_dir): expected_bytes(take) for take in sorted(data_dir.rglob("*.amc"))}
+
+
+def assert_outputs(out: Path, expected: dict) -> None:
+    for relative, data in expected.items():
+        assert (out / relative).read_bytes() == data, relative
+    assert not list(out.rglob(".mt-partial-*"))
+
+
+def test_corpus_on_two_processes_is_bit_identical_to_each_file_alone(data_dir, tmp_path, corpus_expected, capsys):
+    out = tmp_path / "out"
+    assert main(["batch", "--median", "5", "--jobs", "2", str(data_dir), "-o", str(out)]) == 0
+    assert_outputs(out, corpus_expected)
+    assert (out / "cmu" / "01.asf").read_bytes() == (data_dir / "cmu" / "01.asf").read_bytes()
+    assert re.match(r"44 processed, 0 skipped \(already done\), 0 failed of 44 takes", capsys.readouterr().out)
+
+
+def test_corpus_on_a_dask_local_cluster(data_dir, tmp_path, corpus_expected):
+    pytest.importorskip("dask.distributed")
+    out = tmp_path / "out"
+    jobs, settled = batch.plan_jobs([str(data_dir)], out, batch.Recipe("median", 5))
+    summary = batch.run(jobs, settled, workers=2, dask_local=True, out=out)
+    assert not summary.failed and len(summary.results) == 44
+    assert_outputs(out, corpus_expected)
+
+
+def test_a_bad_take_is_reported_and_the_others_go_on(data_dir, tmp_path, capsys):
+    src = tmp_path / "in"
+    shutil.copytree(data_dir / "cmu", src)
+    text = (src / "02_02.amc").read_bytes()
+    (src / "02_02.amc").write_bytes(text.replace(b"lfemur ", b"lfemur x ", 1))
+    out = tmp_path / "out"
+    assert main(["batch", "--mean", "3", "--jobs", "2", str(src), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "9 processed, 0 skipped (already done), 1 failed of 10 takes" in err
+    assert re.search(r"FAILED .*02_02\.amc, line \d+: expected a number as value 1 of bone 'lfemur', found 'x'", err)
+    assert not (out / "02_02.amc").exists() and (out / "02_01.amc").exists()
+
+
+def test_json_summary(data_dir, tmp_path, capsys):
+    import json
+
+    out = tmp_path / "out"
+    assert main(["batch", "--binomial", "3", "--json", "--jobs", "1", str(data_dir / "edge"), "-o", str(out)]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["processed"] == 1 and report["failed"] == 0 and report["results"][0]["frames"] == 300
+
+
+def test_resume_skips_what_is_done(data_dir, tmp_path, capsys):
+    src, out = tmp_path / "in", tmp_path / "out"
+    shutil.copytree(data_dir / "cmu", src)
+    assert main(["batch", "--median", "3", "--jobs", "1", str(src), "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["batch", "--median", "3", "--resume", "--jobs", "1", str(src), "-o", str(out)]) == 0
+    assert "0 processed, 10 skipped (already done)" in capsys.readouterr().out
+    later = (out / "02_01.amc").stat().st_mtime + 10
+    os.utime(src / "02_01.amc", (later, later))  # an input changed since its output
+    assert main(["batch", "--median", "3", "--resume", "--jobs", "1", str(src), "-o", str(out)]) == 0
+    assert "1 processed, 9 skipped (already done)" in capsys.readouterr().out
+
+
+def test_killing_a_run_leaves_no_partial_outputs_and_resume_completes_it(data_dir, tmp_path):
+    src = tmp_path / "in"
+    for copy in range(12):  # enough work to be caught midway
+        shutil.copytree(data_dir / "hdm05", src / f"copy{copy:02d}")
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "motiontheater", "batch", "--median", "5", "--jobs", "2", str(src), "-o",
+               str(out), "--quiet"]
+    run = subprocess.Popen(command)
+    deadline = time.time() + 60
+    while time.time() < deadline and len(list(out.rglob("*.amc"))) < 20:
+        time.sleep(0.01)
+    run.send_signal(signal.SIGTERM)
+    run.wait(timeout=60)
+    done = list(out.rglob("*.amc"))
+    assert 0 < len(done) < 12 * 33, "the run was not caught midway"
+    assert not list(out.rglob(".mt-partial-*"))
+    expected = {}
+    for take in done:  # whatever was written is complete
+        relative = take.relative_to(out)
+        expected[relative] = expected.get(relative) or expected_bytes(src / relative)
+        assert take.read_bytes() == expected[relative], relative
+    finished = subprocess.run(command[:-1] + ["--resume"], capture_output=True, text=True)
+    assert finished.returncode == 0, finished.stderr
+    assert f"{len(done)} skipped (already done)" in finished.stdout
+    assert len(list(out.rglob("*.amc"))) == 12 * 33
+    sample = out / "copy07" / "HDM_bd_squat1Reps_003_120.amc"
+    assert sample.read_bytes() == expected_bytes(src / "copy07" / "HDM_bd_squat1Reps_003_120.amc")
+
+
+@pytest.mark.parametrize("kind,size", [("mean", 7), ("binomial", 5), ("median", 3)])
+def test_streaming_equals_whole(data_dir, tmp_path, monkeypatch, kind, size):
+    """Small read blocks and chunks, so that every cut is exercised: the same bytes as whole."""
+    monkeypatch.setattr(batch, "READ_BYTES", 20_000)
+    take = data_dir / "cmu" / "01_01.amc"
+    skeleton = mt.read_asf(data_dir / "cmu" / "01.asf")
+    frames = batch.stream_filter(str(take), str(tmp_path / "s.amc"), skeleton, batch.Recipe(kind, size),
+                                 chunk_frames=300)
+    assert frames == 2751
+    assert (tmp_path / "s.amc").read_bytes() == expected_bytes(take, kind, size)
+
+
+def test_streaming_reports_bad_lines_with_their_file_line(data_dir, tmp_path, monkeypatch):
+    monkeypatch.setattr(batch, "READ_BYTES", 20_000)
+    text = (data_dir / "cmu" / "01_01.amc").read_bytes()
+    lines = text.split(b"\r\n")
+    lines[5000] = lines[5000] + b" 99"
+    (tmp_path / "bad.amc").write_bytes(b"\r\n".join(lines))
+    skeleton = mt.read_asf(data_dir / "cmu" / "01.asf")
+    with pytest.raises(mt.CountError, match=rf"bad.amc, line 5001: bone '{lines[5000].split()[0].decode()}' takes"):
+        batch.stream_filter(str(tmp_path / "bad.amc"), str(tmp_path / "o.amc"), skeleton, batch.Recipe("mean", 3))
+    assert not (tmp_path / "o.amc").exists()
+
+
+def test_two_hour_take_streams_in_bounded_memory(data_dir, tmp_path):
+    """864,000 frames (the real 01_01 repeated): peak memory under 300 MB, the same bytes as in memory."""
+    take = tmp_path / "long.amc"
+    text = (data_dir / "cmu" / "01_01.amc").read_bytes()
+    first = re.search(rb"(?m)^1\s*$", text).start()
+    blocks = re.split(rb"(?m)^\d+\s*\r?\n", text[first:])[1:]
+    with open(take, "wb") as f:
+        f.write(text[:first])
+        for i in range(864_000):
+            f.write(b"%d\r\n" % (i + 1))
+            f.write(blocks[i % len(blocks)])
+    script = textwrap.dedent(f"""
+        import re, sys, motiontheater as mt
+        from motiontheater import batch
+        def peak():
+            return int(re.search(r"VmHWM:\\s+(\\d+)", open("/proc/self/status").read()).group(1)) * 1024
+        skeleton = mt.read_asf({str(data_dir / "cmu" / "01.asf")!r})
+        if sys.argv[1] == "stream":
+            batch.stream_filter({str(take)!r}, {str(tmp_path / "streamed.amc")!r}, skeleton, batch.Recipe("median", 5))
+        else:
+            motion = mt.read_amc({str(take)!r}, skeleton)
+            mt.write_amc(motion.filter("median", 5), {str(tmp_path / "whole.amc")!r})
+        print(peak())
+    """)
+    streamed = subprocess.run([sys.executable, "-c", script, "stream"], capture_output=True, text=True, check=True)
+    assert int(streamed.stdout) < 300e6, f"peak {int(streamed.stdout) / 1e6:.0f} MB"
+    subprocess.run([sys.executable, "-c", script, "whole"], capture_output=True, text=True, check=True)
+    with open(tmp_path / "streamed.amc", "rb") as a, open(tmp_path / "whole.amc", "rb") as b:
+        while True:
+            x, y = a.read(1 << 24), b.read(1 << 24)
+            assert x == y
+            if not x:
+                break
+
+
+def test_batch_streams_takes_above_the_threshold(data_dir, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["batch", "--median", "5", "--json", "--stream-above", "1", "--jobs", "1",
+                 str(data_dir / "cmu" / "01_01.amc"), str(data_dir / "cmu" / "02_01.amc"), "-o", str(out)]) == 0
+    import json
+
+    report = json.loads(capsys.readouterr().out)
+    assert report["streamed"] == 1  # 01_01 is 2.2 MB, 02_01 is smaller
+    assert (out / "01_01.amc").read_bytes() == expected_bytes(data_dir / "cmu" / "01_01.amc")
+
+
+def test_inputs_files_folders_and_globs(data_dir, tmp_path):
+    found = dict(batch.find_takes([str(data_dir / "hdm05" / "HDM_bd_*.amc"), str(data_dir / "edge"),
+                                   str(data_dir / "cmu" / "02_01.amc")]))
+    assert len(found) == 11 + 1 + 1
+    assert found[data_dir / "edge" / "test.amc"] == Path("test.amc")
+    assert found[data_dir / "cmu" / "02_01.amc"] == Path("02_01.amc")
+    assert found[data_dir / "hdm05" / "HDM_bd_squat1Reps_003_120.amc"] == Path("HDM_bd_squat1Reps_003_120.amc")
+    with pytest.raises(FileNotFoundError, match="no file, folder or glob match"):
+        batch.find_takes([str(tmp_path / "nothing.amc")])
+
+
+def test_progress_bar(capsys):
+    progress = batch.Progress(2, 2_000_000, enabled=True)
+    progress.advance(batch.Result("a", "b", bytes=1_000_000))
+    progress.close()
+    err = capsys.readouterr().err
+    assert "1/2 files, 1.0/2.0 MB" in err and "MB/s, ETA" in err
+    silent = batch.Progress(2, 10, enabled=False)
+    silent.advance(batch.Result("a", "b", bytes=5))
+    assert capsys.readouterr().err == ""
+
+
