@@ -10,6 +10,7 @@ processing it whole.
 
 from __future__ import annotations
 
+import functools
 import glob
 import itertools
 import json
@@ -123,7 +124,7 @@ def run_job(job: Job) -> Result:
     result = Result(job.input, job.output, bytes=os.path.getsize(job.input))
     try:
         os.makedirs(os.path.dirname(job.output) or ".", exist_ok=True)
-        skeleton = read_asf(job.skeleton)
+        skeleton = _skeleton(job.skeleton, *_stamp(job.skeleton))
         _copy_skeleton(job.skeleton, os.path.dirname(job.output))
         if result.bytes > job.stream_above:
             result.frames = stream_filter(job.input, job.output, skeleton, job.recipe, job.frame_rate,
@@ -139,6 +140,18 @@ def run_job(job: Job) -> Result:
         result.ok, result.error = False, str(e)
     result.seconds = time.perf_counter() - start
     return result
+
+
+def _stamp(path: str) -> tuple[int, int]:
+    status = os.stat(path)
+    return status.st_mtime_ns, status.st_size
+
+
+@functools.lru_cache(maxsize=256)
+def _skeleton(path: str, mtime_ns: int, size: int):
+    """A worker reads each skeleton once (a database has a few, and thousands of takes);
+    a changed file has a new stamp and is read again."""
+    return read_asf(path)
 
 
 def _copy_skeleton(asf: str, folder: str) -> None:
