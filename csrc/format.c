@@ -172,3 +172,24 @@ int mt_format_frames(const double *values, size_t frames, size_t channels, long 
     *written = (size_t)(out - buf);
     return MT_OK;
 }
+
+int mt_format_table(const double *values, size_t rows, size_t columns, char *buf, size_t cap,
+                    size_t *written)
+{
+    if (written == NULL || (rows > 0 && columns > 0 && (values == NULL || buf == NULL)))
+        return MT_EINVAL;
+    *written = 0;
+    if (columns > 0 && cap / (columns * (MT_NUMBER_MAX + 1) + 1) < rows)
+        return MT_ERANGE;
+    char *out = buf;
+    for (size_t r = 0; r < rows; r++) {
+        for (size_t c = 0; c < columns; c++) {
+            if (c > 0)
+                *out++ = ' ';
+            out += mt_format_double(values[r * columns + c], out);
+        }
+        *out++ = '\n';
+    }
+    *written = (size_t)(out - buf);
+    return MT_OK;
+}

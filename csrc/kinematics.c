@@ -154,7 +154,8 @@ struct fk {
     const double *axis, *direction, *segment;
     const size_t *dof_start, *dof_column;
     const int *dof_kind;
-    const unsigned char *plain; /* C is the identity: L = M */
+    const unsigned char *parent_frame; /* the segment turns with the parent (BVH), or NULL */
+    const unsigned char *plain;        /* C is the identity: L = M */
     double angle_scale;
     double (*world)[9][BLOCK]; /* scratch: each joint's world rotation over the block */
     double (*end)[3][BLOCK];   /* scratch: each joint's end point over the block */
@@ -213,10 +214,11 @@ static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *
                 for (int f = 0; f < BLOCK; f++)
                     vec[e][f] = seg[e] + dir[e] * stretch[f] + c9[3 * e] * t[0][f] + c9[3 * e + 1] * t[1][f] +
                                 c9[3 * e + 2] * t[2][f];
+            double(*turn)[BLOCK] = k->parent_frame && k->parent_frame[j] ? k->world[q] : w;
             for (int e = 0; e < 3; e++)
                 for (int f = 0; f < BLOCK; f++)
-                    p[e][f] = k->end[q][e][f] + w[3 * e][f] * vec[0][f] + w[3 * e + 1][f] * vec[1][f] +
-                              w[3 * e + 2][f] * vec[2][f];
+                    p[e][f] = k->end[q][e][f] + turn[3 * e][f] * vec[0][f] + turn[3 * e + 1][f] * vec[1][f] +
+                              turn[3 * e + 2][f] * vec[2][f];
         }
         for (size_t f = 0; f < n; f++) {
             const size_t at = (f0 + f) * k->joints + j;
@@ -235,9 +237,9 @@ static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *
 int mt_forward_kinematics(const double *values, size_t frames, size_t channels, size_t joints,
                           const long long *parent, const long long *order, const double *axis,
                           const double *direction, const double *segment, const size_t *dof_start,
-                          const int *dof_kind, const size_t *dof_column, double angle_scale,
-                          size_t begin, size_t end, double *positions, double *world,
-                          double *local)
+                          const int *dof_kind, const size_t *dof_column,
+                          const unsigned char *parent_frame, double angle_scale, size_t begin,
+                          size_t end, double *positions, double *world, double *local)
 {
     if (begin > end || end > frames)
         return MT_EINVAL;
@@ -255,8 +257,8 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
     int status = check_tree(joints, parent, order);
     if (status != MT_OK)
         return status;
-    struct fk k = {values, channels, joints, parent, order, axis, direction, segment,
-                   dof_start, dof_column, dof_kind, NULL, angle_scale, NULL, NULL};
+    struct fk k = {values,    channels,   joints,   parent,       order, axis,        direction, segment,
+                   dof_start, dof_column, dof_kind, parent_frame, NULL,  angle_scale, NULL,      NULL};
     unsigned char *plain = malloc(joints);
     k.world = malloc(joints * sizeof *k.world);
     k.end = malloc(joints * sizeof *k.end);

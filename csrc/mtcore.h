@@ -125,6 +125,21 @@ int mt_scan_frames(const char *text, size_t len, const char *const *keys, const 
                    size_t max_frames, size_t channels, struct mt_scan_report *report);
 
 /*
+ * A table of numbers (the MOTION section of a BVH file): `rows` lines of
+ * exactly `columns` numbers each, separated by spaces or tabs, into values
+ * (rows x columns).  Blank lines are skipped; lines end in LF, CRLF or CR.
+ * MT_ECOUNT for a line with more or fewer numbers (report->found and
+ * ->expected), MT_ESYNTAX for a token that is not a number, MT_EMISSING for
+ * fewer lines than rows, MT_ERANGE for more (report->frames counts rows read).
+ */
+int mt_scan_table(const char *text, size_t len, size_t rows, size_t columns, double *values,
+                  struct mt_scan_report *report);
+
+/* Writes values (rows x columns) as lines of numbers separated by a blank; see mt_format_frames. */
+int mt_format_table(const double *values, size_t rows, size_t columns, char *buf, size_t cap,
+                    size_t *written);
+
+/*
  * Writes the shortest decimal text that reads back as exactly `value` into
  * buf (at least MT_NUMBER_MAX bytes, not NUL-terminated); returns its length.
  * Style of printf %g and Python repr: 17.8693, 1.23246e-13, 3, -0, -nan, inf;
@@ -180,7 +195,10 @@ int mt_axis_rotations(const int *axes, const double *angles, size_t count, doubl
  * local rotation L = C M C^T; its world rotation W = W[parent] L (L for a
  * root).  A root is at segment + t, t its translation channels in world
  * axes; any other joint ends at the end of its parent plus
- * W (segment + direction * l + C t), l its stretch and t its translations.
+ * W (segment + direction * l + C t), l its stretch and t its translations,
+ * W its own world rotation (ASF: a bone turns its own segment) or, where
+ * parent_frame[j] is set, its parent's (BVH: a joint's offset turns with its
+ * parent).  parent_frame may be NULL (no joint set).
  *
  * Writes, for frames begin .. end-1, positions (frames x joints x 3) and,
  * where not NULL, world and local (frames x joints x 9).  NaN in a channel
@@ -189,9 +207,9 @@ int mt_axis_rotations(const int *axes, const double *angles, size_t count, doubl
 int mt_forward_kinematics(const double *values, size_t frames, size_t channels, size_t joints,
                           const long long *parent, const long long *order, const double *axis,
                           const double *direction, const double *segment, const size_t *dof_start,
-                          const int *dof_kind, const size_t *dof_column, double angle_scale,
-                          size_t begin, size_t end, double *positions, double *world,
-                          double *local);
+                          const int *dof_kind, const size_t *dof_column,
+                          const unsigned char *parent_frame, double angle_scale, size_t begin,
+                          size_t end, double *positions, double *world, double *local);
 
 /*
  * n rotation matrices (n x 9) of angles (n x count, times scale radians)

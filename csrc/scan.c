@@ -265,6 +265,63 @@ static int scan_text(const char *text, const char *end, struct scan *s, double *
     return MT_OK;
 }
 
+int mt_scan_table(const char *text, size_t len, size_t rows, size_t columns, double *values,
+                  struct mt_scan_report *report)
+{
+    if (report == NULL)
+        return MT_EINVAL;
+    memset(report, 0, sizeof *report);
+    report->key = -1;
+    report->line = 1;
+    if ((text == NULL && len > 0) || (values == NULL && rows > 0 && columns > 0))
+        return MT_EINVAL;
+    const char *p = text, *end = text + len;
+    size_t row = 0;
+    while (p < end) {
+        while (p < end && is_blank(*p))
+            p++;
+        if (p < end && !is_eol(*p)) {
+            if (row == rows)
+                return MT_ERANGE;
+            double *dst = values + row * columns;
+            size_t i = 0;
+            for (;; i++) {
+                while (p < end && is_blank(*p))
+                    p++;
+                if (p == end || is_eol(*p))
+                    break;
+                if (i >= columns) {
+                    p = token_end(p, end);
+                    continue;
+                }
+                const char *stop = parse_number(p, end, &dst[i]);
+                if (stop == NULL) {
+                    report->found = (long long)i;
+                    return MT_ESYNTAX;
+                }
+                p = stop;
+            }
+            if (i != columns) {
+                report->found = (long long)i;
+                report->expected = (long long)columns;
+                return MT_ECOUNT;
+            }
+            report->frames = ++row;
+        }
+        if (p < end) {
+            p += (*p == '\r' && p + 1 < end && p[1] == '\n') ? 2 : 1;
+            report->line++;
+            report->offset = (size_t)(p - text);
+        }
+    }
+    if (row < rows) {
+        report->found = (long long)row;
+        report->expected = (long long)rows;
+        return MT_EMISSING;
+    }
+    return MT_OK;
+}
+
 int mt_scan_frames(const char *text, size_t len, const char *const *keys, const size_t *key_lens,
                    const size_t *offsets, const size_t *counts, size_t nkeys, double *values,
                    size_t max_frames, size_t channels, struct mt_scan_report *report)

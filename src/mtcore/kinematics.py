@@ -31,7 +31,9 @@ class JointTree:
 
     ``parent`` (joints,) int, -1 for a root; ``order`` visits parents first;
     ``axis`` (joints, 3, 3); ``direction`` and ``segment`` (joints, 3);
-    ``dof_start`` (joints + 1,) into ``dof_kind`` / ``dof_column``.
+    ``dof_start`` (joints + 1,) into ``dof_kind`` / ``dof_column``;
+    ``parent_frame`` (joints,) marks joints whose segment turns with their
+    parent (BVH) rather than with themselves (ASF, the default).
     """
 
     parent: np.ndarray
@@ -43,14 +45,17 @@ class JointTree:
     dof_kind: np.ndarray
     dof_column: np.ndarray
     angle_scale: float = 1.0
+    parent_frame: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.parent)
         fields = dict(
             parent=(np.int64, (n,)), order=(np.int64, (n,)), axis=(np.float64, (n, 3, 3)),
             direction=(np.float64, (n, 3)), segment=(np.float64, (n, 3)), dof_start=(np.uintp, (n + 1,)),
-            dof_kind=(np.intc, None), dof_column=(np.uintp, None),
+            dof_kind=(np.intc, None), dof_column=(np.uintp, None), parent_frame=(np.uint8, (n,)),
         )
+        if self.parent_frame is None:
+            object.__setattr__(self, "parent_frame", np.zeros(n, np.uint8))
         for name, (dtype, shape) in fields.items():
             array = np.ascontiguousarray(getattr(self, name), dtype=dtype)
             if shape is not None and array.shape != shape:
@@ -93,7 +98,8 @@ def forward_kinematics(values: np.ndarray, tree: JointTree, *, world: bool = Fal
     args = (
         ptr(values), frames, channels, n, ptr(tree.parent, "long long[]"), ptr(tree.order, "long long[]"),
         ptr(tree.axis), ptr(tree.direction), ptr(tree.segment), ptr(tree.dof_start, "size_t[]"),
-        ptr(tree.dof_kind, "int[]"), ptr(tree.dof_column, "size_t[]"), tree.angle_scale,
+        ptr(tree.dof_kind, "int[]"), ptr(tree.dof_column, "size_t[]"), ptr(tree.parent_frame, "unsigned char[]"),
+        tree.angle_scale,
     )
     outs = (ptr(positions), ptr(world_out), ptr(local_out))
 

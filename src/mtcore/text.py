@@ -19,7 +19,7 @@ from ._parallel import cpu_count, run_all
 from ._status import check
 from .errors import SequenceError
 
-__all__ = ["scan_frames", "format_frames", "format_number"]
+__all__ = ["scan_frames", "scan_table", "format_frames", "format_table", "format_number"]
 
 _FORMAT_CHUNK = 2048  # frames per C call when writing: bounds the text buffer
 
@@ -211,6 +211,57 @@ def format_frames(
                 table.c_offsets, table.c_counts, table.n, c_buf, len(buf), written,
             )
             check(status, "mt_format_frames")
+            write(bytes(memoryview(buf)[: written[0]]))
+
+
+def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0) -> np.ndarray:
+    """Scan ``text[start:]``, lines of exactly ``columns`` numbers, into a new (rows, columns)
+    float64 array (a BVH MOTION section).  A FormatError subclass names the line, counted
+    from 1 at ``text[start]``, and what was expected."""
+    if rows < 0 or columns < 0:
+        raise ValueError(f"rows and columns must not be negative, got {rows}, {columns}")
+    if not 0 <= start <= len(text):
+        raise ValueError(f"start must be within the text's {len(text)} bytes, got {start}")
+    values = np.empty((rows, columns))
+    report = ffi.new("struct mt_scan_report *")
+    with ffi.from_buffer(text) as c_text, ffi.from_buffer("double[]", values) as c_values:
+        status = lib.mt_scan_table(c_text + start, len(text) - start, rows, columns, c_values, report)
+
+    def describe(code: int) -> tuple[str, int, bool]:
+        line = _line_text(text, start + report.offset)
+        if code == lib.MT_ESYNTAX:
+            tokens = line.split()
+            token = tokens[report.found] if report.found < len(tokens) else ""
+            return f"expected a number as value {report.found + 1} of the frame, found '{token}'", report.line, False
+        if code == lib.MT_ECOUNT:
+            return (f"a frame takes {report.expected} values (the channels declared), found {report.found}",
+                    report.line, False)
+        if code == lib.MT_EMISSING:
+            return (f"the header says {rows} frames but the data holds {report.frames} (truncated?)",
+                    report.line, True)
+        return f"the header says {rows} frames but the data holds more", report.line, False
+
+    if status == lib.MT_ERANGE:
+        raise SequenceError(describe(status)[0], int(report.line))
+    check(status, "mt_scan_table", describe)
+    return values
+
+
+def format_table(values: np.ndarray, write: Callable[[bytes], object]) -> None:
+    """Write (rows, columns) values as lines of numbers through ``write``, in chunks; every
+    number the shortest text that reads back to exactly the same float64."""
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    if values.ndim != 2:
+        raise ValueError(f"values must be (rows, columns), got shape {values.shape}")
+    rows, columns = values.shape
+    chunk = max(1, min(rows, _FORMAT_CHUNK))
+    buf = bytearray(chunk * (columns * (lib.MT_NUMBER_MAX + 1) + 1))
+    written = ffi.new("size_t *")
+    with ffi.from_buffer("double[]", values) as c_values, ffi.from_buffer(buf) as c_buf:
+        for r0 in range(0, rows, chunk):
+            n = min(chunk, rows - r0)
+            check(lib.mt_format_table(c_values + r0 * columns, n, columns, c_buf, len(buf), written),
+                  "mt_format_table")
             write(bytes(memoryview(buf)[: written[0]]))
 
 
