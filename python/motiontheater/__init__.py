@@ -28,6 +28,7 @@ from mtcore.errors import (
 
 from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
+from .bvh import read_bvh, write_bvh
 from .combine import combine
 from .scene import Scene, Track, read_recipe
 from .export import write_positions
@@ -59,9 +60,11 @@ __all__ = [
     "pascal_weights",
     "read_amc",
     "read_asf",
+    "read_bvh",
     "skeleton_path_for",
     "uniform_filter1d",
     "write_amc",
     "write_asf",
+    "write_bvh",
     "write_positions",
 ]

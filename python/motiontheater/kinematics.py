@@ -39,11 +39,17 @@ def joint_tree(skeleton: Skeleton) -> JointTree:
         order.append(index[name])
         queue.extend(skeleton.children(name))
     root = skeleton.root
+    bvh = skeleton.convention == "bvh"
     axis = [_frame(root.axis, root.orientation, scale)]
-    direction, segment = [np.zeros(3)], [np.asarray(root.position, float)]
+    direction, segment = [np.zeros(3)], [_replaced(root.position, root.order) if bvh else np.asarray(root.position)]
     for bone in skeleton.bones:
-        axis.append(_frame(bone.axis_order, bone.axis, scale))
         d = np.asarray(bone.direction, float)
+        if bvh:  # the OFFSET itself, turned by the parent; position channels replace its components
+            axis.append(np.eye(3))
+            direction.append(np.zeros(3))
+            segment.append(_replaced(d, bone.dofs))
+            continue
+        axis.append(_frame(bone.axis_order, bone.axis, scale))
         norm = np.linalg.norm(d)
         unit = d / norm if norm > 0 else np.zeros(3)
         direction.append(unit)
@@ -51,10 +57,25 @@ def joint_tree(skeleton: Skeleton) -> JointTree:
     dof_start, dof_kind, dof_column = [0], [], []
     column = 0
     for name in names:
-        for dof in skeleton.dofs(name):
-            dof_kind.append(DOFS[dof])
-            dof_column.append(column)
-            column += 1
+        dofs = skeleton.dofs(name)
+        entries = [(DOFS[dof], column + i) for i, dof in enumerate(dofs)]
+        if bvh:  # BVH lists rotations as R = R1 R2 R3 (v' = R v): about fixed axes, the last applies first
+            rotations = [e for e in entries if e[0] <= DOFS["rz"]][::-1]
+            entries = [e for e in entries if e[0] > DOFS["rz"]] + rotations
+        for kind, col in entries:
+            dof_kind.append(kind)
+            dof_column.append(col)
+        column += len(dofs)
         dof_start.append(len(dof_kind))
     return JointTree(parent=parent, order=order, axis=axis, direction=direction, segment=segment,
-                     dof_start=dof_start, dof_kind=dof_kind, dof_column=dof_column, angle_scale=scale)
+                     dof_start=dof_start, dof_kind=dof_kind, dof_column=dof_column, angle_scale=scale,
+                     parent_frame=[0] + [1 if bvh else 0] * len(skeleton.bones))
+
+
+def _replaced(offset, dofs) -> np.ndarray:
+    """A BVH offset with the components that position channels replace set to zero."""
+    out = np.asarray(offset, float).copy()
+    for i, dof in enumerate(("tx", "ty", "tz")):
+        if dof in dofs:
+            out[i] = 0.0
+    return out

@@ -42,16 +42,19 @@ class Bone:
     limits: tuple[tuple[float, float], ...] = ()
     id: int | None = None
     extra: tuple[tuple[str, str], ...] = ()
+    end_site: bool = False  # a BVH End Site: a point with no channels
 
 
 @dataclass(frozen=True)
 class Root:
-    """The ASF ``:root``: its channel ``order`` (lower case), axis order, position and orientation."""
+    """The ASF ``:root``: its channel ``order`` (lower case), axis order, position and orientation.
+    ``name`` is the root's name in a BVH file ("root" in ASF, and as a key everywhere)."""
 
     order: tuple[str, ...] = ROOT_DOFS
     axis: str = "XYZ"
     position: Vec3 = (0.0, 0.0, 0.0)
     orientation: Vec3 = (0.0, 0.0, 0.0)
+    name: str = "root"
 
 
 @dataclass(frozen=True)
@@ -63,7 +66,10 @@ class Skeleton:
     children as the file lists them.  ``units`` keeps every ``:units`` key
     with its text, unknown ones included, and ``sections`` every section
     this library does not interpret (``:skin`` and the like: keyword with
-    its line, then its lines), so that they are written back.  Lengths and
+    its line, then its lines), so that they are written back.  A BVH
+    skeleton (``convention="bvh"``) holds each joint as a bone whose
+    ``direction`` is its OFFSET, channels listed as in the file, and its end
+    sites as channel-less bones named ``<joint>_End``.  Lengths and
     angles are in the file's units (see :attr:`angle_unit` and
     :attr:`meters_per_unit`).
     """
@@ -76,6 +82,7 @@ class Skeleton:
     units: tuple[tuple[str, str], ...] = (("mass", "1.0"), ("length", "1.0"), ("angle", "deg"))
     documentation: tuple[str, ...] = ()
     sections: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    convention: str = "asf"  # "asf", or "bvh": a joint's offset turns with its parent, see kinematics
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
     _parents: dict[str, str] = field(init=False, repr=False, compare=False)
 
@@ -83,7 +90,10 @@ class Skeleton:
         index: dict[str, int] = {}
         for i, bone in enumerate(self.bones):
             name = bone.name
-            if not name or name.split() != [name] or name[0] in "#:" or name.isdigit():
+            if self.convention == "bvh":
+                if not name.strip() or any(c in name for c in "{}\r\n"):
+                    raise ValueError(f"joint name {name!r} cannot be written to BVH")
+            elif not name or name.split() != [name] or name[0] in "#:" or name.isdigit():
                 raise ValueError(f"bone name {name!r} cannot be written to ASF/AMC: it must be one word, "
                                  "not all digits, not starting with '#' or ':'")
             if bone.name == "root":
@@ -103,8 +113,14 @@ class Skeleton:
 
     @property
     def joint_names(self) -> tuple[str, ...]:
-        """The root followed by the bones in ``:bonedata`` order."""
+        """The root followed by the bones in ``:bonedata`` order; the root is called "root"."""
         return ("root", *self.bone_names)
+
+    @property
+    def point_names(self) -> tuple[str, ...]:
+        """``joint_names`` with the root under its own name (a BVH file's, e.g. "Hips"): what
+        exported positions are called."""
+        return (self.root.name, *self.bone_names)
 
     def bone(self, name: str) -> Bone:
         try:
