@@ -30,6 +30,7 @@ from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
 from .bvh import read_bvh, write_bvh
 from .combine import combine
+from .convert import to_asf, to_bvh
 from .scene import Scene, Track, read_recipe
 from .export import write_positions
 from .motion import DEFAULT_FRAME_RATE, Motion
@@ -56,6 +57,8 @@ __all__ = [
     "Scene",
     "Track",
     "read_recipe",
+    "to_asf",
+    "to_bvh",
     "median_filter1d",
     "pascal_weights",
     "read_amc",

@@ -183,8 +183,10 @@ def write_bvh(motion: Motion, target: Source) -> None:
     from mtcore import format_number
 
     lines = ["HIERARCHY"]
+    written: list[str] = []  # joints in the order the file declares them: its columns' order
 
     def joint(name: str, depth: int) -> None:
+        written.append(name)
         pad = "\t" * depth
         bone = None if name == "root" else skeleton.bone(name)
         if bone is not None and bone.end_site:
@@ -206,6 +208,7 @@ def write_bvh(motion: Motion, target: Source) -> None:
     if frame_time is None or 1.0 / float(frame_time) != motion.frame_rate:
         frame_time = format_number(1.0 / motion.frame_rate)
     lines += ["MOTION", f"Frames: {motion.frames}", f"Frame Time: {frame_time}"]
+    columns = [c for name in written for c in motion.columns(name)] if motion.values.shape[1] else []
     with output(target) as f:
         f.write(encode("\n".join(lines) + "\n"))
-        format_table(motion.values, f.write)
+        format_table(motion.values[:, columns], f.write)

@@ -14,7 +14,7 @@ import mtcore
 
 from . import __version__
 from .amc import read_amc
-from .asf import read_asf
+from .asf import read_asf, write_asf
 from .examples import noisy_rotations
 from .amc import skeleton_path_for, write_amc
 from .export import FORMATS, write_positions
@@ -103,6 +103,34 @@ def _batch(args: argparse.Namespace) -> int:
     elif not args.quiet or summary.failed:
         print(summary.text(), file=sys.stderr if summary.failed else sys.stdout)
     return 1 if summary.failed else 0
+
+
+def _read_any(path: str, asf: str | None, frame_rate: float | None):
+    from .bvh import read_bvh
+
+    if path.lower().endswith(".bvh"):
+        return read_bvh(path)
+    return read_amc(path, read_asf(asf or skeleton_path_for(path)), frame_rate=frame_rate)
+
+
+def _convert(args: argparse.Namespace) -> int:
+    from .bvh import write_bvh
+    from .convert import to_asf, to_bvh
+
+    motion = _read_any(args.input, args.asf, args.frame_rate)
+    out = args.output
+    if out.lower().endswith(".bvh"):
+        write_bvh(to_bvh(motion, args.order), out)
+        print(f"wrote {motion.frames} frames to {out}")
+    elif out.lower().endswith(".amc"):
+        converted = to_asf(motion)
+        skeleton_out = os.path.splitext(out)[0] + ".asf"
+        write_asf(converted.skeleton, skeleton_out)
+        write_amc(converted, out)
+        print(f"wrote {motion.frames} frames to {out} and its skeleton to {skeleton_out}")
+    else:
+        raise ValueError(f"the output must end in .bvh or .amc, got {out}")
+    return 0
 
 
 def _filter(args: argparse.Namespace) -> int:
@@ -233,6 +261,23 @@ def build_parser() -> argparse.ArgumentParser:
     many.add_argument("--stream-above", type=float, default=256.0, metavar="MB",
                       help="stream takes larger than this many MB in chunks (default 256)")
     many.set_defaults(run=_batch)
+
+    conversion = verbs.add_parser(
+        "convert",
+        help="convert between ASF/AMC and BVH (forward kinematics gives the same points)",
+        description=(
+            "Convert a motion between ASF/AMC and BVH, by the output's suffix. AMC to BVH: a joint at "
+            "each bone's start carries the bone's rotation. BVH to AMC: a bone per segment, named "
+            "after the joint it ends at; the skeleton is written beside it as OUT.asf. Examples: "
+            "motiontheater convert 01_01.amc 01_01.bvh --asf 01.asf; motiontheater convert walk.bvh walk.amc"
+        ),
+    )
+    conversion.add_argument("input", help="an AMC (with its ASF) or a BVH file")
+    conversion.add_argument("output", help="OUT.bvh or OUT.amc")
+    conversion.add_argument("--asf", help="the input AMC's skeleton (default: the ASF beside it)")
+    conversion.add_argument("--order", default="ZXY", help="rotation channel order of the BVH written (default ZXY)")
+    conversion.add_argument("--frame-rate", type=float, help="frames per second when the AMC does not say")
+    conversion.set_defaults(run=_convert)
 
     recipe = verbs.add_parser(
         "combine",

@@ -1,0 +1,111 @@
+"""ASF/AMC <-> BVH: the same motion in the other format, forward kinematics giving the same points.
+
+ASF bones turn their own segment; BVH joints turn their children's
+offsets.  So an ASF bone becomes a BVH joint at the bone's start, carrying
+the bone's local rotation C M C^T as Euler angles, with the bone's vector
+as the offset of the joints (or End Site) at its end.  A BVH segment from a
+joint to a child becomes an ASF bone named after the child, carrying the
+joint's rotation channels (in ASF's order: BVH lists R = R1 R2 R3, ASF
+applies dofs about fixed axes, so the list is reversed) with an identity
+axis.  Angles are degrees in BVH; lengths keep their units.
+"""
+
+from __future__ import annotations
+
+
+import numpy as np
+
+from mtcore.kinematics import euler_angles
+
+from .motion import Motion
+from .skeleton import ROTATIONS, TRANSLATIONS, Bone, Root, Skeleton, canonical_hierarchy
+
+BVH_ORDERS = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
+
+
+def to_bvh(motion: Motion, order: str = "ZXY") -> Motion:
+    """An ASF/AMC motion as a BVH motion (rotation channels listed in ``order``, e.g. "ZXY")."""
+    skeleton = motion.skeleton
+    if skeleton.convention == "bvh":
+        return motion
+    order = order.upper()
+    if order not in BVH_ORDERS:
+        raise ValueError(f"order must be one of {', '.join(BVH_ORDERS)}, got {order!r}")
+    for bone in skeleton.bones:
+        if set(bone.dofs) - set(ROTATIONS):
+            raise ValueError(f"bone '{bone.name}' has translation dofs {bone.dofs}: BVH conversion supports "
+                             "rotation dofs only")
+    rotation_dofs = tuple("r" + a.lower() for a in order)
+    fixed = order[::-1].lower()  # BVH's R = R1 R2 R3 applies R3 first about fixed axes
+    segments = {b.name: _segment(b) for b in skeleton.bones}
+    bones, pairs = [], []
+    for bone in skeleton.bones:
+        parent = skeleton.parent(bone.name)
+        offset = segments[parent] if parent != "root" else np.zeros(3)
+        turns = bool(bone.dofs)
+        bones.append(Bone(name=bone.name, direction=tuple(offset), length=float(np.linalg.norm(offset)),
+                          dofs=rotation_dofs if turns else ()))
+        pairs.append((parent, (bone.name,)))
+        if not skeleton.children(bone.name):
+            bones.append(Bone(name=f"{bone.name}_End", direction=tuple(segments[bone.name]),
+                              length=float(np.linalg.norm(segments[bone.name])), end_site=True))
+            pairs.append((bone.name, (f"{bone.name}_End",)))
+    root = Root(order=("tx", "ty", "tz", *rotation_dofs), position=(0.0, 0.0, 0.0), name="root")
+    target = Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs), root=root,
+                      name=skeleton.name, units=(("angle", "deg"),), convention="bvh")
+    local = motion.rotations(local=True)
+    positions = motion.positions()
+    columns = [positions[:, 0]]
+    for j, name in enumerate(skeleton.joint_names):
+        if name == "root" or skeleton.bone(name).dofs:
+            angles = np.degrees(euler_angles(local[:, j], fixed))[:, ::-1]  # in the listed order
+            columns.append(angles)
+    values = np.concatenate(columns, axis=1)
+    values.flags.writeable = False
+    return Motion(target, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame, header=())
+
+
+def to_asf(motion: Motion) -> Motion:
+    """A BVH motion as an ASF/AMC motion (bones named after the joints they end at)."""
+    skeleton = motion.skeleton
+    if skeleton.convention != "bvh":
+        return motion
+    for bone in skeleton.bones:
+        if set(bone.dofs) - set(ROTATIONS):
+            raise ValueError(f"joint '{bone.name}' has position channels: ASF conversion supports them on the "
+                             "root only")
+    root = skeleton.root
+    root_rotations = tuple(d for d in root.order if d in ROTATIONS)[::-1]
+    root_translations = tuple(d for d in root.order if d in TRANSLATIONS)
+    position = tuple(0.0 if d in root_translations else v for d, v in zip(("tx", "ty", "tz"), root.position))
+    bones, pairs = [], []
+    for bone in skeleton.bones:
+        parent = skeleton.parent(bone.name)
+        turner = () if parent == "root" else tuple(d for d in skeleton.bone(parent).dofs)[::-1]
+        name = bone.name.replace(" ", "_")
+        bones.append(Bone(name=name, direction=bone.direction, length=float(np.linalg.norm(bone.direction)),
+                          dofs=turner, axis=(0.0, 0.0, 0.0), axis_order="XYZ"))
+        pairs.append(("root" if parent == "root" else parent.replace(" ", "_"), (name,)))
+    target = Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs),
+                      root=Root(order=(*root_translations, *root_rotations), position=position),
+                      name=skeleton.name or "converted",
+                      units=(("mass", "1.0"), ("length", "1.0"), ("angle", "deg")))
+    columns = [motion.values[:, motion.columns("root", root_translations)]] if root_translations else []
+    columns.append(motion.values[:, motion.columns("root", root_rotations)] if root_rotations else
+                   np.zeros((motion.frames, 0)))
+    for bone in skeleton.bones:
+        parent = skeleton.parent(bone.name)
+        if parent != "root" and skeleton.bone(parent).dofs:
+            columns.append(motion.values[:, motion.columns(parent, skeleton.bone(parent).dofs[::-1])])
+    values = np.concatenate(columns, axis=1)
+    values.flags.writeable = False
+    return Motion(target, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame,
+                  header=(":FULLY-SPECIFIED", ":DEGREES"))
+
+
+def _segment(bone: Bone) -> np.ndarray:
+    d = np.asarray(bone.direction, float)
+    norm = np.linalg.norm(d)
+    return d / norm * bone.length if norm > 0 else np.zeros(3)
+
+
