@@ -214,37 +214,72 @@ def format_frames(
             write(bytes(memoryview(buf)[: written[0]]))
 
 
-def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0) -> np.ndarray:
+def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers: int | None = None) -> np.ndarray:
     """Scan ``text[start:]``, lines of exactly ``columns`` numbers, into a new (rows, columns)
     float64 array (a BVH MOTION section).  A FormatError subclass names the line, counted
-    from 1 at ``text[start]``, and what was expected."""
+    from 1 at ``text[start]``, and what was expected.  Large tables are scanned on all cores
+    when their line breaks show where every piece's rows begin (``workers`` as for the filters)."""
     if rows < 0 or columns < 0:
         raise ValueError(f"rows and columns must not be negative, got {rows}, {columns}")
     if not 0 <= start <= len(text):
         raise ValueError(f"start must be within the text's {len(text)} bytes, got {start}")
     values = np.empty((rows, columns))
-    report = ffi.new("struct mt_scan_report *")
+    pieces = _table_pieces(text, start, rows, _piece_count(workers, len(text) - start))
+    reports = [ffi.new("struct mt_scan_report *") for _ in pieces]
     with ffi.from_buffer(text) as c_text, ffi.from_buffer("double[]", values) as c_values:
-        status = lib.mt_scan_table(c_text + start, len(text) - start, rows, columns, c_values, report)
 
-    def describe(code: int) -> tuple[str, int, bool]:
-        line = _line_text(text, start + report.offset)
-        if code == lib.MT_ESYNTAX:
-            tokens = line.split()
-            token = tokens[report.found] if report.found < len(tokens) else ""
-            return f"expected a number as value {report.found + 1} of the frame, found '{token}'", report.line, False
-        if code == lib.MT_ECOUNT:
-            return (f"a frame takes {report.expected} values (the channels declared), found {report.found}",
-                    report.line, False)
-        if code == lib.MT_EMISSING:
-            return (f"the header says {rows} frames but the data holds {report.frames} (truncated?)",
-                    report.line, True)
-        return f"the header says {rows} frames but the data holds more", report.line, False
+        def piece(i: int):
+            begin, stop, first_row, count = pieces[i]
+            return lambda: lib.mt_scan_table(c_text + begin, stop - begin, count, columns,
+                                             c_values + first_row * columns, reports[i])
 
-    if status == lib.MT_ERANGE:
-        raise SequenceError(describe(status)[0], int(report.line))
-    check(status, "mt_scan_table", describe)
+        statuses = run_all([piece(i) for i in range(len(pieces))])
+    for (begin, _, _, count), report, status in zip(pieces, reports, statuses):
+        if status == lib.MT_OK:
+            continue
+        lines_before = _line_breaks(text, start, begin)
+
+        def describe(code: int, report=report, begin=begin, count=count) -> tuple[str, int, bool]:
+            line, at = _line_text(text, begin + report.offset), lines_before + report.line
+            if code == lib.MT_ESYNTAX:
+                tokens = line.split()
+                token = tokens[report.found] if report.found < len(tokens) else ""
+                return f"expected a number as value {report.found + 1} of the frame, found '{token}'", at, False
+            if code == lib.MT_ECOUNT:
+                return (f"a frame takes {report.expected} values (the channels declared), found {report.found}",
+                        at, False)
+            return (f"the header says {rows} frames but the data holds "
+                    f"{report.frames + sum(p[3] for p in pieces if p[0] < begin)} (truncated?)", at, True)
+
+        if status == lib.MT_ERANGE:
+            raise SequenceError(f"the header says {rows} frames but the data holds more", lines_before + report.line)
+        check(status, "mt_scan_table", describe)
     return values
+
+
+def _table_pieces(text: bytes, start: int, rows: int, count: int) -> list[tuple[int, int, int, int]]:
+    """(begin, end, first row, rows) of pieces that together cover text[start:].  Several
+    pieces only where every line holds a row (no blank lines, LF or CRLF endings, as writers
+    write), so that each piece's rows are known from its line breaks; else one piece."""
+    whole = [(start, len(text), 0, rows)]
+    if count < 2:
+        return whole
+    size = len(text) - start
+    ends_open = not text.endswith(b"\n")
+    crs = text.count(b"\r", start)
+    if (text.count(b"\n", start) + ends_open != rows or text.find(b"\n\n", start) != -1
+            or text.find(b"\n\r\n", start) != -1 or (crs and crs != text.count(b"\r\n", start))):
+        return whole
+    bounds, first = [start], [0]
+    for i in range(1, count):
+        cut = text.find(b"\n", start + size * i // count)
+        if cut == -1 or cut + 1 >= len(text):
+            break
+        first.append(first[-1] + text.count(b"\n", bounds[-1], cut + 1))
+        bounds.append(cut + 1)
+    bounds.append(len(text))
+    first.append(rows)
+    return [(bounds[i], bounds[i + 1], first[i], first[i + 1] - first[i]) for i in range(len(bounds) - 1)]
 
 
 def format_table(values: np.ndarray, write: Callable[[bytes], object]) -> None:
