@@ -1,47 +1,17 @@
 /*
  * kinematics.c - forward kinematics of joint trees over frames (ASF/AMC
- * semantics, see mtcore.h), and rotation matrices to quaternions.
+ * semantics, see mtcore.h).
  *
  * Frames are independent: a call computes a range of them, so that several
  * threads can share one output.  The joints are visited parents first; a
  * joint's world rotation and end point are kept in scratch for its children.
  */
+#include "blocks.h"
 #include "clones.h"
 #include "mtcore.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* m = R(axis, angle) m: a rotation about a fixed axis, applied after m. */
-static void rotate_left(double m[9], int axis, double angle)
-{
-    const double c = cos(angle), s = sin(angle);
-    /* Rows a and b of m mix; the row of the axis itself stays. */
-    const int a = axis == MT_DOF_RX ? 1 : axis == MT_DOF_RY ? 2 : 0;
-    const int b = axis == MT_DOF_RX ? 2 : axis == MT_DOF_RY ? 0 : 1;
-    for (int k = 0; k < 3; k++) {
-        const double ra = m[3 * a + k], rb = m[3 * b + k];
-        m[3 * a + k] = c * ra - s * rb;
-        m[3 * b + k] = s * ra + c * rb;
-    }
-}
-
-static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-
-int mt_axis_rotations(const int *axes, const double *angles, size_t count, double scale,
-                      double *out)
-{
-    if (out == NULL || (count > 0 && (axes == NULL || angles == NULL)))
-        return MT_EINVAL;
-    memcpy(out, identity, sizeof identity);
-    for (size_t i = 0; i < count; i++) {
-        if (axes[i] < MT_DOF_RX || axes[i] > MT_DOF_RZ)
-            return MT_EINVAL;
-        rotate_left(out, axes[i], angles[i] * scale);
-    }
-    return MT_OK;
-}
 
 /* Checks that order[] is a permutation visiting parents first. */
 static int check_tree(size_t joints, const long long *parent, const long long *order)
@@ -61,65 +31,6 @@ static int check_tree(size_t joints, const long long *parent, const long long *o
     }
     free(seen);
     return status;
-}
-
-/*
- * Frames are computed BLOCK at a time, every quantity an array over the
- * block (structure of arrays), so that the inner loops run over frames and
- * vectorise: sin and cos included, with the polynomial below instead of
- * libm's scalar calls.
- */
-enum { BLOCK = 8 };
-
-/*
- * sin and cos of x (radians), branch-free: reduction by pi/4 in three parts
- * and the minimax polynomials of Cephes (Moshier), to about 1e-16 for
- * |x| < 2^30.  Larger angles (where the reduction fails) go to libm.
- */
-static MT_INLINE void sincos_block(const double *x, double *sin_out, double *cos_out)
-{
-    static const double s1 = 1.58962301576546568060e-10, s2 = -2.50507477628578072866e-8,
-                        s3 = 2.75573136213857245213e-6, s4 = -1.98412698295895385996e-4,
-                        s5 = 8.33333333332211858878e-3, s6 = -1.66666666666666307295e-1;
-    static const double c1 = -1.13585365213876817300e-11, c2 = 2.08757008419747316778e-9,
-                        c3 = -2.75573141792967388112e-7, c4 = 2.48015872888517045348e-5,
-                        c5 = -1.38888888888730564116e-3, c6 = 4.16666666666665929218e-2;
-    static const double dp1 = 7.85398125648498535156e-1, dp2 = 3.77489470793079817668e-8,
-                        dp3 = 2.69515142907905952645e-15, four_over_pi = 1.27323954473516268615;
-    int large = 0;
-    for (int b = 0; b < BLOCK; b++) {
-        const double a = fabs(x[b]);
-        large |= !(a < 1073741824.0); /* 2^30, and NaN */
-        int j = (int)(a < 1073741824.0 ? a * four_over_pi : 0.0);
-        j += j & 1; /* round the octant up to even */
-        const double y = (double)j;
-        const double z = ((a - y * dp1) - y * dp2) - y * dp3, zz = z * z;
-        const double ps = z + z * zz * (((((s1 * zz + s2) * zz + s3) * zz + s4) * zz + s5) * zz + s6);
-        const double pc = 1.0 - 0.5 * zz + zz * zz * (((((c1 * zz + c2) * zz + c3) * zz + c4) * zz + c5) * zz + c6);
-        const int q = (j >> 1) & 3; /* quadrant of a */
-        const double sa = (q & 1) ? pc : ps, ca = (q & 1) ? ps : pc;
-        sin_out[b] = ((q & 2) ? -sa : sa) * (x[b] < 0 ? -1.0 : 1.0);
-        cos_out[b] = ((q == 1 || q == 2) ? -ca : ca);
-    }
-    if (large)
-        for (int b = 0; b < BLOCK; b++)
-            if (!(fabs(x[b]) < 1073741824.0)) {
-                sin_out[b] = sin(x[b]);
-                cos_out[b] = cos(x[b]);
-            }
-}
-
-/* m = R(axis, angle) m for BLOCK matrices m[entry][frame]. */
-static MT_INLINE void rotate_left_block(double m[9][BLOCK], int axis, const double *s, const double *c)
-{
-    const int a = axis == MT_DOF_RX ? 1 : axis == MT_DOF_RY ? 2 : 0;
-    const int b = axis == MT_DOF_RX ? 2 : axis == MT_DOF_RY ? 0 : 1;
-    for (int k = 0; k < 3; k++)
-        for (int f = 0; f < BLOCK; f++) {
-            const double ra = m[3 * a + k][f], rb = m[3 * b + k][f];
-            m[3 * a + k][f] = c[f] * ra - s[f] * rb;
-            m[3 * b + k][f] = s[f] * ra + c[f] * rb;
-        }
 }
 
 /* out = x y for block matrices. */
@@ -275,86 +186,4 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
     free(k.world);
     free(k.end);
     return status;
-}
-
-static MT_CLONES void euler_block(const double *angles, size_t n, const int *axes, size_t count,
-                                  double scale, double *out)
-{
-    for (size_t f0 = 0; f0 < n; f0 += BLOCK) {
-        const size_t m = n - f0 < BLOCK ? n - f0 : BLOCK;
-        double r[9][BLOCK], v[BLOCK], sn[BLOCK], cs[BLOCK];
-        for (int e = 0; e < 9; e++)
-            for (int f = 0; f < BLOCK; f++)
-                r[e][f] = identity[e];
-        for (size_t a = 0; a < count; a++) {
-            for (int f = 0; f < BLOCK; f++)
-                v[f] = angles[(f0 + ((size_t)f < m ? (size_t)f : m - 1)) * count + a] * scale;
-            sincos_block(v, sn, cs);
-            rotate_left_block(r, axes[a], sn, cs);
-        }
-        for (size_t f = 0; f < m; f++)
-            for (int e = 0; e < 9; e++)
-                out[(f0 + f) * 9 + e] = r[e][f];
-    }
-}
-
-int mt_euler_to_matrices(const double *angles, size_t n, const int *axes, size_t count, double scale,
-                         double *out)
-{
-    if (n == 0)
-        return MT_OK;
-    if (!out || (count > 0 && (!angles || !axes)))
-        return MT_EINVAL;
-    for (size_t a = 0; a < count; a++)
-        if (axes[a] < MT_DOF_RX || axes[a] > MT_DOF_RZ)
-            return MT_EINVAL;
-    euler_block(angles, n, axes, count, scale, out);
-    return MT_OK;
-}
-
-int mt_matrices_to_euler(const double *m, size_t n, const int *axes, double scale, double *angles)
-{
-    if (n > 0 && (!m || !axes || !angles))
-        return MT_EINVAL;
-    if (n == 0)
-        return MT_OK;
-    const int i = axes[0], j = axes[1], k = axes[2];
-    if (i < MT_DOF_RX || i > MT_DOF_RZ || j < MT_DOF_RX || j > MT_DOF_RZ || k < MT_DOF_RX ||
-        k > MT_DOF_RZ || i == j || j == k || i == k)
-        return MT_EINVAL;
-    /* R = R_k(c) R_j(b) R_i(a); e is the parity of the axis permutation. */
-    const double e = (j - i + 3) % 3 == 1 ? 1.0 : -1.0;
-    for (size_t f = 0; f < n; f++, m += 9, angles += 3) {
-        /* atan2 against the cosine, not asin: accurate up to gimbal lock */
-        angles[1] = atan2(-e * m[3 * k + i], hypot(m[3 * k + j], m[3 * k + k])) / scale;
-        angles[0] = atan2(e * m[3 * k + j], m[3 * k + k]) / scale;
-        angles[2] = atan2(e * m[3 * j + i], m[3 * i + i]) / scale;
-    }
-    return MT_OK;
-}
-
-int mt_rotations_to_quaternions(const double *m, size_t n, double *q)
-{
-    if (n > 0 && (m == NULL || q == NULL))
-        return MT_EINVAL;
-    for (size_t i = 0; i < n; i++, m += 9, q += 4) {
-        const double trace = m[0] + m[4] + m[8];
-        double w, x, y, z;
-        if (trace > 0) { /* Shepperd: divide by the largest of 4w^2, 4x^2, 4y^2, 4z^2 */
-            const double s = 2 * sqrt(trace + 1);
-            w = s / 4, x = (m[7] - m[5]) / s, y = (m[2] - m[6]) / s, z = (m[3] - m[1]) / s;
-        } else if (m[0] > m[4] && m[0] > m[8]) {
-            const double s = 2 * sqrt(1 + m[0] - m[4] - m[8]);
-            w = (m[7] - m[5]) / s, x = s / 4, y = (m[1] + m[3]) / s, z = (m[2] + m[6]) / s;
-        } else if (m[4] > m[8]) {
-            const double s = 2 * sqrt(1 + m[4] - m[0] - m[8]);
-            w = (m[2] - m[6]) / s, x = (m[1] + m[3]) / s, y = s / 4, z = (m[5] + m[7]) / s;
-        } else {
-            const double s = 2 * sqrt(1 + m[8] - m[0] - m[4]);
-            w = (m[3] - m[1]) / s, x = (m[2] + m[6]) / s, y = (m[5] + m[7]) / s, z = s / 4;
-        }
-        const double sign = w < 0 ? -1.0 : 1.0;
-        q[0] = sign * w, q[1] = sign * x, q[2] = sign * y, q[3] = sign * z;
-    }
-    return MT_OK;
 }

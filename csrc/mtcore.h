@@ -173,14 +173,6 @@ enum mt_dof {
 };
 
 /*
- * The rotation (3x3, row-major) of `count` rotations about the axes
- * axes[i] (MT_DOF_RX .. RZ) by angles[i] * scale radians, applied in that
- * order about fixed axes: R = R[count-1] ... R[1] R[0].
- */
-int mt_axis_rotations(const int *axes, const double *angles, size_t count, double scale,
-                      double *out);
-
-/*
  * Forward kinematics of a tree of joints over frames, ASF/AMC semantics.
  *
  * Joint j has parent[j] (-1 for a root); order[] lists every joint once,
@@ -212,22 +204,65 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
                           size_t end, double *positions, double *world, double *local);
 
 /*
- * n rotation matrices (n x 9) of angles (n x count, times scale radians)
- * about axes[0..count-1] (MT_DOF_RX .. RZ), applied in that order about
- * fixed axes: the vectorised mt_axis_rotations.
+ * Rotations (rotation.c), n at a time.  Matrices are 3x3 row-major (n x 9);
+ * quaternions (n x 4) are (w, x, y, z), need not be unit (they are
+ * normalised; a zero quaternion gives NaN) and come out with w >= 0 where
+ * they are results of a conversion; rotation vectors (n x 3) are the axis
+ * times the angle in radians.  Axes are MT_DOF_RX .. MT_DOF_RZ.
+ *
+ * Euler angles about axes[0], axes[1], axes[2] (angles times scale
+ * radians) are extrinsic, about fixed axes, R = R2(c) R1(b) R0(a), or
+ * intrinsic, about the axes as they turn, R = R0(a) R1(b) R2(c).
  */
-int mt_euler_to_matrices(const double *angles, size_t n, const int *axes, size_t count, double scale,
-                         double *out);
 
 /*
- * The angles (n x 3, in units of 1/scale radians) about three distinct
- * axes applied in that order about fixed axes, of n rotation matrices; the
- * middle angle in [-90, 90] degrees.
+ * Matrices of n sequences of `count` rotations (angles n x count) about
+ * axes[0 .. count-1], any sequence of axes, extrinsic or intrinsic.
  */
-int mt_matrices_to_euler(const double *matrices, size_t n, const int *axes, double scale, double *angles);
+int mt_euler_to_matrices(const double *angles, size_t n, const int *axes, size_t count, int intrinsic,
+                         double scale, double *out);
 
-/* Unit quaternions (w, x, y, z), w >= 0, of n rotation matrices (3x3, row-major). */
-int mt_rotations_to_quaternions(const double *matrices, size_t n, double *quaternions);
+/*
+ * Euler angles (n x 3, in units of 1/scale radians) of n matrices, for
+ * Tait-Bryan axes (three distinct) or proper Euler axes (the first and last
+ * the same): a and c in [-pi, pi], b in [-pi/2, pi/2] (Tait-Bryan) or
+ * [0, pi] (proper), the ranges of scipy.  At gimbal lock (b = +-pi/2,
+ * or 0 or pi) only a +- c is defined: c is then 0.
+ */
+int mt_matrices_to_euler(const double *matrices, size_t n, const int *axes, int intrinsic, double scale,
+                         double *angles);
+
+int mt_matrices_to_quaternions(const double *matrices, size_t n, double *quaternions);
+int mt_quaternions_to_matrices(const double *quaternions, size_t n, double *matrices);
+/* The rotation vectors have angles in [0, pi]. */
+int mt_quaternions_to_rotvecs(const double *quaternions, size_t n, double *rotvecs);
+int mt_rotvecs_to_quaternions(const double *rotvecs, size_t n, double *quaternions);
+
+/*
+ * Continuity along the middle axis of (outer, n, inner) arrays of quaternions
+ * (inner quaternions per frame) or Euler triples (inner triples per frame).
+ * Frame 0 is copied; each later frame becomes, of the rotations equal to it,
+ * the one nearest to the output frame before it:
+ *   quaternions  q or -q, whichever has a non-negative dot product;
+ *   Euler        (a, b, c) or the other solution (a + h, h - b, c + h)
+ *                (Tait-Bryan; (a + h, -b, c + h) when `proper`), each angle
+ *                shifted by whole turns 2h; h is a half turn (pi or 180).
+ * An item after one holding NaN is kept as it is: the filter restarts there.
+ */
+int mt_unroll_quaternions(const double *in, size_t outer, size_t n, size_t inner, double *out);
+int mt_unroll_euler(const double *in, size_t outer, size_t n, size_t inner, int proper, double half_turn,
+                    double *out);
+
+/*
+ * Interpolation from key 0 to key 1 by the fractions t (n of each): SLERP
+ * along the shorter arc (unit quaternions out), or rotation vectors
+ * v0 + t (v1 - v0), where `aligned` first replaces v0 by the rotation vector
+ * of -q0 (v0 (1 - 2 pi / |v0|)) when q0 . q1 < 0, q0 and q1 the keys'
+ * quaternions.
+ */
+int mt_slerp(const double *q0, const double *q1, const double *t, size_t n, double *out);
+int mt_interpolate_rotvecs(const double *v0, const double *v1, const double *t, size_t n, int aligned,
+                           double *out);
 
 /*
  * The per-frame loop of the motion combiner: output frame f of `channels`

@@ -6,7 +6,8 @@ scipy.ndimage counterparts (same signatures, defaults and results)::
     from mtcore import median_filter1d, uniform_filter1d, binomial_filter1d
 
 and frame text (AMC bodies) scanned into arrays and written back exactly
-(:func:`scan_frames`, :func:`format_frames`).
+(:func:`scan_frames`, :func:`format_frames`); rotations of whole arrays (Euler
+angles, matrices, quaternions, rotation vectors) in :mod:`mtcore.rotations`.
 """
 
 from . import errors

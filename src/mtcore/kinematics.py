@@ -12,6 +12,7 @@ import numpy as np
 from ._mtcore import ffi, lib
 from ._parallel import cpu_count, run_all
 from ._status import check
+from .rotations import _sequence_matrices, matrices_to_euler, matrices_to_quaternions
 
 __all__ = ["JointTree", "axis_rotations", "euler_angles", "euler_matrices", "forward_kinematics",
            "rotations_to_quaternions", "DOFS"]
@@ -114,14 +115,11 @@ def forward_kinematics(values: np.ndarray, tree: JointTree, *, world: bool = Fal
 def axis_rotations(axes: str, angles, scale: float = 1.0) -> np.ndarray:
     """The 3x3 rotation of rotations about ``axes`` (letters such as "XYZ") by
     ``angles`` times ``scale`` radians, applied in that order about fixed axes."""
-    codes = [DOFS["r" + a.lower()] for a in axes]
+    codes = _axis_codes(axes)
     angles = _doubles(angles)
-    if len(codes) != len(angles):
+    if angles.shape != (len(codes),):
         raise ValueError(f"{len(codes)} axes but {len(angles)} angles")
-    out = np.empty((3, 3))
-    check(lib.mt_axis_rotations(ffi.new("int[]", codes), ffi.from_buffer("double[]", angles), len(codes),
-                                scale, ffi.from_buffer("double[]", out)), "mt_axis_rotations")
-    return out
+    return _sequence_matrices(angles[None], codes, False, scale)[0]
 
 
 def _axis_codes(axes: str) -> list[int]:
@@ -133,36 +131,18 @@ def _axis_codes(axes: str) -> list[int]:
 
 def euler_matrices(angles: np.ndarray, axes: str) -> np.ndarray:
     """(..., 3, 3) rotations of angles (..., len(axes)) in radians about ``axes``
-    (letters such as "xyz"), applied in that order about fixed axes."""
+    (letters such as "xyz", any number of them), applied in that order about fixed axes."""
     codes = _axis_codes(axes)
     angles = _doubles(angles)
     if angles.shape[-1:] != (len(codes),):
         raise ValueError(f"angles must end in an axis of {len(codes)} (one per axis), got shape {angles.shape}")
-    out = np.empty(angles.shape[:-1] + (3, 3))
-    check(lib.mt_euler_to_matrices(ffi.from_buffer("double[]", angles), out.size // 9, ffi.new("int[]", codes),
-                                   len(codes), 1.0, ffi.from_buffer("double[]", out)), "mt_euler_to_matrices")
-    return out
+    return _sequence_matrices(angles, codes, False, 1.0)
 
 
 def euler_angles(matrices: np.ndarray, axes: str) -> np.ndarray:
-    """The angles (..., 3) in radians about three distinct ``axes`` applied in order
-    of rotations (..., 3, 3); the middle angle in [-pi/2, pi/2]."""
-    codes = _axis_codes(axes)
-    if len(codes) != 3 or len(set(codes)) != 3:
-        raise ValueError(f"axes must be three distinct letters, got {axes!r}")
-    m = _doubles(matrices)
-    out = np.empty(m.shape[:-2] + (3,))
-    check(lib.mt_matrices_to_euler(ffi.from_buffer("double[]", m), m.size // 9, ffi.new("int[]", codes), 1.0,
-                                   ffi.from_buffer("double[]", out)), "mt_matrices_to_euler")
-    return out
+    """The angles (..., 3) in radians about ``axes`` (one of mtcore.rotations.ORDERS) applied
+    in that order about fixed axes, of rotations (..., 3, 3): ``matrices_to_euler``, extrinsic."""
+    return matrices_to_euler(matrices, axes, extrinsic=True)
 
 
-def rotations_to_quaternions(matrices: np.ndarray) -> np.ndarray:
-    """Unit quaternions (..., 4) as (w, x, y, z) with w >= 0, of rotation matrices (..., 3, 3)."""
-    m = _doubles(matrices)
-    if m.shape[-2:] != (3, 3):
-        raise ValueError(f"matrices must have shape (..., 3, 3), got {m.shape}")
-    q = np.empty(m.shape[:-2] + (4,))
-    check(lib.mt_rotations_to_quaternions(ffi.from_buffer("double[]", m), m.size // 9,
-                                          ffi.from_buffer("double[]", q)), "mt_rotations_to_quaternions")
-    return q
+rotations_to_quaternions = matrices_to_quaternions

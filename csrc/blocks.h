@@ -1,0 +1,73 @@
+/*
+ * blocks.h - build-internal: rotations of BLOCK frames at a time, shared by
+ * forward kinematics (kinematics.c) and the rotation kernels (rotation.c).
+ *
+ * Frames are computed BLOCK at a time, every quantity an array over the
+ * block (structure of arrays), so that the inner loops run over frames and
+ * vectorise: sin and cos included, with the polynomial below instead of
+ * libm's scalar calls.
+ */
+#ifndef MT_BLOCKS_H
+#define MT_BLOCKS_H
+
+#include "clones.h"
+#include "mtcore.h"
+
+#include <math.h>
+
+enum { BLOCK = 8 };
+
+static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+/*
+ * sin and cos of x (radians), branch-free: reduction by pi/4 in three parts
+ * and the minimax polynomials of Cephes (Moshier), to about 1e-16 for
+ * |x| < 2^30.  Larger angles (where the reduction fails) go to libm.
+ */
+static MT_INLINE void sincos_block(const double *x, double *sin_out, double *cos_out)
+{
+    static const double s1 = 1.58962301576546568060e-10, s2 = -2.50507477628578072866e-8,
+                        s3 = 2.75573136213857245213e-6, s4 = -1.98412698295895385996e-4,
+                        s5 = 8.33333333332211858878e-3, s6 = -1.66666666666666307295e-1;
+    static const double c1 = -1.13585365213876817300e-11, c2 = 2.08757008419747316778e-9,
+                        c3 = -2.75573141792967388112e-7, c4 = 2.48015872888517045348e-5,
+                        c5 = -1.38888888888730564116e-3, c6 = 4.16666666666665929218e-2;
+    static const double dp1 = 7.85398125648498535156e-1, dp2 = 3.77489470793079817668e-8,
+                        dp3 = 2.69515142907905952645e-15, four_over_pi = 1.27323954473516268615;
+    int large = 0;
+    for (int b = 0; b < BLOCK; b++) {
+        const double a = fabs(x[b]);
+        large |= !(a < 1073741824.0); /* 2^30, and NaN */
+        int j = (int)(a < 1073741824.0 ? a * four_over_pi : 0.0);
+        j += j & 1; /* round the octant up to even */
+        const double y = (double)j;
+        const double z = ((a - y * dp1) - y * dp2) - y * dp3, zz = z * z;
+        const double ps = z + z * zz * (((((s1 * zz + s2) * zz + s3) * zz + s4) * zz + s5) * zz + s6);
+        const double pc = 1.0 - 0.5 * zz + zz * zz * (((((c1 * zz + c2) * zz + c3) * zz + c4) * zz + c5) * zz + c6);
+        const int q = (j >> 1) & 3; /* quadrant of a */
+        const double sa = (q & 1) ? pc : ps, ca = (q & 1) ? ps : pc;
+        sin_out[b] = ((q & 2) ? -sa : sa) * (x[b] < 0 ? -1.0 : 1.0);
+        cos_out[b] = ((q == 1 || q == 2) ? -ca : ca);
+    }
+    if (large)
+        for (int b = 0; b < BLOCK; b++)
+            if (!(fabs(x[b]) < 1073741824.0)) {
+                sin_out[b] = sin(x[b]);
+                cos_out[b] = cos(x[b]);
+            }
+}
+
+/* m = R(axis, angle) m for BLOCK matrices m[entry][frame]. */
+static MT_INLINE void rotate_left_block(double m[9][BLOCK], int axis, const double *s, const double *c)
+{
+    const int a = axis == MT_DOF_RX ? 1 : axis == MT_DOF_RY ? 2 : 0;
+    const int b = axis == MT_DOF_RX ? 2 : axis == MT_DOF_RY ? 0 : 1;
+    for (int k = 0; k < 3; k++)
+        for (int f = 0; f < BLOCK; f++) {
+            const double ra = m[3 * a + k][f], rb = m[3 * b + k][f];
+            m[3 * a + k][f] = c[f] * ra - s[f] * rb;
+            m[3 * b + k][f] = s[f] * ra + c[f] * rb;
+        }
+}
+
+#endif /* MT_BLOCKS_H */

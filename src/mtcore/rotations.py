@@ -1,0 +1,268 @@
+"""Rotations of whole arrays, in C: Euler angles, matrices, quaternions and
+rotation vectors (exponential maps), their continuity along frames, and
+interpolation between keys.
+
+Conventions (those of ``scipy.spatial.transform.Rotation``, which the tests
+reproduce to 1e-12):
+
+- Matrices (..., 3, 3) are row-major and act on column vectors, v' = R v.
+- Quaternions (..., 4) are (w, x, y, z), scalar first.  Inputs need not be
+  unit: they are normalised, and a zero quaternion gives NaN.  Conversions
+  return the sign with w >= 0.
+- Rotation vectors (..., 3) are the axis times the angle in radians;
+  conversions return angles in [0, pi].
+- Euler angles (..., 3) (a, b, c) about the axes of ``order``, one of
+  :data:`ORDERS`: three lowercase letters, Tait-Bryan (three distinct axes)
+  or proper Euler (the first axis again last).  The keyword ``extrinsic``
+  (always required) says about which axes: for order "ijk",
+
+  - ``extrinsic=True``: about the fixed axes, in order: R = R_k(c) R_j(b) R_i(a)
+    (scipy's lowercase "ijk");
+  - ``extrinsic=False``: intrinsic, about the axes as they turn:
+    R = R_i(a) R_j(b) R_k(c) (scipy's uppercase "IJK").
+
+  Angles are radians, or degrees with ``degrees=True``.  Angles found from
+  rotations lie, as in scipy, in a, c in [-pi, pi], b in [-pi/2, pi/2]
+  (Tait-Bryan) or [0, pi] (proper Euler).  At gimbal lock (b = +-pi/2, or
+  b = 0 or pi) only a + c or a - c is defined: c is then 0.
+
+Arrays may have any leading shape, any real dtype and any memory layout
+(they are computed in float64); inputs are never modified.  Arguments are
+checked before any C call: TypeError for a dtype that is not real, ValueError
+for a wrong shape or an unknown order.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.lib.array_utils import normalize_axis_index
+
+from ._mtcore import ffi, lib
+from ._status import check
+
+__all__ = [
+    "ORDERS", "euler_to_matrices", "euler_to_quaternions", "euler_to_rotvecs", "interpolate_rotvecs",
+    "matrices_to_euler", "matrices_to_quaternions", "matrices_to_rotvecs", "quaternions_to_euler",
+    "quaternions_to_matrices", "quaternions_to_rotvecs", "rotvecs_to_euler", "rotvecs_to_matrices",
+    "rotvecs_to_quaternions", "slerp", "unroll_euler", "unroll_quaternions",
+]
+
+ORDERS = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx", "xyx", "xzx", "yxy", "yzy", "zxz", "zyz")
+AXES = {"x": lib.MT_DOF_RX, "y": lib.MT_DOF_RY, "z": lib.MT_DOF_RZ}
+
+
+def _real(a, name: str, trailing: tuple[int, ...]) -> np.ndarray:
+    """``a`` as a C-contiguous float64 array of shape (..., *trailing)."""
+    a = np.asarray(a)
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    if a.ndim < len(trailing) or a.shape[a.ndim - len(trailing):] != trailing:
+        wanted = ", ".join(["..."] + [str(n) for n in trailing])
+        raise ValueError(f"{name} must have shape ({wanted}), got {a.shape}")
+    return np.asarray(a, dtype=np.float64, order="C")
+
+
+def _flag(value, name: str) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def _order(order) -> list[int]:
+    if not isinstance(order, str):
+        raise TypeError(f"order must be a string such as 'xyz', got {type(order).__name__}")
+    if order not in ORDERS:
+        hint = " (lowercase; extrinsic= says fixed or turning axes)" if order.lower() in ORDERS else ""
+        raise ValueError(f"order must be one of {', '.join(ORDERS)}, got {order!r}{hint}")
+    return [AXES[letter] for letter in order]
+
+
+def _scale(degrees) -> float:
+    return math.pi / 180 if _flag(degrees, "degrees") else 1.0
+
+
+def _ptr(a: np.ndarray):
+    return ffi.from_buffer("double[]", a)
+
+
+def _sequence_matrices(angles: np.ndarray, codes: list[int], intrinsic: bool, scale: float) -> np.ndarray:
+    """Matrices (..., 3, 3) of float64 angles (..., len(codes)) about the axes ``codes``."""
+    out = np.empty(angles.shape[:-1] + (3, 3))
+    check(lib.mt_euler_to_matrices(_ptr(angles), out.size // 9, ffi.new("int[]", codes), len(codes), intrinsic,
+                                   scale, _ptr(out)), "mt_euler_to_matrices")
+    return out
+
+
+def _euler(m: np.ndarray, codes: list[int], intrinsic: bool, scale: float) -> np.ndarray:
+    out = np.empty(m.shape[:-2] + (3,))
+    check(lib.mt_matrices_to_euler(_ptr(m), out.size // 3, ffi.new("int[]", codes), intrinsic, scale, _ptr(out)),
+          "mt_matrices_to_euler")
+    return out
+
+
+def _convert(kernel: str, x: np.ndarray, lead: tuple[int, ...], trailing: tuple[int, ...]) -> np.ndarray:
+    """out (*lead, *trailing) = kernel(x) for the kernels (in, n, out)."""
+    out = np.empty(lead + trailing)
+    check(getattr(lib, kernel)(_ptr(x), math.prod(lead), _ptr(out)), kernel)
+    return out
+
+
+def _quaternions(m: np.ndarray) -> np.ndarray:
+    return _convert("mt_matrices_to_quaternions", m, m.shape[:-2], (4,))
+
+
+def _matrices(q: np.ndarray) -> np.ndarray:
+    return _convert("mt_quaternions_to_matrices", q, q.shape[:-1], (3, 3))
+
+
+def _rotvecs(q: np.ndarray) -> np.ndarray:
+    return _convert("mt_quaternions_to_rotvecs", q, q.shape[:-1], (3,))
+
+
+def _from_rotvecs(v: np.ndarray) -> np.ndarray:
+    return _convert("mt_rotvecs_to_quaternions", v, v.shape[:-1], (4,))
+
+
+def euler_to_matrices(angles, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
+    """Rotation matrices (..., 3, 3) of Euler angles (..., 3) (see the module's conventions)."""
+    codes, intrinsic, scale = _order(order), not _flag(extrinsic, "extrinsic"), _scale(degrees)
+    return _sequence_matrices(_real(angles, "angles", (3,)), codes, intrinsic, scale)
+
+
+def matrices_to_euler(matrices, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
+    """Euler angles (..., 3) of rotation matrices (..., 3, 3), in scipy's ranges; c = 0 at gimbal lock."""
+    codes, intrinsic, scale = _order(order), not _flag(extrinsic, "extrinsic"), _scale(degrees)
+    return _euler(_real(matrices, "matrices", (3, 3)), codes, intrinsic, scale)
+
+
+def matrices_to_quaternions(matrices) -> np.ndarray:
+    """Unit quaternions (..., 4), w >= 0, of rotation matrices (..., 3, 3) (Shepperd's method)."""
+    return _quaternions(_real(matrices, "matrices", (3, 3)))
+
+
+def quaternions_to_matrices(quaternions) -> np.ndarray:
+    """Rotation matrices (..., 3, 3) of quaternions (..., 4), normalised first."""
+    return _matrices(_real(quaternions, "quaternions", (4,)))
+
+
+def quaternions_to_rotvecs(quaternions) -> np.ndarray:
+    """Rotation vectors (..., 3), angles in [0, pi], of quaternions (..., 4).  Accurate at
+    angles near 0 (a series) and near pi."""
+    return _rotvecs(_real(quaternions, "quaternions", (4,)))
+
+
+def rotvecs_to_quaternions(rotvecs) -> np.ndarray:
+    """Unit quaternions (..., 4), w >= 0, of rotation vectors (..., 3), any angle."""
+    return _from_rotvecs(_real(rotvecs, "rotvecs", (3,)))
+
+
+def euler_to_quaternions(angles, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
+    """Unit quaternions (..., 4), w >= 0, of Euler angles (..., 3)."""
+    return _quaternions(euler_to_matrices(angles, order, extrinsic=extrinsic, degrees=degrees))
+
+
+def quaternions_to_euler(quaternions, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
+    """Euler angles (..., 3) of quaternions (..., 4), as :func:`matrices_to_euler`."""
+    codes, intrinsic, scale = _order(order), not _flag(extrinsic, "extrinsic"), _scale(degrees)
+    return _euler(_matrices(_real(quaternions, "quaternions", (4,))), codes, intrinsic, scale)
+
+
+def euler_to_rotvecs(angles, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
+    """Rotation vectors (..., 3), angles in [0, pi], of Euler angles (..., 3)."""
+    return _rotvecs(euler_to_quaternions(angles, order, extrinsic=extrinsic, degrees=degrees))
+
+
+def rotvecs_to_euler(rotvecs, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
+    """Euler angles (..., 3) of rotation vectors (..., 3), as :func:`matrices_to_euler`."""
+    codes, intrinsic, scale = _order(order), not _flag(extrinsic, "extrinsic"), _scale(degrees)
+    return _euler(_matrices(_from_rotvecs(_real(rotvecs, "rotvecs", (3,)))), codes, intrinsic, scale)
+
+
+def matrices_to_rotvecs(matrices) -> np.ndarray:
+    """Rotation vectors (..., 3), angles in [0, pi], of rotation matrices (..., 3, 3)."""
+    return _rotvecs(matrices_to_quaternions(matrices))
+
+
+def rotvecs_to_matrices(rotvecs) -> np.ndarray:
+    """Rotation matrices (..., 3, 3) of rotation vectors (..., 3)."""
+    return _matrices(rotvecs_to_quaternions(rotvecs))
+
+
+def _along(a: np.ndarray, axis, name: str, width: int) -> tuple[int, int, int]:
+    """(outer, n, inner) of ``a`` (..., width) around its axis of frames ``axis``."""
+    if not isinstance(axis, (int, np.integer)) or isinstance(axis, (bool, np.bool_)):
+        raise TypeError(f"axis must be an integer, got {axis!r}")
+    axis = normalize_axis_index(int(axis), a.ndim)
+    if axis == a.ndim - 1:
+        raise ValueError(f"axis must be an axis of frames, not the last axis of {name} (its {width} components)")
+    return math.prod(a.shape[:axis]), a.shape[axis], math.prod(a.shape[axis + 1:-1])
+
+
+def unroll_quaternions(quaternions, axis: int = 0) -> np.ndarray:
+    """Quaternions (..., 4) with signs continuous along ``axis``: each one after the first
+    is negated (the same rotation) where its dot product with the one before is negative.
+    A quaternion after a NaN one is kept as it is."""
+    q = _real(quaternions, "quaternions", (4,))
+    outer, n, inner = _along(q, axis, "quaternions", 4)
+    out = np.empty_like(q)
+    check(lib.mt_unroll_quaternions(_ptr(q), outer, n, inner, _ptr(out)), "mt_unroll_quaternions")
+    return out
+
+
+def unroll_euler(angles, order: str, *, axis: int = 0, degrees: bool = False) -> np.ndarray:
+    """Euler angles (..., 3) made continuous along ``axis``: each triple after the first becomes,
+    of the triples of the same rotation, the nearest (least sum of squared differences) to the
+    output before it.  Those are the triple and the other solution, (a + pi, pi - b, c + pi)
+    for Tait-Bryan orders and (a + pi, -b, c + pi) for proper Euler orders, each angle shifted
+    by any whole turns.  Intrinsic and extrinsic angles alike (``order`` only tells the kind).
+    A triple next to one holding NaN is kept as it is.  The split of a + c or a - c at gimbal
+    lock is kept as given."""
+    codes, half_turn = _order(order), 180.0 if _flag(degrees, "degrees") else math.pi
+    a = _real(angles, "angles", (3,))
+    outer, n, inner = _along(a, axis, "angles", 3)
+    out = np.empty_like(a)
+    check(lib.mt_unroll_euler(_ptr(a), outer, n, inner, codes[0] == codes[2], half_turn, _ptr(out)),
+          "mt_unroll_euler")
+    return out
+
+
+def _keys(k0, k1, t, names: tuple[str, str], width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Keys (..., width) and fractions (...) broadcast together, C-contiguous float64."""
+    k0, k1 = _real(k0, names[0], (width,)), _real(k1, names[1], (width,))
+    t = _real(t, "t", ())
+    try:
+        shape = np.broadcast_shapes(k0.shape[:-1], k1.shape[:-1], t.shape)
+    except ValueError:
+        raise ValueError(f"{names[0]} {k0.shape}, {names[1]} {k1.shape} and t {t.shape} do not broadcast "
+                         f"together (the keys' last axis aside)") from None
+    return (np.ascontiguousarray(np.broadcast_to(k0, shape + (width,))),
+            np.ascontiguousarray(np.broadcast_to(k1, shape + (width,))),
+            np.ascontiguousarray(np.broadcast_to(t, shape)))
+
+
+def slerp(q0, q1, t) -> np.ndarray:
+    """Spherical linear interpolation from quaternions q0 to q1 (..., 4) by fractions t, along
+    the shorter arc (q1 negated where q0 . q1 < 0): unit quaternions of the broadcast shape of
+    q0, q1 (the last axis aside) and t, (..., 4).  t = 0 gives q0 normalised, t = 1 q1 or -q1
+    normalised; t outside [0, 1] extrapolates.  E.g. frames between two keys:
+    ``slerp(q0, q1, np.linspace(0, 1, frames)[:, None])`` for keys (joints, 4)."""
+    q0, q1, t = _keys(q0, q1, t, ("q0", "q1"), 4)
+    out = np.empty_like(q0)
+    check(lib.mt_slerp(_ptr(q0), _ptr(q1), _ptr(t), t.size, _ptr(out)), "mt_slerp")
+    return out
+
+
+def interpolate_rotvecs(v0, v1, t, *, aligned: bool = False) -> np.ndarray:
+    """Rotation vectors interpolated linearly from v0 to v1 (..., 3) by fractions t, broadcast
+    as for :func:`slerp`.  Plain (``aligned=False``) this may take the long way round; with
+    ``aligned=True`` v0 is first replaced by the rotation vector of its quaternion negated,
+    v0 (1 - 2 pi / |v0|), where the keys' quaternions have a negative dot product, so that
+    keys near the same rotation interpolate through it."""
+    v0, v1, t = _keys(v0, v1, t, ("v0", "v1"), 3)
+    aligned = _flag(aligned, "aligned")
+    out = np.empty_like(v0)
+    check(lib.mt_interpolate_rotvecs(_ptr(v0), _ptr(v1), _ptr(t), t.size, aligned, _ptr(out)),
+          "mt_interpolate_rotvecs")
+    return out
