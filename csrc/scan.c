@@ -117,6 +117,41 @@ static const char *parse_number(const char *p, const char *end, double *out)
     return parse_slow(start, stop, out) ? stop : NULL;
 }
 
+/*
+ * Reads the numbers of the line at *p into dst[0 .. count-1], leaving *p at
+ * the line's end; MT_ESYNTAX or MT_ECOUNT (with found/expected) otherwise.
+ */
+static int line_numbers(const char **p, const char *end, double *dst, size_t count,
+                        struct mt_scan_report *r)
+{
+    const char *q = *p;
+    size_t i = 0;
+    for (;; i++) {
+        while (q < end && is_blank(*q))
+            q++;
+        if (q == end || is_eol(*q))
+            break;
+        if (i >= count) { /* too many: count them for the report */
+            q = token_end(q, end);
+            continue;
+        }
+        const char *stop = parse_number(q, end, &dst[i]);
+        if (stop == NULL) {
+            r->found = (long long)i;
+            *p = q;
+            return MT_ESYNTAX;
+        }
+        q = stop;
+    }
+    *p = q;
+    if (i != count) {
+        r->found = (long long)i;
+        r->expected = (long long)count;
+        return MT_ECOUNT;
+    }
+    return MT_OK;
+}
+
 /* A line holding one token of digits only: the frame number, or -1. */
 static long long frame_number(const char *tok, const char *tok_end, const char *line_rest,
                               const char *end)
@@ -222,31 +257,10 @@ static int scan_text(const char *text, const char *end, struct scan *s, double *
                 if (frames == 1)
                     s->order[s->norder++] = (size_t)k;
                 position++;
-                const size_t count = s->counts[k];
-                double *dst = row + s->offsets[k];
                 p = tok_stop;
-                size_t i = 0;
-                for (;; i++) {
-                    while (p < end && is_blank(*p))
-                        p++;
-                    if (p == end || is_eol(*p))
-                        break;
-                    if (i >= count) { /* too many: count them for the report */
-                        p = token_end(p, end);
-                        continue;
-                    }
-                    const char *stop = parse_number(p, end, &dst[i]);
-                    if (stop == NULL) {
-                        r->found = (long long)i;
-                        return MT_ESYNTAX;
-                    }
-                    p = stop;
-                }
-                if (i != count) {
-                    r->found = (long long)i;
-                    r->expected = (long long)count;
-                    return MT_ECOUNT;
-                }
+                const int status = line_numbers(&p, end, row + s->offsets[k], s->counts[k], r);
+                if (status != MT_OK)
+                    return status;
                 r->key = -1;
             }
         }
@@ -283,29 +297,9 @@ int mt_scan_table(const char *text, size_t len, size_t rows, size_t columns, dou
         if (p < end && !is_eol(*p)) {
             if (row == rows)
                 return MT_ERANGE;
-            double *dst = values + row * columns;
-            size_t i = 0;
-            for (;; i++) {
-                while (p < end && is_blank(*p))
-                    p++;
-                if (p == end || is_eol(*p))
-                    break;
-                if (i >= columns) {
-                    p = token_end(p, end);
-                    continue;
-                }
-                const char *stop = parse_number(p, end, &dst[i]);
-                if (stop == NULL) {
-                    report->found = (long long)i;
-                    return MT_ESYNTAX;
-                }
-                p = stop;
-            }
-            if (i != columns) {
-                report->found = (long long)i;
-                report->expected = (long long)columns;
-                return MT_ECOUNT;
-            }
+            const int status = line_numbers(&p, end, values + row * columns, columns, report);
+            if (status != MT_OK)
+                return status;
             report->frames = ++row;
         }
         if (p < end) {
