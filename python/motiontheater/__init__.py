@@ -33,6 +33,7 @@ from .combine import combine
 from .convert import to_asf, to_bvh
 from .scene import Scene, Track, read_recipe
 from .export import write_positions
+from .interpolate import Pipeline, interpolate
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Bone, Root, Skeleton
 
@@ -54,6 +55,8 @@ __all__ = [
     "__version__",
     "binomial_filter1d",
     "combine",
+    "interpolate",
+    "Pipeline",
     "Scene",
     "Track",
     "read_recipe",
