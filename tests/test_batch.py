@@ -18,10 +18,13 @@ from motiontheater.cli import main
 
 
 def expected_bytes(take: Path, kind="median", size=5) -> bytes:
-    """The take filtered alone, in memory, as write_amc writes it."""
-    motion = mt.read_amc(take, mt.read_asf(mt.skeleton_path_for(take)))
-    out = Path(os.environ.get("TMPDIR", "/tmp")) / f"expected-{os.getpid()}.amc"
-    mt.write_amc(motion.filter(kind, size), out)
+    """The take filtered alone, in memory, as write_amc or write_bvh writes it."""
+    out = Path(os.environ.get("TMPDIR", "/tmp")) / f"expected-{os.getpid()}{take.suffix}"
+    if take.suffix == ".bvh":
+        mt.write_bvh(mt.read_bvh(take).filter(kind, size), out)
+    else:
+        motion = mt.read_amc(take, mt.read_asf(mt.skeleton_path_for(take)))
+        mt.write_amc(motion.filter(kind, size), out)
     data = out.read_bytes()
     out.unlink()
     return data
@@ -29,7 +32,8 @@ def expected_bytes(take: Path, kind="median", size=5) -> bytes:
 
 @pytest.fixture(scope="module")
 def corpus_expected(data_dir):
-    return {take.relative_to(data_dir): expected_bytes(take) for take in sorted(data_dir.rglob("*.amc"))}
+    takes = sorted([*data_dir.rglob("*.amc"), *data_dir.rglob("*.bvh")])
+    return {take.relative_to(data_dir): expected_bytes(take) for take in takes}
 
 
 def assert_outputs(out: Path, expected: dict) -> None:
@@ -43,7 +47,7 @@ def test_corpus_on_two_processes_is_bit_identical_to_each_file_alone(data_dir, t
     assert main(["batch", "--median", "5", "--jobs", "2", str(data_dir), "-o", str(out)]) == 0
     assert_outputs(out, corpus_expected)
     assert (out / "cmu" / "01.asf").read_bytes() == (data_dir / "cmu" / "01.asf").read_bytes()
-    assert re.match(r"44 processed, 0 skipped \(already done\), 0 failed of 44 takes", capsys.readouterr().out)
+    assert re.match(r"54 processed, 0 skipped \(already done\), 0 failed of 54 takes", capsys.readouterr().out)
 
 
 def test_corpus_on_a_dask_local_cluster(data_dir, tmp_path, corpus_expected):
@@ -51,7 +55,7 @@ def test_corpus_on_a_dask_local_cluster(data_dir, tmp_path, corpus_expected):
     out = tmp_path / "out"
     jobs, settled = batch.plan_jobs([str(data_dir)], out, batch.Recipe("median", 5))
     summary = batch.run(jobs, settled, workers=2, dask_local=True, out=out)
-    assert not summary.failed and len(summary.results) == 44
+    assert not summary.failed and len(summary.results) == 54
     assert_outputs(out, corpus_expected)
 
 
@@ -63,7 +67,7 @@ def test_a_bad_take_is_reported_and_the_others_go_on(data_dir, tmp_path, capsys)
     out = tmp_path / "out"
     assert main(["batch", "--mean", "3", "--jobs", "2", str(src), "-o", str(out)]) == 1
     err = capsys.readouterr().err
-    assert "9 processed, 0 skipped (already done), 1 failed of 10 takes" in err
+    assert "11 processed, 0 skipped (already done), 1 failed of 12 takes" in err  # 10 AMC, 2 BVH
     assert re.search(r"FAILED .*02_02\.amc, line \d+: expected a number as value 1 of bone 'lfemur', found 'x'", err)
     assert not (out / "02_02.amc").exists() and (out / "02_01.amc").exists()
 
@@ -83,11 +87,11 @@ def test_resume_skips_what_is_done(data_dir, tmp_path, capsys):
     assert main(["batch", "--median", "3", "--jobs", "1", str(src), "-o", str(out)]) == 0
     capsys.readouterr()
     assert main(["batch", "--median", "3", "--resume", "--jobs", "1", str(src), "-o", str(out)]) == 0
-    assert "0 processed, 10 skipped (already done)" in capsys.readouterr().out
+    assert "0 processed, 12 skipped (already done)" in capsys.readouterr().out
     later = (out / "02_01.amc").stat().st_mtime + 10
     os.utime(src / "02_01.amc", (later, later))  # an input changed since its output
     assert main(["batch", "--median", "3", "--resume", "--jobs", "1", str(src), "-o", str(out)]) == 0
-    assert "1 processed, 9 skipped (already done)" in capsys.readouterr().out
+    assert "1 processed, 11 skipped (already done)" in capsys.readouterr().out
 
 
 def test_killing_a_run_leaves_no_partial_outputs_and_resume_completes_it(data_dir, tmp_path):
@@ -193,6 +197,7 @@ def test_inputs_files_folders_and_globs(data_dir, tmp_path):
     found = dict(batch.find_takes([str(data_dir / "hdm05" / "HDM_bd_*.amc"), str(data_dir / "edge"),
                                    str(data_dir / "cmu" / "02_01.amc")]))
     assert len(found) == 11 + 1 + 1
+    assert len(batch.find_takes([str(data_dir / "bvh")])) == 8
     assert found[data_dir / "edge" / "test.amc"] == Path("test.amc")
     assert found[data_dir / "cmu" / "02_01.amc"] == Path("02_01.amc")
     assert found[data_dir / "hdm05" / "HDM_bd_squat1Reps_003_120.amc"] == Path("HDM_bd_squat1Reps_003_120.amc")

@@ -116,3 +116,10 @@ def test_filter_command_finds_the_skeleton_and_writes_nothing_on_failure(data_di
     assert main(["filter", "--mean", "3", "--median", "5", str(data_dir / "cmu" / "01_01.amc"), "-o", str(bad)]) == 2
     assert "give exactly one of --median N, --mean N, --binomial N" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["smooth.amc"]
+
+
+def test_filter_command_on_bvh(data_dir, tmp_path, capsys):
+    out = tmp_path / "w.bvh"
+    assert main(["filter", "--median", "3", str(data_dir / "bvh" / "walk01.bvh"), "-o", str(out)]) == 0
+    expected = mt.read_bvh(data_dir / "bvh" / "walk01.bvh").filter("median", 3)
+    assert mt.read_bvh(out).values.tobytes() == expected.values.tobytes()

@@ -31,6 +31,7 @@ from mtcore.errors import FormatError, SequenceError
 from ._io import PARTIAL_PREFIX, encode, output
 from .amc import _first_frame_order, _header_lines, _layout, _split_header, read_amc, skeleton_path_for, write_amc
 from .asf import read_asf
+from .bvh import read_bvh, write_bvh
 from .filtering import Smoother, TakeStats
 from .motion import DEFAULT_FRAME_RATE, Motion
 
@@ -78,19 +79,22 @@ class Result:
     seconds: float = 0.0
 
 
+TAKES = (".amc", ".bvh")
+
+
 def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
-    """(take, its path relative to the output folder) for every AMC under the inputs."""
+    """(take, its path relative to the output folder) for every AMC and BVH under the inputs."""
     found: dict[Path, Path] = {}
     for item in inputs:
         if any(c in item for c in "*?["):
             base = Path(item.split("*")[0].split("?")[0].split("[")[0])
             base = base if str(item).endswith(os.sep) or base.is_dir() and str(base).endswith(os.sep) else base.parent
             for match in sorted(glob.glob(item, recursive=True)):
-                if match.lower().endswith(".amc"):
+                if match.lower().endswith(TAKES):
                     found.setdefault(Path(match), Path(match).relative_to(base))
         elif os.path.isdir(item):
             for path in sorted(Path(item).rglob("*")):
-                if path.suffix.lower() == ".amc" and path.is_file():
+                if path.suffix.lower() in TAKES and path.is_file():
                     found.setdefault(path, path.relative_to(item))
         elif os.path.isfile(item):
             found.setdefault(Path(item), Path(Path(item).name))
@@ -107,14 +111,16 @@ def plan_jobs(inputs: Iterable[str], out: str | os.PathLike, recipe: Recipe, *, 
     for take, relative in find_takes(inputs):
         target = Path(out) / relative
         try:
-            asf = Path(skeleton) if skeleton else skeleton_path_for(take)
+            asf = None if take.suffix.lower() == ".bvh" else Path(skeleton) if skeleton else skeleton_path_for(take)
         except FileNotFoundError as e:
             settled.append(Result(str(take), str(target), ok=False, error=str(e)))
             continue
-        if resume and target.exists() and target.stat().st_mtime >= max(take.stat().st_mtime, asf.stat().st_mtime):
+        inputs_time = max(take.stat().st_mtime, asf.stat().st_mtime if asf else 0)
+        if resume and target.exists() and target.stat().st_mtime >= inputs_time:
             settled.append(Result(str(take), str(target), skipped=True, bytes=take.stat().st_size))
             continue
-        jobs.append(Job(str(take), str(target), str(asf), recipe, frame_rate, stream_above, chunk_frames))
+        jobs.append(Job(str(take), str(target), str(asf) if asf else "", recipe, frame_rate, stream_above,
+                        chunk_frames))
     return jobs, settled
 
 
@@ -124,6 +130,12 @@ def run_job(job: Job) -> Result:
     result = Result(job.input, job.output, bytes=os.path.getsize(job.input))
     try:
         os.makedirs(os.path.dirname(job.output) or ".", exist_ok=True)
+        if not job.skeleton:  # a BVH take holds its skeleton
+            motion = read_bvh(job.input)
+            write_bvh(_smooth(motion, job.recipe), job.output)
+            result.frames = motion.frames
+            result.seconds = time.perf_counter() - start
+            return result
         skeleton = _skeleton(job.skeleton, *_stamp(job.skeleton))
         _copy_skeleton(job.skeleton, os.path.dirname(job.output))
         if result.bytes > job.stream_above:
@@ -132,14 +144,17 @@ def run_job(job: Job) -> Result:
             result.streamed = True
         else:
             motion = read_amc(job.input, skeleton, job.frame_rate, workers=1)
-            smoothed = motion.filter(job.recipe.kind, job.recipe.size, job.recipe.joints,
-                                     translation=job.recipe.translation, mode=job.recipe.mode, workers=1)
-            write_amc(smoothed, job.output)
+            write_amc(_smooth(motion, job.recipe), job.output)
             result.frames = motion.frames
     except (FormatError, ValueError, OSError) as e:
         result.ok, result.error = False, str(e)
     result.seconds = time.perf_counter() - start
     return result
+
+
+def _smooth(motion: Motion, recipe: Recipe) -> Motion:
+    return motion.filter(recipe.kind, recipe.size, recipe.joints, translation=recipe.translation, mode=recipe.mode,
+                         workers=1)
 
 
 def _stamp(path: str) -> tuple[int, int]:

@@ -134,12 +134,13 @@ def _convert(args: argparse.Namespace) -> int:
 
 
 def _filter(args: argparse.Namespace) -> int:
+    from .bvh import write_bvh
+
     kind, size = _chosen_filter(args)
-    skeleton_path = args.asf or skeleton_path_for(args.input)
-    motion = read_amc(args.input, read_asf(skeleton_path), frame_rate=args.frame_rate)
+    motion = _read_any(args.input, args.asf, args.frame_rate)
     joints = args.joints.split(",") if args.joints else None
     smoothed = motion.filter(kind, size, joints, translation=not args.no_translation, mode=args.mode)
-    write_amc(smoothed, args.output)
+    (write_bvh if motion.skeleton.convention == "bvh" else write_amc)(smoothed, args.output)
     which = ", ".join(joints) if joints else "all joints"
     print(f"{kind} {size} over {motion.frames} frames of {which}: wrote {args.output}")
     return 0
@@ -231,8 +232,8 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     _filter_options(smooth)
-    smooth.add_argument("input", help="the AMC file")
-    smooth.add_argument("-o", "--output", required=True, help="the AMC file to write")
+    smooth.add_argument("input", help="the AMC or BVH file")
+    smooth.add_argument("-o", "--output", required=True, help="the file to write (the input's format)")
     smooth.set_defaults(run=_filter)
 
     many = verbs.add_parser(
@@ -250,7 +251,7 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     _filter_options(many)
-    many.add_argument("inputs", nargs="+", help="AMC files, folders or globs")
+    many.add_argument("inputs", nargs="+", help="AMC and BVH files, folders or globs")
     many.add_argument("-o", "--output", required=True, help="the output folder")
     many.add_argument("--jobs", type=int, default=0, help="processes (default: every core)")
     many.add_argument("--resume", action="store_true", help="skip takes whose output is newer than the input")
