@@ -70,7 +70,7 @@ class Motion:
         """Column indices of a joint's channels ("root" or a bone), all or the named dofs."""
         available = self.skeleton.dofs(joint)
         wanted = available if dofs is None else ((dofs,) if isinstance(dofs, str) else tuple(dofs))
-        start = self.channels.index((joint, available[0])) if available else 0
+        start = self.skeleton.first_column(joint)
         result = []
         for dof in wanted:
             dof = dof.lower()

@@ -85,6 +85,8 @@ class Skeleton:
     convention: str = "asf"  # "asf", or "bvh": a joint's offset turns with its parent, see kinematics
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
     _parents: dict[str, str] = field(init=False, repr=False, compare=False)
+    _channels: tuple[tuple[str, str], ...] = field(init=False, repr=False, compare=False)
+    _first_column: dict[str, int] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         index: dict[str, int] = {}
@@ -105,6 +107,13 @@ class Skeleton:
                 raise ValueError(f"bone '{bone.name}' has {len(bone.dofs)} dofs but {len(bone.limits)} limits")
         object.__setattr__(self, "_index", index)
         object.__setattr__(self, "_parents", _parents_of(self.hierarchy, index))
+        # the layout is asked for on every column lookup: worked out once
+        channels, first = [], {}
+        for joint in ("root", *(b.name for b in self.bones)):
+            first[joint] = len(channels)
+            channels.extend((joint, d) for d in (self.root.order if joint == "root" else self.bone(joint).dofs))
+        object.__setattr__(self, "_channels", tuple(channels))
+        object.__setattr__(self, "_first_column", first)
 
     @property
     def bone_names(self) -> tuple[str, ...]:
@@ -144,7 +153,14 @@ class Skeleton:
     def channels(self) -> tuple[tuple[str, str], ...]:
         """The canonical layout of motion values: (joint, dof) for the root's
         channels in its order, then each bone's dofs in bone order."""
-        return tuple((j, d) for j in self.joint_names for d in self.dofs(j))
+        return self._channels
+
+    def first_column(self, joint: str) -> int:
+        """The column of a joint's first channel in the canonical layout."""
+        try:
+            return self._first_column[joint]
+        except KeyError:
+            raise UnknownNameError(f"no bone '{joint}' in skeleton '{self.name}'") from None
 
     def rest_positions(self, *, start: bool = False) -> np.ndarray:
         """The calibration pose: (joints, 3) positions in ``joint_names`` order,
