@@ -34,8 +34,14 @@ static double decimal_value(uint64_t m, int k)
  */
 static int shortest_fast(double a, char *digits, int *e10)
 {
-    int e = (int)floor(log10(a));
-    for (int attempt = 0; attempt < 2; attempt++) {
+    /* floor(log10(a)) from the binary exponent, off by one at most; a wrong guess shows as a
+       mantissa of p+1 or p-1 digits below, and is tried once more */
+    uint64_t bits;
+    memcpy(&bits, &a, sizeof bits);
+    const int e2 = (int)((bits >> 52) & 0x7ff) - 1023;
+    /* floor(e2 * log10(2)) in integers, for |e2| < 1700 (a shift of a negative is not portable) */
+    int e = e2 >= 0 ? (e2 * 78913) >> 18 : -((-e2 * 78913 + (1 << 18) - 1) >> 18);
+    for (int attempt = 0; attempt < 3; attempt++) {
         int p = 15 < 23 + e ? 15 : 23 + e; /* digits, so that k = p - 1 - e <= 22 */
         int k = p - 1 - e;
         if (p < 1 || k < -22)
@@ -57,10 +63,15 @@ static int shortest_fast(double a, char *digits, int *e10)
             m /= 10;
             n--;
         }
-        for (int i = n - 1; i >= 0; i--) {
-            digits[i] = (char)('0' + m % 10);
-            m /= 10;
+        int i = n;
+        for (; i >= 2; i -= 2) { /* two digits per division */
+            const unsigned pair = (unsigned)(m % 100);
+            m /= 100;
+            digits[i - 1] = (char)('0' + pair % 10);
+            digits[i - 2] = (char)('0' + pair / 10);
         }
+        if (i == 1)
+            digits[0] = (char)('0' + m);
         *e10 = e;
         return n;
     }
