@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 from mtcore import format_frames, format_number, scan_frames
@@ -129,24 +130,20 @@ def _check_angle_unit(header: list[tuple[int, str]], skeleton: Skeleton) -> None
             raise FormatError(f"the AMC says {word} but its skeleton's angles are in {skeleton.angle_unit}", number)
 
 
+_NEXT_FRAME_LINE = re.compile(rb"[\r\n][ \t]*\d+[ \t]*(?=[\r\n]|$)")
+
+
 def _first_frame_order(data: bytes, body: int, joints: set[str]) -> tuple[str, ...]:
     """The bone lines of the first frame, in order."""
-    order, started = [], False
-    pos = body
-    while pos < len(data):
-        end = min((x for x in (data.find(b"\n", pos), data.find(b"\r", pos)) if x != -1), default=len(data))
-        words = data[pos:end].split()
-        pos = end + 1
-        if not words or words[0].startswith(b"#"):
-            continue
-        if words[0].isdigit() and len(words) == 1:
-            if started:
-                break
-            started = True
-            continue
-        name = decode(words[0])
-        if name in joints:
-            order.append(name)
+    following = _NEXT_FRAME_LINE.search(data, body + 1)
+    block = data[body:following.start() if following else len(data)]
+    order = []
+    for line in re.split(rb"\r\n|\r|\n", block)[1:]:
+        words = line.split(None, 1)
+        if words and not words[0].startswith(b"#"):
+            name = decode(words[0])
+            if name in joints:
+                order.append(name)
     return tuple(order)
 
 
