@@ -86,9 +86,11 @@ def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
     """(take, its path relative to the output folder) for every AMC and BVH under the inputs."""
     found: dict[Path, Path] = {}
     for item in inputs:
-        if any(c in item for c in "*?["):
-            base = Path(item.split("*")[0].split("?")[0].split("[")[0])
-            base = base if str(item).endswith(os.sep) or base.is_dir() and str(base).endswith(os.sep) else base.parent
+        wild = next((i for i, c in enumerate(item) if c in "*?["), None)
+        if wild is not None:
+            # outputs mirror the tree below the folder the pattern starts in
+            prefix = item[:wild]
+            base = Path(prefix) if prefix.endswith(os.sep) else Path(prefix).parent
             for match in sorted(glob.glob(item, recursive=True)):
                 if match.lower().endswith(TAKES):
                     found.setdefault(Path(match), Path(match).relative_to(base))
@@ -184,7 +186,7 @@ def _frames_of(path: str, skeleton, keys, offsets, counts, frame_rate):
         head = f.read(READ_BYTES)
     header, body, header_lines = _split_header(head)
     rate = None
-    for number, line in header:
+    for _, line in header:
         words = line.split()
         if words and words[0].upper() in (":SAMPLES-PER-SECOND", ":SAMPLES_PER_SECOND", ":FRAME-RATE"):
             rate = float(words[1])
