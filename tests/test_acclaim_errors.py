@@ -127,6 +127,7 @@ ASF_CASES = [
     ((b"     name knee", b"     name hip"), mt.DuplicateError, b"     name hip\n     direction 0 -1 0\n     length 4",
      "bone 'hip' is defined twice (first at line 16)"),
     ((b"length 4", b"length four"), mt.NumberError, b"length four", "expected a number for length, found 'four'"),
+    ((b"id 2", b"id 1e999"), mt.NumberError, b"id 1e999", "expected a whole number after id, found '1e999'"),
     ((b"direction 0 -1 0\n     length 5", b"direction 0 -1\n     length 5"), mt.CountError, b"direction 0 -1\n",
      "direction takes 3 numbers, found 2"),
     ((b"dof rx ry", b"dof rx qq"), mt.FormatError, b"dof rx qq", "dof takes distinct channels of rx ry rz tx ty tz l, found 'rx qq'"),

@@ -173,7 +173,9 @@ def _parse_bone(lines: _Lines, begin: int) -> tuple[Bone, int]:
         if key == "end":
             break
         if key == "id":
-            values["id"] = int(_number(args[0], n, "id")) if len(args) == 1 else None
+            if len(args) != 1 or not re.fullmatch(r"[+-]?\d+", args[0]):
+                raise NumberError(f"expected a whole number after id, found '{' '.join(args)}'", n)
+            values["id"] = int(args[0])
         elif key == "name":
             if len(args) != 1:
                 raise CountError(f"a bone name is one word, found {len(args)}", n)
