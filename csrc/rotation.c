@@ -208,30 +208,52 @@ int mt_quaternions_to_rotvecs(const double *q, size_t n, double *v)
     return MT_OK;
 }
 
-int mt_unroll_quaternions(const double *in, size_t outer, size_t n, size_t inner, double *out)
+/* A continuity pass's kind of rotation. */
+struct unroll_rule {
+    size_t width;           /* values per rotation */
+    double half_turn, flip; /* Euler angles only */
+};
+/* to = the rotation equal to cur that is nearest prev. */
+typedef void unroll_step(const double *prev, const double *cur, double *to, const struct unroll_rule *rule);
+
+/*
+ * Keeps the first frame of each outer slice and steps every later one from
+ * its predecessor's output.  Inlined into each caller, where step is a known
+ * function that is inlined in turn.
+ */
+static MT_INLINE int unroll(const double *in, size_t outer, size_t n, size_t inner, unroll_step *step,
+                            const struct unroll_rule *rule, double *out)
 {
     if (outer == 0 || n == 0 || inner == 0)
         return MT_OK;
     if (in == NULL || out == NULL)
         return MT_EINVAL;
-    const size_t row = 4 * inner;
+    const size_t row = rule->width * inner;
     for (size_t o = 0; o < outer; o++) {
         const double *src = in + o * n * row;
         double *dst = out + o * n * row;
         memcpy(dst, src, row * sizeof *dst);
-        for (size_t t = 1; t < n; t++) {
-            const double *prev = dst + (t - 1) * row, *cur = src + t * row;
-            double *to = dst + t * row;
-            for (size_t i = 0; i < row; i += 4) {
-                const double dot = prev[i] * cur[i] + prev[i + 1] * cur[i + 1] + prev[i + 2] * cur[i + 2] +
-                                   prev[i + 3] * cur[i + 3];
-                const double sign = dot < 0 ? -1.0 : 1.0;
-                for (int c = 0; c < 4; c++)
-                    to[i + c] = sign * cur[i + c];
-            }
-        }
+        for (size_t t = 1; t < n; t++)
+            for (size_t i = 0; i < row; i += rule->width)
+                step(dst + (t - 1) * row + i, src + t * row + i, dst + t * row + i, rule);
     }
     return MT_OK;
+}
+
+static MT_INLINE void quaternion_step(const double *prev, const double *cur, double *to,
+                                      const struct unroll_rule *rule)
+{
+    (void)rule;
+    const double dot = prev[0] * cur[0] + prev[1] * cur[1] + prev[2] * cur[2] + prev[3] * cur[3];
+    const double sign = dot < 0 ? -1.0 : 1.0;
+    for (int c = 0; c < 4; c++)
+        to[c] = sign * cur[c];
+}
+
+int mt_unroll_quaternions(const double *in, size_t outer, size_t n, size_t inner, double *out)
+{
+    const struct unroll_rule rule = {.width = 4};
+    return unroll(in, outer, n, inner, quaternion_step, &rule, out);
 }
 
 /* x plus the whole turns that bring it nearest to ref. */
@@ -240,43 +262,32 @@ static MT_INLINE double nearest(double x, double ref, double turn)
     return x + turn * nearbyint((ref - x) / turn);
 }
 
+static MT_INLINE void euler_step(const double *prev, const double *cur, double *to, const struct unroll_rule *rule)
+{
+    const double half_turn = rule->half_turn, turn = 2 * half_turn;
+    const double a[3] = {nearest(cur[0], prev[0], turn), nearest(cur[1], prev[1], turn),
+                         nearest(cur[2], prev[2], turn)};
+    const double b[3] = {nearest(cur[0] + half_turn, prev[0], turn), nearest(rule->flip - cur[1], prev[1], turn),
+                         nearest(cur[2] + half_turn, prev[2], turn)};
+    double da = 0, db = 0;
+    for (int c = 0; c < 3; c++) {
+        da += (a[c] - prev[c]) * (a[c] - prev[c]);
+        db += (b[c] - prev[c]) * (b[c] - prev[c]);
+    }
+    /* NaN in either frame: no nearest, the frame as it is */
+    const int other = db < da, restart = isnan(da);
+    for (int c = 0; c < 3; c++)
+        to[c] = restart ? cur[c] : other ? b[c] : a[c];
+}
+
 int mt_unroll_euler(const double *in, size_t outer, size_t n, size_t inner, int proper, double half_turn,
                     double *out)
 {
     if (!(half_turn > 0) || isinf(half_turn))
         return MT_EINVAL;
-    if (outer == 0 || n == 0 || inner == 0)
-        return MT_OK;
-    if (in == NULL || out == NULL)
-        return MT_EINVAL;
-    const size_t row = 3 * inner;
-    const double turn = 2 * half_turn, flip = proper ? 0.0 : half_turn;
-    for (size_t o = 0; o < outer; o++) {
-        const double *src = in + o * n * row;
-        double *dst = out + o * n * row;
-        memcpy(dst, src, row * sizeof *dst);
-        for (size_t t = 1; t < n; t++) {
-            const double *prev = dst + (t - 1) * row, *cur = src + t * row;
-            double *to = dst + t * row;
-            for (size_t i = 0; i < row; i += 3) {
-                const double a[3] = {nearest(cur[i], prev[i], turn), nearest(cur[i + 1], prev[i + 1], turn),
-                                     nearest(cur[i + 2], prev[i + 2], turn)};
-                const double b[3] = {nearest(cur[i] + half_turn, prev[i], turn),
-                                     nearest(flip - cur[i + 1], prev[i + 1], turn),
-                                     nearest(cur[i + 2] + half_turn, prev[i + 2], turn)};
-                double da = 0, db = 0;
-                for (int c = 0; c < 3; c++) {
-                    da += (a[c] - prev[i + c]) * (a[c] - prev[i + c]);
-                    db += (b[c] - prev[i + c]) * (b[c] - prev[i + c]);
-                }
-                /* NaN in either frame: no nearest, the frame as it is */
-                const int other = db < da, restart = isnan(da);
-                for (int c = 0; c < 3; c++)
-                    to[i + c] = restart ? cur[i + c] : other ? b[c] : a[c];
-            }
-        }
-    }
-    return MT_OK;
+    const struct unroll_rule rule = {.width = 3, .half_turn = half_turn,
+                                     .flip = proper ? 0.0 : half_turn};
+    return unroll(in, outer, n, inner, euler_step, &rule, out);
 }
 
 /* sin(x theta) / sin(theta), by its series where it tends to 0/0; theta in [0, pi/2]. */
