@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtcore.kinematics import euler_angles
+from mtcore.kinematics import euler_angles, forward_kinematics
 
+from .kinematics import joint_tree
 from .motion import Motion
 from .skeleton import ROTATIONS, TRANSLATIONS, Bone, Root, Skeleton, canonical_hierarchy
 
@@ -37,7 +38,8 @@ def to_bvh(motion: Motion, order: str = "ZXY") -> Motion:
                              "rotation dofs only")
     rotation_dofs = tuple("r" + a.lower() for a in order)
     fixed = order[::-1].lower()  # BVH's R = R1 R2 R3 applies R3 first about fixed axes
-    segments = {b.name: _segment(b) for b in skeleton.bones}
+    tree = joint_tree(skeleton)
+    segments = dict(zip(skeleton.bone_names, tree.segment[1:]))
     bones, pairs = [], []
     for bone in skeleton.bones:
         parent = skeleton.parent(bone.name)
@@ -53,14 +55,10 @@ def to_bvh(motion: Motion, order: str = "ZXY") -> Motion:
     root = Root(order=("tx", "ty", "tz", *rotation_dofs), position=(0.0, 0.0, 0.0), name="root")
     target = Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs), root=root,
                       name=skeleton.name, units=(("angle", "deg"),), convention="bvh")
-    local = motion.rotations(local=True)
-    positions = motion.positions()
-    columns = [positions[:, 0]]
-    for j, name in enumerate(skeleton.joint_names):
-        if name == "root" or skeleton.bone(name).dofs:
-            angles = np.degrees(euler_angles(local[:, j], fixed))[:, ::-1]  # in the listed order
-            columns.append(angles)
-    values = np.concatenate(columns, axis=1)
+    positions, _, local = forward_kinematics(motion.values, tree, local=True)
+    turning = [j for j, name in enumerate(skeleton.joint_names) if name == "root" or skeleton.bone(name).dofs]
+    angles = np.degrees(euler_angles(local[:, turning], fixed))[..., ::-1]  # in the listed order
+    values = np.concatenate([positions[:, 0], angles.reshape(motion.frames, 3 * len(turning))], axis=1)
     values.flags.writeable = False
     return Motion(target, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame, header=())
 
@@ -101,11 +99,5 @@ def to_asf(motion: Motion) -> Motion:
     values.flags.writeable = False
     return Motion(target, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame,
                   header=(":FULLY-SPECIFIED", ":DEGREES"))
-
-
-def _segment(bone: Bone) -> np.ndarray:
-    d = np.asarray(bone.direction, float)
-    norm = np.linalg.norm(d)
-    return d / norm * bone.length if norm > 0 else np.zeros(3)
 
 
