@@ -227,3 +227,12 @@ def test_c_loop_checks_every_row_it_reads():
     with pytest.raises(ValueError, match="mt_combine"):
         combine_frames(old, new, [0, 1], [0, 0], [0.0, 1.5])  # a weight above 1
     np.testing.assert_array_equal(combine_frames(old, new, [0, 1], [0, 0], [0.0, 1.0]), [[0, 0, 0], [1, 1, 1]])
+
+
+def test_offset_channels_without_offsets():
+    """No offset rows is a valid (empty) table, not a NULL the C loop rejects."""
+    from mtcore.combine import combine_frames
+
+    old, new = np.zeros((2, 3)), np.arange(6.0).reshape(2, 3)
+    out = combine_frames(old, new, [0, 1], [0, 1], [0.0, 1.0], offset_channels=[0])
+    np.testing.assert_array_equal(out, [old[0], new[1]])

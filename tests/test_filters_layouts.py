@@ -167,3 +167,24 @@ def test_bad_workers(pair, workers, exc):
     ours, _ = pair
     with pytest.raises(exc, match="workers must be"):
         ours(np.zeros((10, 3)), 3, workers=workers)
+
+
+def _every_parallel_call(workers):
+    """The array-level calls that split work over threads, each on a small valid input."""
+    from mtcore.combine import combine_frames
+    from mtcore.kinematics import JointTree, forward_kinematics
+    from mtcore.text import scan_table
+
+    a = np.ones((2, 3))
+    tree = JointTree(parent=[-1], order=[0], axis=[np.eye(3)], direction=[np.zeros(3)], segment=[np.zeros(3)],
+                     dof_start=[0, 0], dof_kind=[], dof_column=[])
+    return [lambda: combine_frames(a, a, [0, 1], [0, 1], [0.0, 1.0], workers=workers),
+            lambda: forward_kinematics(a, tree, workers=workers),
+            lambda: scan_table(b"1 2 3\n", 1, 3, workers=workers)]
+
+
+@pytest.mark.parametrize("workers,exc", [(0, ValueError), (-2, ValueError), (1.5, TypeError)])
+def test_bad_workers_everywhere(workers, exc):
+    for call in _every_parallel_call(workers):
+        with pytest.raises(exc, match="workers must be"):
+            call()

@@ -6,11 +6,14 @@ ranges of one array run truly in parallel.
 
 from __future__ import annotations
 
+import operator
 import os
 import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import TypeVar
+
+from ._status import check
 
 R = TypeVar("R")
 
@@ -52,3 +55,32 @@ def run_all(tasks: Sequence[Callable[[], R]]) -> list[R]:
     futures = [pool.submit(task) for task in tasks[1:]]
     first = tasks[0]()
     return [first, *(f.result() for f in futures)]
+
+
+def thread_count(workers: int | None, large: bool) -> int:
+    """Threads a call may use: ``workers`` threads, every core for -1, and for
+    None every core when the job is ``large`` enough to gain, else one."""
+    if workers is None:
+        return cpu_count() if large else 1
+    try:
+        wanted = operator.index(workers)
+    except TypeError:
+        raise TypeError(f"workers must be an integer or None, got {type(workers).__name__}") from None
+    if wanted == -1:
+        return cpu_count()
+    if wanted < 1:
+        raise ValueError(f"workers must be a positive integer, -1 (every core) or None, got {wanted}")
+    return wanted
+
+
+def even_bounds(count: int, threads: int) -> list[int]:
+    """Bounds cutting range(count) into at most ``threads`` near-equal ranges."""
+    threads = max(1, min(threads, count))
+    return [count * i // threads for i in range(threads + 1)]
+
+
+def run_ranges(call: Callable[[int, int], int], bounds: Sequence[int], name: str) -> None:
+    """Run the C function ``call(begin, end)`` over each range between bounds, in parallel, and check its status."""
+    parts = [lambda b=b, e=e: call(b, e) for b, e in zip(bounds, bounds[1:])]
+    for status in run_all(parts):
+        check(status, name)

@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._mtcore import ffi, lib
-from ._parallel import cpu_count, run_all
-from ._status import check
+from ._cdata import c_array
+from ._mtcore import lib
+from ._parallel import even_bounds, run_ranges, thread_count
 
 __all__ = ["combine_frames"]
 
@@ -54,25 +54,15 @@ def combine_frames(old: np.ndarray | None, new: np.ndarray | None, old_row, new_
     if offsets.ndim != 2 or offsets.shape[1] != len(offset_channels):
         raise ValueError(f"offsets must have one column per offset channel ({len(offset_channels)})")
     out = np.empty((frames, channels))
-    wanted = (cpu_count() if out.size >= _PARALLEL_MIN_VALUES else 1) if workers is None else (
-        cpu_count() if workers == -1 else workers)
-    threads = max(1, min(wanted, frames))
-    bounds = [frames * i // threads for i in range(threads + 1)]
-
-    def buf(a, kind="double[]"):
-        return ffi.NULL if a is None or a.size == 0 else ffi.from_buffer(kind, a)
-
+    bounds = even_bounds(frames, thread_count(workers, out.size >= _PARALLEL_MIN_VALUES))
+    rows = "long long[]"
     args = (
-        buf(old), 0 if old is None else len(old), buf(new), 0 if new is None else len(new), channels, frames,
-        buf(old_row, "long long[]"), buf(new_row, "long long[]"), buf(next_row, "long long[]"), buf(ramp),
-        buf(weight), buf(selected, "unsigned char[]"), buf(offset_row, "long long[]"), buf(offsets),
-        len(offsets), buf(offset_channels, "size_t[]"), len(offset_channels),
+        c_array(old), 0 if old is None else len(old), c_array(new), 0 if new is None else len(new), channels, frames,
+        c_array(old_row, rows), c_array(new_row, rows), c_array(next_row, rows), c_array(ramp), c_array(weight),
+        c_array(selected, "unsigned char[]"), c_array(offset_row, rows), c_array(offsets), len(offsets),
+        c_array(offset_channels, "size_t[]"), len(offset_channels),
     )
-    out_buf = buf(out)
+    out_buf = c_array(out)
 
-    def part(begin: int, end: int):
-        return lambda: lib.mt_combine(*args, begin, end, out_buf)
-
-    for status in run_all([part(b, e) for b, e in zip(bounds, bounds[1:])]):
-        check(status, "mt_combine")
+    run_ranges(lambda begin, end: lib.mt_combine(*args, begin, end, out_buf), bounds, "mt_combine")
     return out

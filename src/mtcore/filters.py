@@ -38,8 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike, DTypeLike
 
 from ._mtcore import ffi, lib
-from ._parallel import cpu_count, run_all
-from ._status import check
+from ._parallel import run_ranges, thread_count
 
 __all__ = ["median_filter1d", "uniform_filter1d", "binomial_filter1d", "pascal_weights", "MODES"]
 
@@ -173,17 +172,7 @@ def _work_dtype(dtype: np.dtype, role: str = "input") -> np.dtype:
 def _split(workers: int | None, values: int, frames: int, block: int) -> list[int]:
     """Frame bounds of the ranges the threads compute: multiples of the C block
     length, so that the result is the same bit for bit however it is split."""
-    if workers is None:
-        wanted = cpu_count() if values >= _PARALLEL_MIN_VALUES else 1
-    else:
-        try:
-            wanted = operator.index(workers)
-        except TypeError:
-            raise TypeError(f"workers must be an integer or None, got {type(workers).__name__}") from None
-        if wanted == -1:
-            wanted = cpu_count()
-        elif wanted < 1:
-            raise ValueError(f"workers must be a positive integer, -1 (every core) or None, got {wanted}")
+    wanted = thread_count(workers, values >= _PARALLEL_MIN_VALUES)
     blocks = -(-frames // block)
     threads = max(1, min(wanted, blocks))
     return [min(frames, blocks * i // threads * block) for i in range(threads)] + [frames]
@@ -227,12 +216,7 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
         weights = ffi.from_buffer("double[]", _pascal(size)) if kind == lib.MT_FILTER_CORRELATE else ffi.NULL
         head = (kind, _NATIVE[work], ffi.from_buffer(a), ffi.from_buffer(result), outer, n, inner)
         tail = (size, origin, code, cval, weights)
-
-        def part(begin: int, end: int):
-            return lambda: lib.mt_filter1d(*head, begin, end, *tail)
-
-        for status in run_all([part(b, e) for b, e in zip(bounds, bounds[1:])]):
-            check(status, "mt_filter1d")
+        run_ranges(lambda begin, end: lib.mt_filter1d(*head, begin, end, *tail), bounds, "mt_filter1d")
     if not direct:
         if target.dtype == np.bool_:
             # scipy stores through npy_bool, an unsigned char: values truncate, so only |x| >= 1 is True.

@@ -9,9 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._mtcore import ffi, lib
-from ._parallel import cpu_count, run_all
-from ._status import check
+from ._cdata import c_array
+from ._mtcore import lib
+from ._parallel import even_bounds, run_ranges, thread_count
 from .rotations import _sequence_matrices, matrices_to_euler, matrices_to_quaternions
 
 __all__ = ["JointTree", "axis_rotations", "euler_angles", "euler_matrices", "forward_kinematics",
@@ -86,29 +86,17 @@ def forward_kinematics(values: np.ndarray, tree: JointTree, *, world: bool = Fal
     positions = np.empty((frames, n, 3))
     world_out = np.empty((frames, n, 3, 3)) if world else None
     local_out = np.empty((frames, n, 3, 3)) if local else None
-    wanted = (cpu_count() if frames * n >= _PARALLEL_MIN_TRANSFORMS else 1) if workers is None else (
-        cpu_count() if workers == -1 else workers)
-    if wanted < 1:
-        raise ValueError(f"workers must be a positive integer, -1 (every core) or None, got {wanted}")
-    threads = max(1, min(wanted, frames))
-    bounds = [frames * i // threads for i in range(threads + 1)]
-
-    def ptr(a, kind="double[]"):
-        return ffi.NULL if a is None else ffi.from_buffer(kind, a)
-
+    bounds = even_bounds(frames, thread_count(workers, frames * n >= _PARALLEL_MIN_TRANSFORMS))
     args = (
-        ptr(values), frames, channels, n, ptr(tree.parent, "long long[]"), ptr(tree.order, "long long[]"),
-        ptr(tree.axis), ptr(tree.direction), ptr(tree.segment), ptr(tree.dof_start, "size_t[]"),
-        ptr(tree.dof_kind, "int[]"), ptr(tree.dof_column, "size_t[]"), ptr(tree.parent_frame, "unsigned char[]"),
-        tree.angle_scale,
+        c_array(values), frames, channels, n, c_array(tree.parent, "long long[]"), c_array(tree.order, "long long[]"),
+        c_array(tree.axis), c_array(tree.direction), c_array(tree.segment), c_array(tree.dof_start, "size_t[]"),
+        c_array(tree.dof_kind, "int[]"), c_array(tree.dof_column, "size_t[]"),
+        c_array(tree.parent_frame, "unsigned char[]"), tree.angle_scale,
     )
-    outs = (ptr(positions), ptr(world_out), ptr(local_out))
+    outs = (c_array(positions), c_array(world_out), c_array(local_out))
 
-    def part(begin: int, end: int):
-        return lambda: lib.mt_forward_kinematics(*args, begin, end, *outs)
-
-    for status in run_all([part(b, e) for b, e in zip(bounds, bounds[1:])]):
-        check(status, "mt_forward_kinematics")
+    run_ranges(lambda begin, end: lib.mt_forward_kinematics(*args, begin, end, *outs), bounds,
+               "mt_forward_kinematics")
     return positions, world_out, local_out
 
 

@@ -39,6 +39,7 @@ import math
 import numpy as np
 from numpy.lib.array_utils import normalize_axis_index
 
+from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._status import check
 
@@ -83,21 +84,17 @@ def _scale(degrees) -> float:
     return math.pi / 180 if _flag(degrees, "degrees") else 1.0
 
 
-def _ptr(a: np.ndarray):
-    return ffi.from_buffer("double[]", a)
-
-
 def _sequence_matrices(angles: np.ndarray, codes: list[int], intrinsic: bool, scale: float) -> np.ndarray:
     """Matrices (..., 3, 3) of float64 angles (..., len(codes)) about the axes ``codes``."""
     out = np.empty(angles.shape[:-1] + (3, 3))
-    check(lib.mt_euler_to_matrices(_ptr(angles), out.size // 9, ffi.new("int[]", codes), len(codes), intrinsic,
-                                   scale, _ptr(out)), "mt_euler_to_matrices")
+    check(lib.mt_euler_to_matrices(c_array(angles), out.size // 9, ffi.new("int[]", codes), len(codes), intrinsic,
+                                   scale, c_array(out)), "mt_euler_to_matrices")
     return out
 
 
 def _euler(m: np.ndarray, codes: list[int], intrinsic: bool, scale: float) -> np.ndarray:
     out = np.empty(m.shape[:-2] + (3,))
-    check(lib.mt_matrices_to_euler(_ptr(m), out.size // 3, ffi.new("int[]", codes), intrinsic, scale, _ptr(out)),
+    check(lib.mt_matrices_to_euler(c_array(m), out.size // 3, ffi.new("int[]", codes), intrinsic, scale, c_array(out)),
           "mt_matrices_to_euler")
     return out
 
@@ -105,7 +102,7 @@ def _euler(m: np.ndarray, codes: list[int], intrinsic: bool, scale: float) -> np
 def _convert(kernel: str, x: np.ndarray, lead: tuple[int, ...], trailing: tuple[int, ...]) -> np.ndarray:
     """out (*lead, *trailing) = kernel(x) for the kernels (in, n, out)."""
     out = np.empty(lead + trailing)
-    check(getattr(lib, kernel)(_ptr(x), math.prod(lead), _ptr(out)), kernel)
+    check(getattr(lib, kernel)(c_array(x), math.prod(lead), c_array(out)), kernel)
     return out
 
 
@@ -207,7 +204,7 @@ def unroll_quaternions(quaternions, axis: int = 0) -> np.ndarray:
     q = _real(quaternions, "quaternions", (4,))
     outer, n, inner = _along(q, axis, "quaternions", 4)
     out = np.empty_like(q)
-    check(lib.mt_unroll_quaternions(_ptr(q), outer, n, inner, _ptr(out)), "mt_unroll_quaternions")
+    check(lib.mt_unroll_quaternions(c_array(q), outer, n, inner, c_array(out)), "mt_unroll_quaternions")
     return out
 
 
@@ -223,7 +220,7 @@ def unroll_euler(angles, order: str, *, axis: int = 0, degrees: bool = False) ->
     a = _real(angles, "angles", (3,))
     outer, n, inner = _along(a, axis, "angles", 3)
     out = np.empty_like(a)
-    check(lib.mt_unroll_euler(_ptr(a), outer, n, inner, codes[0] == codes[2], half_turn, _ptr(out)),
+    check(lib.mt_unroll_euler(c_array(a), outer, n, inner, codes[0] == codes[2], half_turn, c_array(out)),
           "mt_unroll_euler")
     return out
 
@@ -250,7 +247,7 @@ def slerp(q0, q1, t) -> np.ndarray:
     ``slerp(q0, q1, np.linspace(0, 1, frames)[:, None])`` for keys (joints, 4)."""
     q0, q1, t = _keys(q0, q1, t, ("q0", "q1"), 4)
     out = np.empty_like(q0)
-    check(lib.mt_slerp(_ptr(q0), _ptr(q1), _ptr(t), t.size, _ptr(out)), "mt_slerp")
+    check(lib.mt_slerp(c_array(q0), c_array(q1), c_array(t), t.size, c_array(out)), "mt_slerp")
     return out
 
 
@@ -263,6 +260,6 @@ def interpolate_rotvecs(v0, v1, t, *, aligned: bool = False) -> np.ndarray:
     v0, v1, t = _keys(v0, v1, t, ("v0", "v1"), 3)
     aligned = _flag(aligned, "aligned")
     out = np.empty_like(v0)
-    check(lib.mt_interpolate_rotvecs(_ptr(v0), _ptr(v1), _ptr(t), t.size, aligned, _ptr(out)),
+    check(lib.mt_interpolate_rotvecs(c_array(v0), c_array(v1), c_array(t), t.size, aligned, c_array(out)),
           "mt_interpolate_rotvecs")
     return out

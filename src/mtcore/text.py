@@ -8,14 +8,13 @@ and columns.
 
 from __future__ import annotations
 
-import operator
 import re
 from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from ._mtcore import ffi, lib
-from ._parallel import cpu_count, run_all
+from ._parallel import run_all, thread_count
 from ._status import check
 from .errors import SequenceError
 
@@ -119,10 +118,7 @@ _FRAME_LINE = re.compile(rb"[\r\n][ \t]*\d+[ \t]*(?=[\r\n])")
 
 
 def _piece_count(workers: int | None, size: int) -> int:
-    wanted = cpu_count() if workers is None else (cpu_count() if workers == -1 else operator.index(workers))
-    if wanted < 1:
-        raise ValueError(f"workers must be a positive integer, -1 (every core) or None, got {wanted}")
-    return max(1, min(wanted, size // _PIECE_BYTES))
+    return max(1, min(thread_count(workers, True), size // _PIECE_BYTES))
 
 
 def _pieces(text: bytes, start: int, count: int) -> list[tuple[int, int]]:
