@@ -147,6 +147,19 @@ def test_streaming_reports_bad_lines_with_their_file_line(data_dir, tmp_path, mo
     assert not (tmp_path / "o.amc").exists()
 
 
+@pytest.mark.parametrize("extra,error", [(b":SAMPLES-PER-SECOND", mt.FormatError), (b":RADIANS", mt.FormatError)])
+def test_streaming_reads_the_header_as_read_amc_does(data_dir, tmp_path, extra, error):
+    text = (data_dir / "cmu" / "01_01.amc").read_bytes()
+    (tmp_path / "h.amc").write_bytes(extra + b"\r\n" + text)
+    skeleton = mt.read_asf(data_dir / "cmu" / "01.asf")
+    with pytest.raises(error) as whole:
+        mt.read_amc(tmp_path / "h.amc", skeleton)
+    with pytest.raises(error) as streamed:
+        batch.stream_filter(str(tmp_path / "h.amc"), str(tmp_path / "o.amc"), skeleton, batch.Recipe("mean", 3))
+    assert str(streamed.value) == str(whole.value)
+    assert not (tmp_path / "o.amc").exists()
+
+
 def test_two_hour_take_streams_in_bounded_memory(data_dir, tmp_path):
     """864,000 frames (the real 01_01 repeated): peak memory under 300 MB, the same bytes as in memory."""
     take = tmp_path / "long.amc"

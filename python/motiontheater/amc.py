@@ -38,12 +38,8 @@ def skeleton_path_for(amc_path: str | os.PathLike) -> Path:
 
 def _layout(skeleton: Skeleton, joints) -> tuple[list[bytes], list[int], list[int]]:
     """Keys, first columns and channel counts of the given joints in the canonical layout."""
-    start, offset = {}, 0
-    for joint in skeleton.joint_names:
-        start[joint] = offset
-        offset += len(skeleton.dofs(joint))
-    keys = [encode(j) for j in joints]
-    return keys, [start[j] for j in joints], [len(skeleton.dofs(j)) for j in joints]
+    return ([encode(j) for j in joints], [skeleton.first_column(j) for j in joints],
+            [len(skeleton.dofs(j)) for j in joints])
 
 
 def _split_header(data: bytes) -> tuple[list[tuple[int, str]], int, int]:
@@ -94,8 +90,11 @@ def read_amc(source: Source, skeleton: Skeleton, frame_rate: float | None = None
         return _read(data, name, skeleton, frame_rate, workers)
 
 
-def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None,
-          workers: int | None) -> Motion:
+def _read_header(data: bytes, name: str | None, skeleton: Skeleton,
+                 frame_rate: float | None) -> tuple[list[tuple[int, str]], int, int, float]:
+    """The header lines as :func:`_split_header` gives them, where the frames
+    begin, the lines before them, and the frame rate (the header's, else
+    ``frame_rate``, else the default), checked against the skeleton."""
     header, body, header_lines = _split_header(data)
     try:
         rate = _header_rate(header)
@@ -104,6 +103,12 @@ def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float |
         raise e.at(name) from None
     if rate is not None and frame_rate is not None and rate != frame_rate:
         raise ValueError(f"{name}: the header says {rate:g} frames per second, frame_rate={frame_rate:g}")
+    return header, body, header_lines, rate or frame_rate or DEFAULT_FRAME_RATE
+
+
+def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None,
+          workers: int | None) -> Motion:
+    header, body, header_lines, rate = _read_header(data, name, skeleton, frame_rate)
     joints = skeleton.joint_names
     keys, offsets, counts = _layout(skeleton, joints)
     try:
@@ -115,7 +120,7 @@ def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float |
     return Motion(
         skeleton=skeleton,
         values=values,
-        frame_rate=rate or frame_rate or DEFAULT_FRAME_RATE,
+        frame_rate=rate,
         first_frame=first if len(values) else 1,
         header=tuple(text for _, text in header),
         line_order=_first_frame_order(data, body, set(joints)),
@@ -155,16 +160,16 @@ def write_amc(motion: Motion, target: Source) -> None:
     has one, else the root and the bones with dofs in skeleton order.  Every
     number is the shortest text that reads back to exactly the same float64.
     """
-    skeleton = motion.skeleton
-    if motion.line_order is not None:
-        joints = list(motion.line_order)
-        joints += [j for j in skeleton.joint_names if j not in joints and skeleton.dofs(j)]
-    else:
-        joints = [j for j in skeleton.joint_names if skeleton.dofs(j)]
-    keys, offsets, counts = _layout(skeleton, joints)
+    keys, offsets, counts = _layout(motion.skeleton, _write_order(motion.skeleton, motion.line_order))
     with output(target) as f:
         f.write(encode("".join(line + "\n" for line in _header_lines(motion))))
         format_frames(motion.values, motion.first_frame, keys, offsets, counts, f.write)
+
+
+def _write_order(skeleton: Skeleton, line_order: tuple[str, ...] | None) -> list[str]:
+    """The bones of a frame as written: those of ``line_order``, then the others with dofs in skeleton order."""
+    joints = list(line_order or ())
+    return joints + [j for j in skeleton.joint_names if j not in joints and skeleton.dofs(j)]
 
 
 def _header_lines(motion: Motion) -> list[str]:

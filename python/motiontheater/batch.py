@@ -29,11 +29,12 @@ from mtcore import format_frames, scan_frames
 from mtcore.errors import FormatError, SequenceError
 
 from ._io import PARTIAL_PREFIX, encode, output
-from .amc import _first_frame_order, _header_lines, _layout, _split_header, read_amc, skeleton_path_for, write_amc
+from .amc import (_first_frame_order, _header_lines, _layout, _read_header, _write_order, read_amc, skeleton_path_for,
+                  write_amc)
 from .asf import read_asf
 from .bvh import read_bvh, write_bvh
 from .filtering import Smoother, TakeStats
-from .motion import DEFAULT_FRAME_RATE, Motion
+from .motion import Motion
 
 STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed
 CHUNK_FRAMES = 1 << 15  # frames per streamed chunk (a multiple of the filters' block length)
@@ -184,12 +185,7 @@ def _frames_of(path: str, skeleton, keys, offsets, counts, frame_rate):
     read READ_BYTES at a time and cut at frame lines."""
     with open(path, "rb") as f:
         head = f.read(READ_BYTES)
-    header, body, header_lines = _split_header(head)
-    rate = None
-    for _, line in header:
-        words = line.split()
-        if words and words[0].upper() in (":SAMPLES-PER-SECOND", ":SAMPLES_PER_SECOND", ":FRAME-RATE"):
-            rate = float(words[1])
+    header, body, header_lines, rate = _read_header(head, path, skeleton, frame_rate)
     order = _first_frame_order(head, body, set(skeleton.joint_names))
 
     def pieces():
@@ -221,7 +217,7 @@ def _frames_of(path: str, skeleton, keys, offsets, counts, frame_rate):
                 if not more:
                     return
 
-    return header, order, rate or frame_rate or DEFAULT_FRAME_RATE, pieces
+    return header, order, rate, pieces
 
 
 def _last_frame_start(text: bytes, limit: int) -> int:
@@ -254,8 +250,10 @@ def stream_filter(path: str, target: str, skeleton, recipe: Recipe, frame_rate: 
         elif first != first_frame + frames:
             raise SequenceError(f"frame number {first} out of sequence: expected {first_frame + frames}",
                                 lines + 1, path)
-        stats = TakeStats.of(values) if stats is None else stats
-        stats.update(values)
+        if stats is None:
+            stats = TakeStats.of(values)
+        else:
+            stats.update(values)
         frames += len(values)
     header_motion = Motion(skeleton, np.zeros((0, len(skeleton.channels))), rate, first_frame or 1,
                            tuple(text for _, text in header), order)
@@ -301,11 +299,6 @@ def _unwrapped_chunks(pieces: Callable, smoother: Smoother, chunk: int):
             pending, held = [joined[chunk:]], held - chunk
     if held:
         yield np.concatenate(pending)
-
-
-def _write_order(skeleton, order) -> list[str]:
-    joints = list(order) if order else []
-    return joints + [j for j in skeleton.joint_names if j not in joints and skeleton.dofs(j)]
 
 
 class Progress:

@@ -61,13 +61,13 @@ class Smoother:
         self.kind, self.size, self.mode, self.workers = kind, int(size), mode, workers
         self.rotations: list[int] = []
         self.others: list[int] = []
-        column = {channel: i for i, channel in enumerate(skeleton.channels)}
         for joint in (skeleton.joint_names if joints is None else tuple(joints)):
-            for dof in skeleton.dofs(joint):
+            start = skeleton.first_column(joint)
+            for i, dof in enumerate(skeleton.dofs(joint)):
                 if dof in ROTATIONS:
-                    self.rotations.append(column[(joint, dof)])
+                    self.rotations.append(start + i)
                 elif translation:
-                    self.others.append(column[(joint, dof)])
+                    self.others.append(start + i)
         self.period = 360.0 if skeleton.angle_unit == "deg" else 2 * np.pi
 
     @property
@@ -151,8 +151,6 @@ def filter_motion(
         return motion.replace(values=motion.values)
     unwrapped, _ = smoother.unwrap(motion.values, None, None)
     values = smoother.smooth(unwrapped, TakeStats.of(motion.values))
-    others = np.setdiff1d(np.arange(motion.values.shape[1]), chosen)
-    values[:, others] = motion.values[:, others]  # bit-identical, not unwrapped and back
     values.flags.writeable = False
     return motion.replace(values=values)
 
