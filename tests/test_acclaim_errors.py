@@ -126,6 +126,8 @@ ASF_CASES = [
     ((b"    hip knee\n", b""), mt.HierarchyError, b":hierarchy", "bone 'knee' has no parent in the hierarchy"),
     ((b"     name knee", b"     name hip"), mt.DuplicateError, b"     name hip\n     direction 0 -1 0\n     length 4",
      "bone 'hip' is defined twice (first at line 16)"),
+    ((b"     name knee", b"     name :knee"), mt.FormatError, b"     name :knee",
+     "bone name ':knee' cannot be written to ASF/AMC: it must be one word, not all digits, not starting with '#' or ':'"),
     ((b"length 4", b"length four"), mt.NumberError, b"length four", "expected a number for length, found 'four'"),
     ((b"id 2", b"id 1e999"), mt.NumberError, b"id 1e999", "expected a whole number after id, found '1e999'"),
     ((b"direction 0 -1 0\n     length 5", b"direction 0 -1\n     length 5"), mt.CountError, b"direction 0 -1\n",

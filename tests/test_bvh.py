@@ -102,6 +102,7 @@ def test_names_with_spaces_position_channels_and_end_sites():
      "unknown or repeated channel 'Wrotation'"),
     (("\t\t}\n\t}\n}", "\t\t}\n\t}"), mt.TruncatedError, 14, "joint 'hips bone' is not closed"),
     (("MOTION\n", "MOTON\n"), mt.MissingError, 21, "no MOTION section"),
+    (("JOINT arm.L:upper", "JOINT arm}upper"), mt.FormatError, 6, "joint name 'arm}upper' cannot be written to BVH"),
     (("1 2 3 90", "1 2 x 90"), mt.NumberError, 20, "expected a number as value 3 of the frame, found 'x'"),
 ])
 def test_bad_bvh(tmp_path, change, error, line, words):

@@ -9,7 +9,7 @@ from mtcore.errors import CountError, DuplicateError, FormatError, MissingError,
 
 from . import __version__
 from ._io import LINE_BREAK, Source, decode, encode, output, read_source
-from .skeleton import BONE_DOFS, ROOT_DOFS, Bone, Root, Skeleton, canonical_hierarchy
+from .skeleton import BONE_DOFS, ROOT_DOFS, Bone, Root, Skeleton, canonical_hierarchy, name_problem
 
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|infinity|nan)", re.IGNORECASE)
 _LIMIT = re.compile(r"\(\s*(\S+)\s+(\S+)\s*\)")
@@ -179,6 +179,8 @@ def _parse_bone(lines: _Lines, begin: int) -> tuple[Bone, int]:
         elif key == "name":
             if len(args) != 1:
                 raise CountError(f"a bone name is one word, found {len(args)}", n)
+            if problem := name_problem(args[0], "asf"):
+                raise FormatError(problem, n)
             values["name"], name_line = args[0], n
         elif key == "direction":
             values["direction"] = _numbers(args, 3, n, "direction")

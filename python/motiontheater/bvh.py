@@ -19,7 +19,7 @@ from mtcore.text import format_table, scan_table
 
 from ._io import Source, decode, encode, output, read_source
 from .motion import Motion
-from .skeleton import Bone, Root, Skeleton, canonical_hierarchy
+from .skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem
 
 CHANNELS = {"xposition": "tx", "yposition": "ty", "zposition": "tz",
             "xrotation": "rx", "yrotation": "ry", "zrotation": "rz"}
@@ -97,6 +97,8 @@ def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
             joint = {"name": rest.strip(), "line": number, "offset": None, "channels": (), "end": False}
             if not joint["name"]:
                 raise FormatError(f"{key} needs a name", number)
+            if key == "JOINT" and (problem := name_problem(joint["name"], "bvh")):
+                raise FormatError(problem, number)
             pos = _expect_brace(lines, pos, number)
             if stack:
                 pairs.append((stack[-1]["name"] if len(stack) > 1 else "root", (joint["name"],)))

@@ -57,6 +57,17 @@ class Root:
     name: str = "root"
 
 
+def name_problem(name: str, convention: str) -> str | None:
+    """Why a bone (ASF) or joint (BVH) name cannot be written in the convention's format, or None."""
+    if convention == "bvh":
+        if not name.strip() or any(c in name for c in "{}\r\n"):
+            return f"joint name {name!r} cannot be written to BVH"
+    elif not name or name.split() != [name] or name[0] in "#:" or name.isdigit():
+        return (f"bone name {name!r} cannot be written to ASF/AMC: it must be one word, "
+                "not all digits, not starting with '#' or ':'")
+    return None
+
+
 @dataclass(frozen=True)
 class Skeleton:
     """An ASF skeleton.
@@ -91,13 +102,8 @@ class Skeleton:
     def __post_init__(self) -> None:
         index: dict[str, int] = {}
         for i, bone in enumerate(self.bones):
-            name = bone.name
-            if self.convention == "bvh":
-                if not name.strip() or any(c in name for c in "{}\r\n"):
-                    raise ValueError(f"joint name {name!r} cannot be written to BVH")
-            elif not name or name.split() != [name] or name[0] in "#:" or name.isdigit():
-                raise ValueError(f"bone name {name!r} cannot be written to ASF/AMC: it must be one word, "
-                                 "not all digits, not starting with '#' or ':'")
+            if problem := name_problem(bone.name, self.convention):
+                raise ValueError(problem)
             if bone.name == "root":
                 raise DuplicateError("a bone may not be called 'root': the name belongs to the root")
             if bone.name in index:
