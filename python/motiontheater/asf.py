@@ -101,14 +101,14 @@ def _parse(lines: _Lines) -> Skeleton:
                 doc.append(lines.next()[1])
             fields["documentation"] = tuple(doc)
         elif keyword == ":root":
-            root = _parse_root(lines, number)
+            root = _parse_root(lines)
         elif keyword == ":bonedata":
             for bone, line in _parse_bones(lines):
                 bones.append(bone)
                 bone_lines.append(line)
         elif keyword == ":hierarchy":
             hierarchy_line = number
-            pairs.extend(_parse_hierarchy(lines, number))
+            pairs.extend(_parse_hierarchy(lines))
         else:
             body = []
             while lines.more_in_section():
@@ -131,7 +131,7 @@ def _parse(lines: _Lines) -> Skeleton:
         raise
 
 
-def _parse_root(lines: _Lines, line: int) -> Root:
+def _parse_root(lines: _Lines) -> Root:
     values: dict = {}
     while lines.more_in_section():
         n, _, toks = lines.next()
@@ -215,7 +215,7 @@ def _parse_bone(lines: _Lines, begin: int) -> tuple[Bone, int]:
     return Bone(extra=tuple(extra), **values), name_line
 
 
-def _parse_hierarchy(lines: _Lines, line: int):
+def _parse_hierarchy(lines: _Lines):
     started = False
     while lines.more_in_section():
         n, _, toks = lines.next()

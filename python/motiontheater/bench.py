@@ -21,13 +21,14 @@ import numpy as np
 import mtcore
 
 from .examples import noisy_rotations
+from .filtering import FILTERS
 
 THESIS_SCENE = (267, 90)
 HOUR = (432_000, 62)
 # Seconds per filter of the scene at depth 3: Hiller/Bomm's MEL script and MotionTheater's C++ (2004).
 THESIS_2004 = {"mean": (1.99, 0.66), "binomial": (2.05, 0.64), "median": (2.08, 0.59)}
 KINDS = ("mean", "binomial", "median")
-OURS = {"median": mtcore.median_filter1d, "mean": mtcore.uniform_filter1d, "binomial": mtcore.binomial_filter1d}
+OURS = FILTERS
 
 
 def python_filter(kind: str, rows: list[list[float]], size: int) -> list[list[float]]:

@@ -151,14 +151,10 @@ def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
     if root is None:
         raise MissingError("no ROOT in the HIERARCHY", lines[0][0])
     # bones were appended as their blocks closed; the file's order is the order they opened
-    opened = {b["name"] if isinstance(b, dict) else b: i for i, b in enumerate(_opening_order(pairs))}
+    opened = {child: i for i, child in enumerate(child for _, children in pairs for child in children)}
     bones.sort(key=lambda b: opened[b.name])
     return Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs), root=root,
                     units=(("angle", "deg"),), convention="bvh")
-
-
-def _opening_order(pairs):
-    return [child for _, children in pairs for child in children]
 
 
 def _expect_brace(lines, pos: int, number: int) -> int:

@@ -13,18 +13,11 @@ import numpy as np
 import mtcore
 
 from . import __version__
-from .amc import read_amc
+from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
 from .examples import noisy_rotations
-from .amc import skeleton_path_for, write_amc
 from .export import FORMATS, write_positions
 from .filtering import FILTERS
-
-_FILTERS = {
-    "median": mtcore.median_filter1d,
-    "mean": mtcore.uniform_filter1d,
-    "binomial": mtcore.binomial_filter1d,
-}
 
 
 def _demo(args: argparse.Namespace) -> int:
@@ -36,7 +29,7 @@ def _demo(args: argparse.Namespace) -> int:
         f"Filters of size {args.size} along the frames, edge mode 'nearest'.\n"
     )
     rows = [("unfiltered", noisy, 0.0)]
-    for name, fn in _FILTERS.items():
+    for name, fn in FILTERS.items():
         start = time.perf_counter()
         out = fn(noisy, args.size, axis=0, mode="nearest")
         rows.append((name, out, time.perf_counter() - start))

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import io
 import os
 
 import numpy as np
@@ -51,16 +50,14 @@ def write_positions(motion: Motion, target: Source, *, meters: bool = False, for
                      frame_rate=motion.frame_rate,
                      meters_per_unit=1.0 if meters else motion.skeleton.meters_per_unit)
         else:
-            text = io.StringIO()
             table = np.column_stack([frames, motion.times, positions.reshape(motion.frames, -1)])
+            fmt = ["%d", "%.10g"] + ["%.10g"] * (3 * len(names))
             if format == "csv":
                 header = ",".join(["frame", "time", *(f"{n}.{a}" for n in names for a in "xyz")])
-                np.savetxt(text, table, delimiter=",", fmt=["%d", "%.10g"] + ["%.10g"] * (3 * len(names)),
-                           header=header, comments="")
+                np.savetxt(f, table, delimiter=",", fmt=fmt, header=header, comments="", encoding="utf-8")
             else:
-                text.write(_trc_header(motion, names, unit, target))
-                np.savetxt(text, table, delimiter="\t", fmt=["%d", "%.10g"] + ["%.10g"] * (3 * len(names)))
-            f.write(text.getvalue().encode())
+                f.write(_trc_header(motion, names, unit, target).encode())
+                np.savetxt(f, table, delimiter="\t", fmt=fmt, encoding="utf-8")
     return format
 
 

@@ -96,6 +96,7 @@ class Skeleton:
     convention: str = "asf"  # "asf", or "bvh": a joint's offset turns with its parent, see kinematics
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
     _parents: dict[str, str] = field(init=False, repr=False, compare=False)
+    _children: dict[str, tuple[str, ...]] = field(init=False, repr=False, compare=False)
     _channels: tuple[tuple[str, str], ...] = field(init=False, repr=False, compare=False)
     _first_column: dict[str, int] = field(init=False, repr=False, compare=False)
 
@@ -113,6 +114,7 @@ class Skeleton:
                 raise ValueError(f"bone '{bone.name}' has {len(bone.dofs)} dofs but {len(bone.limits)} limits")
         object.__setattr__(self, "_index", index)
         object.__setattr__(self, "_parents", _parents_of(self.hierarchy, index))
+        object.__setattr__(self, "_children", dict(self.hierarchy))
         # the layout is asked for on every column lookup: worked out once
         channels, first = [], {}
         for joint in ("root", *(b.name for b in self.bones)):
@@ -149,7 +151,7 @@ class Skeleton:
         return self._parents[name]
 
     def children(self, name: str) -> tuple[str, ...]:
-        return dict(self.hierarchy).get(name, ())
+        return self._children.get(name, ())
 
     def dofs(self, joint: str) -> tuple[str, ...]:
         """The channels of a joint ("root" or a bone name), in file order."""
