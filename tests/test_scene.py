@@ -95,3 +95,11 @@ def test_bad_recipes(tmp_path, capsys, data_dir):
     assert main(["combine", str(bad), "--dry-run"]) == 2
     assert "the recipe needs [base]" in capsys.readouterr().err
     assert not (tmp_path / "o.amc").exists()
+
+
+def test_a_track_is_planned_once(data_dir):
+    """Each track's warnings come once per render, not once more for a second planning."""
+    take = mt.read_amc(data_dir / "cmu" / "02_01.amc", mt.read_asf(data_dir / "cmu" / "02.asf"))
+    with pytest.warns(UserWarning, match="blend and preserve exclude each other") as caught:
+        mt.Scene(take).add(take, blend=5, preserve="literal").render()
+    assert len(caught) == 1

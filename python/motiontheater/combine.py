@@ -259,6 +259,14 @@ def combine(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, pres
       channels) or "linear" on the stored Euler angles (the thesis).
     Raises ValueError naming the argument at fault.
     """
+    return combine_planned(old, new, cut, scale, blend, preserve, joints, discard_old, interpolate, rotation_blend,
+                           up, workers)[1]
+
+
+def combine_planned(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserve: str | None = None,
+                    joints: Iterable[str] | None = None, discard_old: bool = False, interpolate: bool = False,
+                    rotation_blend: str = "slerp", up: str = "y", workers: int | None = None) -> tuple[Plan, Motion]:
+    """:func:`combine`, returning the frame map it followed as well."""
     if rotation_blend not in ROTATION_BLENDS:
         raise ValueError(f"rotation_blend must be one of {ROTATION_BLENDS}, got {rotation_blend!r}")
     if up not in UP_AXES:
@@ -281,7 +289,7 @@ def combine(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, pres
     if rotation_blend == "slerp":
         _slerp_blends(values, old, new, p, chosen)
     values.flags.writeable = False
-    return old.replace(values=values, first_frame=int(p.frames[0]) if len(p.frames) else 1)
+    return p, old.replace(values=values, first_frame=int(p.frames[0]) if len(p.frames) else 1)
 
 
 def _slerp_blends(values: np.ndarray, old: Motion, new: Motion, p: Plan, joints) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
 from dataclasses import dataclass, field, replace
@@ -9,7 +10,7 @@ from pathlib import Path
 
 from .amc import read_amc, skeleton_path_for
 from .asf import read_asf
-from .combine import Plan, combine, plan
+from .combine import Plan, combine_planned
 from .motion import Motion
 
 if sys.version_info >= (3, 11):
@@ -58,11 +59,8 @@ class Scene:
         """(track, its frame map, the scene after it) for every track; errors name the track."""
         steps, result = [], self.base
         for n, track in enumerate(self.tracks, start=1):
-            options = {k: v for k, v in track.options.items() if k in ("cut", "scale", "blend", "preserve",
-                                                                         "discard_old", "interpolate")}
             try:
-                frame_map = plan(result, track.motion, **options)
-                result = combine(result, track.motion, workers=workers, **track.options)
+                frame_map, result = combine_planned(result, track.motion, workers=workers, **track.options)
             except ValueError as e:
                 raise ValueError(f"{track.name or f'track {n}'}: {e}") from None
             steps.append((track, frame_map, result))
@@ -103,17 +101,21 @@ def read_recipe(path: str | os.PathLike) -> Scene:
     base = recipe.get("base", {}).get("motion")
     if base is None:
         raise ValueError(f"{path}: the recipe needs [base] with motion = \"FILE.amc\"")
-    skeleton_file = where(recipe["skeleton"], "skeleton") if "skeleton" in recipe else skeleton_path_for(
-        where(base, "base.motion"))
-    skeleton = read_asf(skeleton_file)
+    base = where(base, "base.motion")
+    skeleton = read_asf(where(recipe["skeleton"], "skeleton") if "skeleton" in recipe else skeleton_path_for(base))
     rate = recipe.get("frame_rate")
-    scene = Scene(read_amc(where(base, "base.motion"), skeleton, frame_rate=rate))
+
+    @functools.cache  # a take used by several tracks is read once; motions are read-only
+    def motion(file: Path) -> Motion:
+        return read_amc(file, skeleton, frame_rate=rate)
+
+    scene = Scene(motion(base))
     for n, track in enumerate(recipe.get("track", []), start=1):
         if "motion" not in track:
             raise ValueError(f"{path}: track {n} needs motion = \"FILE.amc\"")
         options = {k: v for k, v in track.items() if k != "motion"}
         try:
-            scene = scene.add(read_amc(where(track["motion"], f"track {n} motion"), skeleton, frame_rate=rate),
+            scene = scene.add(motion(where(track["motion"], f"track {n} motion")),
                               name=f"track {n} ({track['motion']})", **options)
         except ValueError as e:
             raise ValueError(f"{path}: track {n}: {e}") from None
