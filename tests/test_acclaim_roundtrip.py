@@ -88,7 +88,10 @@ def test_motion_round_trip(motion):
 def test_numbers_are_the_shortest_that_round_trip(x):
     text = format_number(x)
     assert float(text) == x
-    assert len(text) <= len(repr(x).replace(".0e", "e").removesuffix(".0")) + 1  # no longer than repr
+    # At most one digit longer than repr: at a power of two a correctly rounded tie
+    # can miss where its other neighbour reads back (2**-24: ...0625 -> repr ...063,
+    # printf ...062 fails), and the writer then takes 17 digits.
+    assert len(text) <= len(repr(x).replace(".0e", "e").removesuffix(".0")) + 1
 
 
 def test_unwritable_bone_names_are_refused():

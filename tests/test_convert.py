@@ -62,9 +62,15 @@ def test_convert_command(data_dir, tmp_path, capsys):
     original = mt.read_amc(data_dir / "cmu" / "02_01.amc", mt.read_asf(data_dir / "cmu" / "02.asf"))
     back = mt.read_amc(tmp_path / "w.amc", mt.read_asf(tmp_path / "w.asf"))
     assert back.frames == 343
+    # there and back: every ASF joint's end is at the same point
+    bvh = mt.read_bvh(tmp_path / "w.bvh")
+    names = back.skeleton.joint_names
+    index = [0] + [names.index(n.replace(" ", "_")) for n in bvh.skeleton.point_names[1:]]
+    expected = original.positions()
+    np.testing.assert_allclose(back.positions()[:, index][:, asf_end_points_in_bvh(original, bvh)], expected,
+                               rtol=0, atol=1e-6 * np.abs(expected).max())
     assert main(["convert", str(tmp_path / "w.bvh"), str(tmp_path / "w.txt")]) == 2
     assert "the output must end in .bvh or .amc" in capsys.readouterr().err
-    del original
 
 
 def test_bad_order():

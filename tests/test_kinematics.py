@@ -169,6 +169,7 @@ def test_euler_conversions_equal_scipy_and_the_numpy_twin(rng, axes):
         back = euler_angles(matrices, axes)
         assert (np.abs(back[:, 1]) <= np.pi / 2).all()
         np.testing.assert_allclose(euler_matrices(back, axes), matrices, rtol=0, atol=1e-14)
+        np.testing.assert_allclose(back, euler_twin.angles(matrices, axes), rtol=0, atol=1e-11)
 
 
 def test_euler_conversions_refuse_bad_axes():
