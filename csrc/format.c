@@ -10,6 +10,7 @@
  * the shortest text is it with trailing zeros dropped.  Values needing 16 or
  * 17 digits, or out of that exponent range, go through snprintf and strtod.
  */
+#include "decimal.h"
 #include "mtcore.h"
 
 #include <math.h>
@@ -17,16 +18,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static const double exact_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                       1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                       1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-
-/* m / 10^k read back exactly, for |k| <= 22 and m < 2^53. */
-static double decimal_value(uint64_t m, int k)
-{
-    return k >= 0 ? (double)m / exact_pow10[k] : (double)m * exact_pow10[-k];
-}
 
 /*
  * The digits (without trailing zeros) and decimal exponent of the shortest
@@ -56,7 +47,7 @@ static int shortest_fast(double a, char *digits, int *e10)
             e += m >= high ? 1 : -1;
             continue;
         }
-        if (decimal_value(m, k) != a)
+        if (exact_decimal(m, -k) != a)
             return 0;
         int n = p;
         while (m % 10 == 0) {

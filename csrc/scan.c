@@ -8,15 +8,12 @@
  * else (more digits, large exponents, inf, nan) goes through strtod, so every
  * value equals what Python's float() gives for the same text.
  */
+#include "decimal.h"
 #include "mtcore.h"
 
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-
-static const double exact_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                       1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                       1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
 static int is_blank(char c)
 {
@@ -108,8 +105,7 @@ static const char *parse_number(const char *p, const char *end, double *out)
     }
     if (digits > 0 && exact && (p == end || is_blank(*p) || is_eol(*p)) &&
         mantissa <= ((uint64_t)1 << 53) && exp10 >= -22 && exp10 <= 22) {
-        double v = (double)mantissa;
-        v = exp10 < 0 ? v / exact_pow10[-exp10] : v * exact_pow10[exp10];
+        const double v = exact_decimal(mantissa, exp10);
         *out = negative ? -v : v;
         return p;
     }
