@@ -17,7 +17,7 @@ import numpy as np
 from mtcore.errors import CountError, FormatError, MissingError, TruncatedError
 from mtcore.text import format_table, scan_table
 
-from ._io import Source, decode, encode, output, read_source
+from ._io import LINE_BREAK, Source, decode, encode, output, read_source
 from .motion import Motion
 from .skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem
 
@@ -49,7 +49,7 @@ def _read(data) -> Motion:
     if motion_at is None:
         raise MissingError("no MOTION section", data.count(b"\n") + 1)
     head = decode(data[:motion_at.start()])
-    lines = [(n, line.strip()) for n, line in enumerate(re.split(r"\r\n|\r|\n", head), start=1) if line.strip()]
+    lines = [(n, line.strip()) for n, line in enumerate(LINE_BREAK.split(head), start=1) if line.strip()]
     skeleton = _hierarchy(lines)
     motion_line = data.count(b"\n", 0, motion_at.start()) + 1
     frames_match = _FRAMES.search(data, motion_at.end())

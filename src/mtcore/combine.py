@@ -30,23 +30,24 @@ def combine_frames(old: np.ndarray | None, new: np.ndarray | None, old_row, new_
     channels = (old if old is not None else new).shape[1]
     frames = len(weight)
 
-    def ints(a, fill):
-        return np.full(frames, fill, np.int64) if a is None else np.ascontiguousarray(a, np.int64)
-
-    def doubles(a, fill):
-        return np.full(frames, fill, np.float64) if a is None else np.ascontiguousarray(a, np.float64)
+    def ints(a):
+        return np.full(frames, -1, np.int64) if a is None else np.ascontiguousarray(a, np.int64)
 
     old = None if old is None else np.ascontiguousarray(old, np.float64)
     new = None if new is None else np.ascontiguousarray(new, np.float64)
     for name, motion in (("old", old), ("new", new)):
         if motion is not None and (motion.ndim != 2 or motion.shape[1] != channels):
             raise ValueError(f"{name} must be (frames, {channels}), got {motion.shape}")
-    old_row, new_row, offset_row = ints(old_row, -1), ints(new_row, -1), ints(offset_row, -1)
-    next_row = new_row if next_row is None else ints(next_row, -1)
-    weight, ramp = doubles(weight, 0.0), doubles(ramp, 0.0)
+    old_row, new_row, offset_row = ints(old_row), ints(new_row), ints(offset_row)
+    weight = np.ascontiguousarray(weight, np.float64)
+    if ramp is None:  # no ramps: the C loop takes NULL for both
+        next_row = None
+    else:
+        ramp = np.ascontiguousarray(ramp, np.float64)
+        next_row = new_row if next_row is None else ints(next_row)
     for name, a in (("old_row", old_row), ("new_row", new_row), ("next_row", next_row), ("ramp", ramp),
                     ("offset_row", offset_row)):
-        if a.shape != (frames,):
+        if a is not None and a.shape != (frames,):
             raise ValueError(f"{name} must have one entry per output frame ({frames}), got shape {a.shape}")
     selected = np.ones(channels, np.uint8) if selected is None else np.ascontiguousarray(selected, np.uint8)
     offset_channels = np.ascontiguousarray(offset_channels, np.uintp)
