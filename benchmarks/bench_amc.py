@@ -75,7 +75,7 @@ def python_parser(path, skeleton):
                 rows.append(row)
                 continue
             start = columns[words[0].decode()]
-            row[start:start + len(words) - 1] = map(float, words[1:])
+            row[start : start + len(words) - 1] = map(float, words[1:])
     return np.array(rows)
 
 
@@ -85,7 +85,7 @@ def python_writer(values, skeleton, out):
     for f, row in enumerate(values.tolist(), start=1):
         out.write(f"{f}\n")
         for joint, i, n in columns:
-            out.write(joint + " " + " ".join(repr(v) for v in row[starts[i]:starts[i] + n]) + "\n")
+            out.write(joint + " " + " ".join(repr(v) for v in row[starts[i] : starts[i] + n]) + "\n")
 
 
 READS = {"all cores": None, "1 thread": 1}
@@ -95,8 +95,13 @@ READS = {"all cores": None, "1 thread": 1}
 def test_read_amc(benchmark, record, big, skeleton, threads):
     motion = benchmark.pedantic(mt.read_amc, (big, skeleton), dict(workers=READS[threads]), **FAST)
     assert motion.frames == FRAMES
-    record(f"read 100 MB AMC (file -> Motion), {threads}", "mtcore", big.stat().st_size, unit="MB",
-           target=">= 300 MB/s, >= 6x pandas, >= 20x plain Python")
+    record(
+        f"read 100 MB AMC (file -> Motion), {threads}",
+        "mtcore",
+        big.stat().st_size,
+        unit="MB",
+        target=">= 300 MB/s, >= 6x pandas, >= 20x plain Python",
+    )
 
 
 def test_pandas_read_csv(benchmark, record, big):
@@ -121,8 +126,13 @@ def test_write_amc(benchmark, record, big, skeleton, tmp_path):
     motion = mt.read_amc(big, skeleton)
     out = tmp_path / "out.amc"
     benchmark.pedantic(mt.write_amc, (motion, out), **FAST)
-    record("write 100 MB AMC (Motion -> file)", "mtcore", out.stat().st_size, unit="MB",
-           target=">= 50 MB/s, >= 5x plain Python")
+    record(
+        "write 100 MB AMC (Motion -> file)",
+        "mtcore",
+        out.stat().st_size,
+        unit="MB",
+        target=">= 50 MB/s, >= 5x plain Python",
+    )
 
 
 def test_python_writer(benchmark, record, tenth, skeleton, tmp_path):
@@ -148,11 +158,16 @@ def test_peak_memory_of_reading(benchmark, big):
         motion = mt.read_amc({str(big)!r}, skeleton)
         print(rss("VmHWM") - base, motion.values.nbytes)
     """)
-    done = benchmark.pedantic(subprocess.run, ([sys.executable, "-c", script],),
-                              dict(capture_output=True, text=True, check=True), rounds=1, iterations=1)
+    done = benchmark.pedantic(
+        subprocess.run,
+        ([sys.executable, "-c", script],),
+        dict(capture_output=True, text=True, check=True),
+        rounds=1,
+        iterations=1,
+    )
     peak, nbytes = map(int, done.stdout.split())
     size = big.stat().st_size
-    NOTES.append(f"Peak memory of read_amc on {size / 1e6:.0f} MB ({FRAMES} frames): {peak / 1e6:.0f} MB above the "
-                 f"interpreter = {peak / (2 * nbytes + size):.2f} x (2 x values {nbytes / 1e6:.0f} MB + file); target < 1")
-
-
+    NOTES.append(
+        f"Peak memory of read_amc on {size / 1e6:.0f} MB ({FRAMES} frames): {peak / 1e6:.0f} MB above the "
+        f"interpreter = {peak / (2 * nbytes + size):.2f} x (2 x values {nbytes / 1e6:.0f} MB + file); target < 1"
+    )

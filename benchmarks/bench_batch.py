@@ -26,8 +26,9 @@ def corpus(tmp_path_factory):
         pytest.skip(f"real capture corpus not found at {DATA}")
     root = tmp_path_factory.mktemp("corpus")
     for copy in range(COPIES):
-        shutil.copytree(DATA, root / f"copy{copy:02d}", ignore=shutil.ignore_patterns("*.npz", "*.csv", "*.bvh",
-                                                                                      "licenses", "*.md"))
+        shutil.copytree(
+            DATA, root / f"copy{copy:02d}", ignore=shutil.ignore_patterns("*.npz", "*.csv", "*.bvh", "licenses", "*.md")
+        )
     return root
 
 
@@ -51,6 +52,11 @@ def test_batch_throughput(benchmark, record, corpus, tmp_path, jobs, where):
 
     summary = benchmark.pedantic(run, rounds=2, iterations=1)
     size = sum(r.bytes for r in summary.results)
-    record(f"batch median 5 over 1 GB of AMC, outputs in {where}", "mtcore" if jobs == 2 else "1 process", size,
-           unit="MB", target=">= 100 MB/s per core; --jobs 2 >= 1.6x --jobs 1")
+    record(
+        f"batch median 5 over 1 GB of AMC, outputs in {where}",
+        "mtcore" if jobs == 2 else "1 process",
+        size,
+        unit="MB",
+        target=">= 100 MB/s per core; --jobs 2 >= 1.6x --jobs 1",
+    )
     shutil.rmtree(base, ignore_errors=True)

@@ -66,8 +66,13 @@ def big(tmp_path_factory, take):
     rows = frames.strip().splitlines()
     copies = 100_000_000 // len(frames) + 1
     path = tmp_path_factory.mktemp("bvh") / "big.bvh"
-    path.write_bytes(head.replace(b"Frames: 2752", b"Frames: %d" % (len(rows) * copies)) + b"Frame Time:" + time_line
-                     + b"\n" + (b"\n".join(rows) + b"\n") * copies)
+    path.write_bytes(
+        head.replace(b"Frames: 2752", b"Frames: %d" % (len(rows) * copies))
+        + b"Frame Time:"
+        + time_line
+        + b"\n"
+        + (b"\n".join(rows) + b"\n") * copies
+    )
     return path
 
 
@@ -75,5 +80,3 @@ def test_scanning_throughput(benchmark, record, big):
     motion = benchmark.pedantic(mt.read_bvh, (big,), rounds=3, iterations=1, warmup_rounds=1)
     assert motion.frames > 100_000
     record("read a 100 MB BVH", "mtcore", big.stat().st_size, unit="MB", target=">= 300 MB/s")
-
-

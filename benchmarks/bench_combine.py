@@ -22,8 +22,8 @@ import motiontheater as mt
 from motiontheater.combine import _root_offsets, combine, plan
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-import euler_twin  # noqa: E402
-from combine_twins import numpy_combine, python_thesis  # noqa: E402
+import euler_twin
+from combine_twins import numpy_combine, python_thesis
 
 DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 FRAMES = 432_000
@@ -53,8 +53,12 @@ def test_combine_mtcore(benchmark, record, hours, case):
     old, new = hours
     result = benchmark.pedantic(combine, (old, new), CASES[case], rounds=5, iterations=1, warmup_rounds=1)
     assert result.frames == FRAMES
-    record(f"combine two 1-hour motions, {case}", "mtcore", output_values(old, new, CASES[case]),
-           target=">= 200 M values/s, >= 3x numpy, >= 100x Python loop")
+    record(
+        f"combine two 1-hour motions, {case}",
+        "mtcore",
+        output_values(old, new, CASES[case]),
+        target=">= 200 M values/s, >= 3x numpy, >= 100x Python loop",
+    )
 
 
 def _numpy_rules(old, new, options):
@@ -95,8 +99,12 @@ def test_combine_python_loop(benchmark, record, hours, case):
         offsets = [(int(f.min()), int(f.max()), dict(zip(channels, table[row].tolist()))) for row, f in spans]
     lists = small_old.values.tolist(), small_new.values.tolist()
     selected = [1] * 62
-    result = benchmark.pedantic(lambda: python_thesis(*lists, 1, 1, options["cut"], options["scale"], windows,
-                                                      selected, offsets), rounds=3, iterations=1)
-    np.testing.assert_allclose(np.array(result), combine(small_old, small_new, rotation_blend="linear",
-                                                         **options).values, rtol=0, atol=1e-9)
+    result = benchmark.pedantic(
+        lambda: python_thesis(*lists, 1, 1, options["cut"], options["scale"], windows, selected, offsets),
+        rounds=3,
+        iterations=1,
+    )
+    np.testing.assert_allclose(
+        np.array(result), combine(small_old, small_new, rotation_blend="linear", **options).values, rtol=0, atol=1e-9
+    )
     record(f"combine two 1-hour motions, {case}", "Python loop", len(p.frames) * 62)

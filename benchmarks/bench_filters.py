@@ -65,8 +65,13 @@ THREADS = {"all cores": None, "1 thread": 1}
 def test_hour_axis0_prealloc(benchmark, record, hour, name, size, threads):
     out = np.empty_like(hour)
     benchmark.pedantic(partial(OURS[name], workers=THREADS[threads]), (hour, size, 0, out), **FAST)
-    record(f"hour axis 0, output=, {name} {size}, {threads}", "mtcore", hour.size,
-           ceiling="numpy.copyto (432000, 62)", target=">= 40% of copy")
+    record(
+        f"hour axis 0, output=, {name} {size}, {threads}",
+        "mtcore",
+        hour.size,
+        ceiling="numpy.copyto (432000, 62)",
+        target=">= 40% of copy",
+    )
 
 
 @pytest.mark.parametrize("size", SIZES)
@@ -79,8 +84,13 @@ def test_hour_axis0_fresh(benchmark, record, hour, name, size, who):
             record(f"hour axis 0, fresh, {name} {size}, {threads}", "scipy", hour.size)
         return
     benchmark.pedantic(partial(OURS[name], workers=THREADS[who]), (hour, size, 0), **FAST)
-    record(f"hour axis 0, fresh, {name} {size}, {who}", "mtcore", hour.size, ceiling="ndarray.copy (432000, 62)",
-           target=">= 40% of copy, >= 10x scipy" + (" (median 30x)" if name == "median" else ""))
+    record(
+        f"hour axis 0, fresh, {name} {size}, {who}",
+        "mtcore",
+        hour.size,
+        ceiling="ndarray.copy (432000, 62)",
+        target=">= 40% of copy, >= 10x scipy" + (" (median 30x)" if name == "median" else ""),
+    )
 
 
 @pytest.mark.parametrize("threads", THREADS)
@@ -88,8 +98,13 @@ def test_hour_axis0_fresh(benchmark, record, hour, name, size, who):
 @pytest.mark.parametrize("name", OURS)
 def test_hour_last_axis(benchmark, record, hour_t, name, size, threads):
     benchmark.pedantic(partial(OURS[name], workers=THREADS[threads]), (hour_t, size, -1), **FAST)
-    record(f"(62, 432000) axis -1, {name} {size}, {threads}", "mtcore", hour_t.size,
-           ceiling="ndarray.copy (432000, 62)", target=">= 200 M values/s")
+    record(
+        f"(62, 432000) axis -1, {name} {size}, {threads}",
+        "mtcore",
+        hour_t.size,
+        ceiling="ndarray.copy (432000, 62)",
+        target=">= 200 M values/s",
+    )
 
 
 @pytest.mark.parametrize("size", SIZES)

@@ -17,7 +17,7 @@ from motiontheater.kinematics import joint_tree
 from mtcore.kinematics import forward_kinematics
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from fk_twin import forward_kinematics as numpy_fk  # noqa: E402
+from fk_twin import forward_kinematics as numpy_fk
 
 DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 FAST = dict(rounds=30, iterations=1, warmup_rounds=2)
@@ -45,8 +45,13 @@ def test_read_and_positions(benchmark, record, take):
         return mt.read_amc(DATA / "cmu" / "01_01.amc", skeleton).positions()
 
     assert benchmark.pedantic(run, **FAST).shape == (2751, 31, 3)
-    record(PIPELINE, "mtcore", transforms(motion), unit="M transforms",
-           target="<= 25 ms, >= 40x upc-pymotion, >= 20x numpy")
+    record(
+        PIPELINE,
+        "mtcore",
+        transforms(motion),
+        unit="M transforms",
+        target="<= 25 ms, >= 40x upc-pymotion, >= 20x numpy",
+    )
 
 
 def test_read_and_numpy_fk(benchmark, record, take):
@@ -76,8 +81,7 @@ def test_fk_kernel(benchmark, record, take, threads):
     tree = joint_tree(motion.skeleton)
     workers = {"all cores": None, "1 thread": 1}[threads]
     benchmark.pedantic(forward_kinematics, (motion.values, tree), dict(workers=workers), **FAST)
-    record(f"{KERNEL}, {threads}", "mtcore", transforms(motion), unit="M transforms",
-           target=">= 20 M transforms/s")
+    record(f"{KERNEL}, {threads}", "mtcore", transforms(motion), unit="M transforms", target=">= 20 M transforms/s")
 
 
 def test_numpy_fk_kernel(benchmark, record, take):

@@ -21,8 +21,9 @@ def record(benchmark):
     """File this test's fastest round under ``case`` as measured for ``who``
     ("mtcore", "copy" or a peer's name) over ``amount`` of ``unit`` (values or MB)."""
 
-    def _record(case: str, who: str, amount: float, ceiling: str = "", target: str = "",
-                unit: str = "M values") -> None:
+    def _record(
+        case: str, who: str, amount: float, ceiling: str = "", target: str = "", unit: str = "M values"
+    ) -> None:
         RESULTS[case][who] = (benchmark.stats.stats.min, amount, unit)
         if ceiling:
             CEILING[case] = ceiling
@@ -59,7 +60,9 @@ def pytest_terminal_summary(terminalreporter):
         ref = RESULTS.get(CEILING.get(case, ""), {}).get("copy")
         vs_copy = f"{_rate(ours) / _rate(ref):.0%}" if ref else "-"
         peers = ", ".join(f"{who} {_rate(ours) / _rate(e):.1f}x" for who, e in whos.items() if who != "mtcore")
-        write(f"| {case} | {_time(ours[0])} | {_rate(ours) / 1e6:.0f} {ours[2]}/s | {vs_copy} | "
-              f"{peers or '-'} | {TARGETS.get(case, '')} |")
+        write(
+            f"| {case} | {_time(ours[0])} | {_rate(ours) / 1e6:.0f} {ours[2]}/s | {vs_copy} | "
+            f"{peers or '-'} | {TARGETS.get(case, '')} |"
+        )
     for note in NOTES:
         write(note)

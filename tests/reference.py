@@ -55,10 +55,7 @@ def mean_line(line, size, mode="reflect", cval=0.0, origin=0):
 
 
 def correlate_line(line, weights, mode="reflect", cval=0.0, origin=0):
-    return [
-        math.fsum(wt * v for wt, v in zip(weights, w))
-        for w in windows(line, len(weights), mode, cval, origin)
-    ]
+    return [math.fsum(wt * v for wt, v in zip(weights, w)) for w in windows(line, len(weights), mode, cval, origin)]
 
 
 def along_axis(fn, x: np.ndarray, axis: int, *args, **kwargs) -> np.ndarray:

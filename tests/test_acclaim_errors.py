@@ -76,18 +76,28 @@ AMC_CASES = [
     # (change to the text, error class, the line it names, words of the message)
     ((b"hip 7 8\nknee 9\n2", b"hip 7\nknee 9\n2"), mt.CountError, b"hip 7\n", "bone 'hip' takes 2 value(s), found 1"),
     ((b"knee 9\n2", b"knee 9 10\n2"), mt.CountError, b"knee 9 10", "bone 'knee' takes 1 value(s), found 2"),
-    ((b"root 1 2 3 4 5 6\nhip 7 8\nknee 9\n2", b"root 1 2 3 4 x 6\nhip 7 8\nknee 9\n2"), mt.NumberError,
-     b"root 1 2 3 4 x", "expected a number as value 5 of bone 'root', found 'x'"),
+    (
+        (b"root 1 2 3 4 5 6\nhip 7 8\nknee 9\n2", b"root 1 2 3 4 x 6\nhip 7 8\nknee 9\n2"),
+        mt.NumberError,
+        b"root 1 2 3 4 x",
+        "expected a number as value 5 of bone 'root', found 'x'",
+    ),
     ((b"knee 9\n2", b"ankle 3\n2"), mt.UnknownNameError, b"ankle", "unknown bone 'ankle'"),
     ((b"knee 9\n2", b"knee 9\nknee 10\n2"), mt.DuplicateError, b"knee 10", "bone 'knee' appears twice in frame 1"),
     ((b"knee 9\n2", b"2"), mt.MissingError, b"2\n", "frame 1 has no line for bone 'knee'"),
     ((b"\n2\n", b"\n3\n"), mt.SequenceError, b"3\n", "frame number 3 out of sequence: expected 2"),
-    ((b":DEGREES\n1\n", b":DEGREES\nroot 1 2 3 4 5 6\n"), mt.SequenceError, b"root 1 2 3 4 5 6\nroot",
-     "expected a frame number, found 'root 1 2 3 4 5 6'"),
+    (
+        (b":DEGREES\n1\n", b":DEGREES\nroot 1 2 3 4 5 6\n"),
+        mt.SequenceError,
+        b"root 1 2 3 4 5 6\nroot",
+        "expected a frame number, found 'root 1 2 3 4 5 6'",
+    ),
 ]
 
 
-@pytest.mark.parametrize("change,error,where,words", AMC_CASES, ids=[c[1].__name__ + str(i) for i, c in enumerate(AMC_CASES)])
+@pytest.mark.parametrize(
+    "change,error,where,words", AMC_CASES, ids=[c[1].__name__ + str(i) for i, c in enumerate(AMC_CASES)]
+)
 def test_bad_amc(tmp_path, change, error, where, words):
     bad = AMC.replace(*change, 1)
     assert bad != AMC
@@ -115,7 +125,9 @@ def test_truncated_amc(tmp_path):
 
 def test_amc_of_another_skeleton(data_dir, tmp_path):
     skeleton = mt.read_asf(data_dir / "cmu" / "01.asf")
-    with pytest.raises(mt.UnknownNameError, match=r"test.amc, line 4: unknown bone 'Head'; expected one of: root, lhipjoint"):
+    with pytest.raises(
+        mt.UnknownNameError, match=r"test.amc, line 4: unknown bone 'Head'; expected one of: root, lhipjoint"
+    ):
         mt.read_amc(data_dir / "edge" / "test.amc", skeleton)
     tiny = mt.read_asf(write(tmp_path, "t.asf", ASF))
     with pytest.raises(mt.UnknownNameError, match=r"01_01.amc, line 7: unknown bone 'lowerback'"):
@@ -124,25 +136,63 @@ def test_amc_of_another_skeleton(data_dir, tmp_path):
 
 ASF_CASES = [
     ((b"    hip knee\n", b""), mt.HierarchyError, b":hierarchy", "bone 'knee' has no parent in the hierarchy"),
-    ((b"     name knee", b"     name hip"), mt.DuplicateError, b"     name hip\n     direction 0 -1 0\n     length 4",
-     "bone 'hip' is defined twice (first at line 16)"),
-    ((b"     name knee", b"     name :knee"), mt.FormatError, b"     name :knee",
-     "bone name ':knee' cannot be written to ASF/AMC: it must be one word, not all digits, not starting with '#' or ':'"),
+    (
+        (b"     name knee", b"     name hip"),
+        mt.DuplicateError,
+        b"     name hip\n     direction 0 -1 0\n     length 4",
+        "bone 'hip' is defined twice (first at line 16)",
+    ),
+    (
+        (b"     name knee", b"     name :knee"),
+        mt.FormatError,
+        b"     name :knee",
+        "bone name ':knee' cannot be written to ASF/AMC: it must be one word, not all digits, not starting with '#' or ':'",
+    ),
     ((b"length 4", b"length four"), mt.NumberError, b"length four", "expected a number for length, found 'four'"),
     ((b"id 2", b"id 1e999"), mt.NumberError, b"id 1e999", "expected a whole number after id, found '1e999'"),
-    ((b"direction 0 -1 0\n     length 5", b"direction 0 -1\n     length 5"), mt.CountError, b"direction 0 -1\n",
-     "direction takes 3 numbers, found 2"),
-    ((b"dof rx ry", b"dof rx qq"), mt.FormatError, b"dof rx qq", "dof takes distinct channels of rx ry rz tx ty tz l, found 'rx qq'"),
+    (
+        (b"direction 0 -1 0\n     length 5", b"direction 0 -1\n     length 5"),
+        mt.CountError,
+        b"direction 0 -1\n",
+        "direction takes 3 numbers, found 2",
+    ),
+    (
+        (b"dof rx ry", b"dof rx qq"),
+        mt.FormatError,
+        b"dof rx qq",
+        "dof takes distinct channels of rx ry rz tx ty tz l, found 'rx qq'",
+    ),
     ((b"            (-inf inf)\n", b""), mt.CountError, b"limits", "bone 'hip' has 2 dofs but 1 limits"),
-    ((b"axis 0 0 0 XYZ\n     dof rx ry", b"axis 0 0 0 XYW\n     dof rx ry"), mt.FormatError, b"XYW",
-     "expected an axis order such as XYZ, found 'XYW'"),
-    ((b"order TX", b"order QX"), mt.FormatError, b"order QX", "root order takes distinct channels of TX TY TZ RX RY RZ"),
-    ((b"    hip knee\n", b"    hip knee\n    knee hip\n"), mt.HierarchyError, b":hierarchy", "bone 'hip' has two parents, 'root' and 'knee'"),
-    ((b"    root hip\n", b"    root hip\n    foot toe\n"), mt.HierarchyError, b":hierarchy", "hierarchy names 'foot', which is not a bone"),
+    (
+        (b"axis 0 0 0 XYZ\n     dof rx ry", b"axis 0 0 0 XYW\n     dof rx ry"),
+        mt.FormatError,
+        b"XYW",
+        "expected an axis order such as XYZ, found 'XYW'",
+    ),
+    (
+        (b"order TX", b"order QX"),
+        mt.FormatError,
+        b"order QX",
+        "root order takes distinct channels of TX TY TZ RX RY RZ",
+    ),
+    (
+        (b"    hip knee\n", b"    hip knee\n    knee hip\n"),
+        mt.HierarchyError,
+        b":hierarchy",
+        "bone 'hip' has two parents, 'root' and 'knee'",
+    ),
+    (
+        (b"    root hip\n", b"    root hip\n    foot toe\n"),
+        mt.HierarchyError,
+        b":hierarchy",
+        "hierarchy names 'foot', which is not a bone",
+    ),
 ]
 
 
-@pytest.mark.parametrize("change,error,where,words", ASF_CASES, ids=[c[1].__name__ + str(i) for i, c in enumerate(ASF_CASES)])
+@pytest.mark.parametrize(
+    "change,error,where,words", ASF_CASES, ids=[c[1].__name__ + str(i) for i, c in enumerate(ASF_CASES)]
+)
 def test_bad_asf(tmp_path, change, error, where, words):
     bad = ASF.replace(*change, 1)
     assert bad != ASF
@@ -183,13 +233,17 @@ def test_frame_rate_from_header_argument_or_default(tmp_path):
 
 def test_angle_unit_contradiction(tmp_path):
     skeleton = mt.read_asf(write(tmp_path, "t.asf", ASF))
-    with pytest.raises(mt.FormatError, match=r"r.amc, line 4: the AMC says :RADIANS but its skeleton's angles are in deg"):
+    with pytest.raises(
+        mt.FormatError, match=r"r.amc, line 4: the AMC says :RADIANS but its skeleton's angles are in deg"
+    ):
         mt.read_amc(write(tmp_path, "r.amc", AMC.replace(b":DEGREES", b"\n\n:RADIANS")), skeleton)
 
 
 def test_bad_rate_line(tmp_path):
     skeleton = mt.read_asf(write(tmp_path, "t.asf", ASF))
-    with pytest.raises(mt.FormatError, match=r"q.amc, line 3: expected a number of frames per second after :SAMPLES-PER-SECOND"):
+    with pytest.raises(
+        mt.FormatError, match=r"q.amc, line 3: expected a number of frames per second after :SAMPLES-PER-SECOND"
+    ):
         mt.read_amc(write(tmp_path, "q.amc", AMC.replace(b":DEGREES", b"\n:SAMPLES-PER-SECOND fast")), skeleton)
 
 

@@ -24,8 +24,9 @@ def test_every_asf_reads_and_writes_back_identically(asf, tmp_path):
     skeleton = mt.read_asf(asf)
     text = asf.read_bytes()
     assert len(skeleton.bones) == text.count(b"begin") - 1  # one begin is the hierarchy's
-    assert skeleton.bone_names == tuple(re.findall(rb"^\s*name\s+(\S+)", text, re.M)[i].decode()
-                                        for i in range(len(skeleton.bones)))
+    assert skeleton.bone_names == tuple(
+        re.findall(rb"^\s*name\s+(\S+)", text, re.MULTILINE)[i].decode() for i in range(len(skeleton.bones))
+    )
     mt.write_asf(skeleton, tmp_path / "out.asf")
     assert mt.read_asf(tmp_path / "out.asf") == skeleton
 
@@ -34,7 +35,7 @@ def test_every_asf_reads_and_writes_back_identically(asf, tmp_path):
 def test_every_amc_equals_a_python_reading_of_its_text(amc):
     motion = load(amc)
     rows, first = parse_amc(amc.read_bytes(), motion.skeleton)
-    assert motion.frames == len(rows) == len(re.findall(rb"^\s*\d+\s*$", amc.read_bytes(), re.M))
+    assert motion.frames == len(rows) == len(re.findall(rb"^\s*\d+\s*$", amc.read_bytes(), re.MULTILINE))
     assert motion.first_frame == first
     np.testing.assert_array_equal(motion.values, np.array(rows).reshape(len(rows), -1))
     assert motion.frame_rate == 120.0
@@ -48,7 +49,11 @@ def test_every_amc_writes_back_bit_identically(amc, tmp_path):
     again = mt.read_amc(tmp_path / "out.amc", motion.skeleton)
     assert again.values.tobytes() == motion.values.tobytes()  # bit-identical, -0.0 and NaN included
     assert (again.first_frame, again.frame_rate, again.header, again.line_order) == (
-        motion.first_frame, motion.frame_rate, motion.header, motion.line_order)
+        motion.first_frame,
+        motion.frame_rate,
+        motion.header,
+        motion.line_order,
+    )
     # Numbers keep their short form: the file does not grow.
     assert (tmp_path / "out.amc").stat().st_size <= amc.stat().st_size * 1.02
 
@@ -105,8 +110,14 @@ def test_cmu_skeleton_in_detail(data_dir):
     assert s.parent("lfemur") == "lhipjoint" and s.children("thorax") == ("lowerneck", "lclavicle", "rclavicle")
     assert s.bone("lfoot").axis == (-90.0, 7.62852e-16, 20.0)
     assert len(s.channels) == 62 and s.channels[:7] == (
-        ("root", "tx"), ("root", "ty"), ("root", "tz"), ("root", "rx"), ("root", "ry"), ("root", "rz"),
-        ("lfemur", "rx"))
+        ("root", "tx"),
+        ("root", "ty"),
+        ("root", "tz"),
+        ("root", "rx"),
+        ("root", "ry"),
+        ("root", "rz"),
+        ("lfemur", "rx"),
+    )
 
 
 def test_to_meters_follows_the_acclaim_convention(data_dir):

@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 import motiontheater as mt
-from mtcore import format_number
 from motiontheater.skeleton import BONE_DOFS, ROOT_DOFS
+from mtcore import format_number
 
 names = st.text(string.ascii_letters + string.digits + "_.:", min_size=1, max_size=12).filter(
     lambda s: s != "root" and not s.isdigit() and s[0] not in "#:"
@@ -28,20 +28,35 @@ def skeletons(draw):
     bones, pairs = [], {}
     for i, name in enumerate(bone_names):
         dofs = tuple(draw(st.permutations(BONE_DOFS))[: draw(st.integers(0, 4))])
-        bones.append(mt.Bone(
-            name=name, id=i + 1, direction=draw(vec3), length=draw(finite),
-            axis=(draw(angle), draw(angle), draw(angle)), axis_order=draw(axis_order), dofs=dofs,
-            limits=tuple(draw(limit) for _ in dofs) if draw(st.booleans()) else (),
-        ))
+        bones.append(
+            mt.Bone(
+                name=name,
+                id=i + 1,
+                direction=draw(vec3),
+                length=draw(finite),
+                axis=(draw(angle), draw(angle), draw(angle)),
+                axis_order=draw(axis_order),
+                dofs=dofs,
+                limits=tuple(draw(limit) for _ in dofs) if draw(st.booleans()) else (),
+            )
+        )
         parent = "root" if i == 0 else draw(st.sampled_from(["root", *bone_names[:i]]))
         pairs.setdefault(parent, []).append(name)
     order = tuple(draw(st.permutations(ROOT_DOFS)))
     root = mt.Root(order=order, axis=draw(axis_order), position=draw(vec3), orientation=draw(vec3))
     hierarchy = tuple((p, tuple(pairs[p])) for p in ["root", *bone_names] if p in pairs)
     return mt.Skeleton(
-        bones=tuple(bones), hierarchy=hierarchy, root=root, name=draw(names), version="1.10",
-        units=(("mass", "1.0"), ("length", draw(st.sampled_from(["0.45", "1", "m"]))),
-               ("angle", draw(st.sampled_from(["deg", "rad"]))), ("time", "s")),
+        bones=tuple(bones),
+        hierarchy=hierarchy,
+        root=root,
+        name=draw(names),
+        version="1.10",
+        units=(
+            ("mass", "1.0"),
+            ("length", draw(st.sampled_from(["0.45", "1", "m"]))),
+            ("angle", draw(st.sampled_from(["deg", "rad"]))),
+            ("time", "s"),
+        ),
         documentation=tuple(draw(st.lists(names, max_size=3))),
     )
 
@@ -50,12 +65,21 @@ def skeletons(draw):
 def motions(draw):
     skeleton = draw(skeletons())
     frames = draw(st.integers(0, 5))
-    values = draw(arrays(np.float64, (frames, len(skeleton.channels)),
-                         elements=st.floats(allow_nan=True, allow_infinity=True, width=64)))
+    values = draw(
+        arrays(
+            np.float64,
+            (frames, len(skeleton.channels)),
+            elements=st.floats(allow_nan=True, allow_infinity=True, width=64),
+        )
+    )
     angle = ":RADIANS" if skeleton.angle_unit == "rad" else ":DEGREES"
-    return mt.Motion(skeleton=skeleton, values=values, first_frame=draw(st.integers(0, 10**6)),
-                     frame_rate=draw(st.sampled_from([120.0, 60.0, 100.0, 29.97])),
-                     header=(":FULLY-SPECIFIED", angle))
+    return mt.Motion(
+        skeleton=skeleton,
+        values=values,
+        first_frame=draw(st.integers(0, 10**6)),
+        frame_rate=draw(st.sampled_from([120.0, 60.0, 100.0, 29.97])),
+        header=(":FULLY-SPECIFIED", angle),
+    )
 
 
 @given(skeletons())
@@ -80,7 +104,9 @@ def test_motion_round_trip(motion):
     np.testing.assert_array_equal(np.signbit(again.values), np.signbit(motion.values))
     assert again.values[~nan].tobytes() == motion.values[~nan].tobytes()
     assert (again.first_frame if motion.frames else 1, again.frame_rate) == (
-        motion.first_frame if motion.frames else 1, motion.frame_rate)
+        motion.first_frame if motion.frames else 1,
+        motion.frame_rate,
+    )
 
 
 @given(st.floats(allow_nan=False, width=64))

@@ -41,9 +41,11 @@ def test_crlf_lf_cr_and_tabs(original, tmp_path):
     reference = read(tmp_path, asf, amc)
     for newline in (b"\n", b"\r\n", b"\r"):
         for blank in (b" ", b"\t", b" \t "):
+
             def variant(text):
                 lines = re.split(rb"\r\n|\r|\n", text)
                 return newline.join(blank.join(line.split(b" ")) for line in lines)
+
             motion = read(tmp_path, variant(asf), variant(amc))
             # :documentation is free text: its blanks are content
             assert replace(motion.skeleton, documentation=()) == replace(reference.skeleton, documentation=())
@@ -74,7 +76,7 @@ def test_another_root_order(original, tmp_path):
         return match.group(1) + b" ".join(words[i] for i in new_order)
 
     asf2 = asf.replace(b"order TX TY TZ RX RY RZ", b"order RX RY RZ TX TY TZ")
-    amc2 = re.sub(rb"^(root )([^\r\n]*)", reorder, amc, flags=re.M)
+    amc2 = re.sub(rb"^(root )([^\r\n]*)", reorder, amc, flags=re.MULTILINE)
     motion = read(tmp_path, asf2, amc2)
     assert motion.skeleton.root.order == ("rx", "ry", "rz", "tx", "ty", "tz")
     assert motion.channels[0] == ("root", "rx")
@@ -105,7 +107,7 @@ def test_bones_shuffled_in_the_asf_and_in_every_frame(original, tmp_path, rng):
     reference = read(tmp_path, asf, amc)
     head, rest = asf.split(b":bonedata", 1)
     blocks, tail = rest.split(b":hierarchy", 1)
-    parts = re.findall(rb"\s*begin.*?end[^\r\n]*", blocks, flags=re.S)
+    parts = re.findall(rb"\s*begin.*?end[^\r\n]*", blocks, flags=re.DOTALL)
     order = rng.permutation(len(parts))
     asf2 = head + b":bonedata" + b"".join(parts[i] for i in order) + b"\r\n:hierarchy" + tail
     frames = re.split(rb"(?m)^(?=\d+\s*$)", amc)

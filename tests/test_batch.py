@@ -99,8 +99,20 @@ def test_killing_a_run_leaves_no_partial_outputs_and_resume_completes_it(data_di
     for copy in range(12):  # enough work to be caught midway
         shutil.copytree(data_dir / "hdm05", src / f"copy{copy:02d}")
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "motiontheater", "batch", "--median", "5", "--jobs", "2", str(src), "-o",
-               str(out), "--quiet"]
+    command = [
+        sys.executable,
+        "-m",
+        "motiontheater",
+        "batch",
+        "--median",
+        "5",
+        "--jobs",
+        "2",
+        str(src),
+        "-o",
+        str(out),
+        "--quiet",
+    ]
     run = subprocess.Popen(command)
     deadline = time.time() + 60
     while time.time() < deadline and len(list(out.rglob("*.amc"))) < 20:
@@ -129,8 +141,9 @@ def test_streaming_equals_whole(data_dir, tmp_path, monkeypatch, kind, size):
     monkeypatch.setattr(batch, "READ_BYTES", 20_000)
     take = data_dir / "cmu" / "01_01.amc"
     skeleton = mt.read_asf(data_dir / "cmu" / "01.asf")
-    frames = batch.stream_filter(str(take), str(tmp_path / "s.amc"), skeleton, batch.Recipe(kind, size),
-                                 chunk_frames=300)
+    frames = batch.stream_filter(
+        str(take), str(tmp_path / "s.amc"), skeleton, batch.Recipe(kind, size), chunk_frames=300
+    )
     assert frames == 2751
     assert (tmp_path / "s.amc").read_bytes() == expected_bytes(take, kind, size)
 
@@ -197,8 +210,25 @@ def test_two_hour_take_streams_in_bounded_memory(data_dir, tmp_path):
 
 def test_batch_streams_takes_above_the_threshold(data_dir, tmp_path, capsys):
     out = tmp_path / "out"
-    assert main(["batch", "--median", "5", "--json", "--stream-above", "1", "--jobs", "1",
-                 str(data_dir / "cmu" / "01_01.amc"), str(data_dir / "cmu" / "02_01.amc"), "-o", str(out)]) == 0
+    assert (
+        main(
+            [
+                "batch",
+                "--median",
+                "5",
+                "--json",
+                "--stream-above",
+                "1",
+                "--jobs",
+                "1",
+                str(data_dir / "cmu" / "01_01.amc"),
+                str(data_dir / "cmu" / "02_01.amc"),
+                "-o",
+                str(out),
+            ]
+        )
+        == 0
+    )
     import json
 
     report = json.loads(capsys.readouterr().out)
@@ -207,8 +237,11 @@ def test_batch_streams_takes_above_the_threshold(data_dir, tmp_path, capsys):
 
 
 def test_inputs_files_folders_and_globs(data_dir, tmp_path):
-    found = dict(batch.find_takes([str(data_dir / "hdm05" / "HDM_bd_*.amc"), str(data_dir / "edge"),
-                                   str(data_dir / "cmu" / "02_01.amc")]))
+    found = dict(
+        batch.find_takes(
+            [str(data_dir / "hdm05" / "HDM_bd_*.amc"), str(data_dir / "edge"), str(data_dir / "cmu" / "02_01.amc")]
+        )
+    )
     assert len(found) == 11 + 1 + 1
     assert len(batch.find_takes([str(data_dir / "bvh")])) == 8
     assert found[data_dir / "edge" / "test.amc"] == Path("test.amc")
@@ -227,5 +260,3 @@ def test_progress_bar(capsys):
     silent = batch.Progress(2, 10, enabled=False)
     silent.advance(batch.Result("a", "b", bytes=5))
     assert capsys.readouterr().err == ""
-
-

@@ -35,7 +35,10 @@ def test_bench_command_json(capsys, monkeypatch):
     assert [(r["filter"], r["size"]) for r in rows] == [(k, s) for k in bench.KINDS for s in (3, 5, 7)]
     assert all(r["mtcore"] > 0 and r["python"] > 0 for r in rows)
     assert {(r["filter"], r["mel_2004"], r["cpp_2004"]) for r in rows if r["size"] == 3} == {
-        ("mean", 1.99, 0.66), ("binomial", 2.05, 0.64), ("median", 2.08, 0.59)}
+        ("mean", 1.99, 0.66),
+        ("binomial", 2.05, 0.64),
+        ("median", 2.08, 0.59),
+    }
     assert report["hour"]["shape"] == [100, 62] and len(report["hour"]["rows"]) == 9
 
 
@@ -46,5 +49,3 @@ def test_bench_command_markdown(capsys, monkeypatch):
     assert "## The thesis scene: 267 frames x 90 rotation channels = 24,030 values" in out
     assert "| median | 3 | 2.08 s | 0.59 s | 4x |" in out
     assert "## One hour at 120 Hz: 100 frames x 62 channels" in out
-
-

@@ -17,8 +17,9 @@ def test_every_bvh_reads_and_writes_back_exactly(path):
     motion = mt.read_bvh(path)
     text = path.read_bytes()
     assert motion.frames == int(text.split(b"Frames:")[1].split()[0])
-    assert len(motion.skeleton.channels) == sum(int(line.split()[1]) for line in text.splitlines()
-                                                if line.strip().startswith(b"CHANNELS"))
+    assert len(motion.skeleton.channels) == sum(
+        int(line.split()[1]) for line in text.splitlines() if line.strip().startswith(b"CHANNELS")
+    )
     out = io.BytesIO()
     mt.write_bvh(motion, out)
     again = mt.read_bvh(io.BytesIO(out.getvalue()))
@@ -37,8 +38,13 @@ def test_walk01_positions_equal_bvh_toolbox(data_dir):
     assert "RightFoot_End" in names  # end sites are points, named as bvh-toolbox names them
     for j, name in enumerate(names):
         for a, axis in enumerate("xyz"):
-            np.testing.assert_allclose(positions[:, j, a], reference[:, header.index(f"{name}.{axis}")],
-                                       rtol=0, atol=1e-4, err_msg=f"{name}.{axis}")
+            np.testing.assert_allclose(
+                positions[:, j, a],
+                reference[:, header.index(f"{name}.{axis}")],
+                rtol=0,
+                atol=1e-4,
+                err_msg=f"{name}.{axis}",
+            )
 
 
 def test_the_same_take_as_amc_and_bvh(data_dir):
@@ -48,12 +54,25 @@ def test_the_same_take_as_amc_and_bvh(data_dir):
     bvh = mt.read_bvh(data_dir / "cmu" / "01_01.bvh")
     assert bvh.frames == amc.frames + 1
     pa, pb = amc.positions(), bvh.positions()
-    pairs = {"Hips": "root", "LeftUpLeg": "lhipjoint", "LeftLeg": "lfemur", "LeftFoot": "ltibia",
-             "LeftToeBase": "lfoot", "RightUpLeg": "rhipjoint", "RightLeg": "rfemur", "RightFoot": "rtibia",
-             "RightToeBase": "rfoot"}
+    pairs = {
+        "Hips": "root",
+        "LeftUpLeg": "lhipjoint",
+        "LeftLeg": "lfemur",
+        "LeftFoot": "ltibia",
+        "LeftToeBase": "lfoot",
+        "RightUpLeg": "rhipjoint",
+        "RightLeg": "rfemur",
+        "RightFoot": "rtibia",
+        "RightToeBase": "rfoot",
+    }
     for b, a in pairs.items():
-        np.testing.assert_allclose(pb[1:, bvh.skeleton.point_names.index(b)], pa[:, amc.skeleton.joint_names.index(a)],
-                                   rtol=0, atol=1e-3, err_msg=b)
+        np.testing.assert_allclose(
+            pb[1:, bvh.skeleton.point_names.index(b)],
+            pa[:, amc.skeleton.joint_names.index(a)],
+            rtol=0,
+            atol=1e-3,
+            err_msg=b,
+        )
 
 
 TINY = """HIERARCHY
@@ -94,17 +113,29 @@ def test_names_with_spaces_position_channels_and_end_sites():
     assert b"Frame Time: 0.0083333\n" in out.getvalue() and b"JOINT arm.L:upper" in out.getvalue()
 
 
-@pytest.mark.parametrize("change,error,line,words", [
-    (("7 0 0 0\n1", "7 0 0\n1"), mt.CountError, 19, "a frame takes 10 values (the channels declared), found 9"),
-    (("Frames: 2", "Frames: 3"), mt.TruncatedError, 21, "the header says 3 frames but the data holds 2"),
-    (("Frames: 2", "Frames: 1"), mt.SequenceError, 20, "the header says 1 frames but the data holds more"),
-    (("Zrotation Xrotation Yrotation\n\tJOINT", "Zrotation Xrotation Wrotation\n\tJOINT"), mt.FormatError, 5,
-     "unknown or repeated channel 'Wrotation'"),
-    (("\t\t}\n\t}\n}", "\t\t}\n\t}"), mt.TruncatedError, 14, "joint 'hips bone' is not closed"),
-    (("MOTION\n", "MOTON\n"), mt.MissingError, 21, "no MOTION section"),
-    (("JOINT arm.L:upper", "JOINT arm}upper"), mt.FormatError, 6, "joint name 'arm}upper' cannot be written to BVH"),
-    (("1 2 3 90", "1 2 x 90"), mt.NumberError, 20, "expected a number as value 3 of the frame, found 'x'"),
-])
+@pytest.mark.parametrize(
+    "change,error,line,words",
+    [
+        (("7 0 0 0\n1", "7 0 0\n1"), mt.CountError, 19, "a frame takes 10 values (the channels declared), found 9"),
+        (("Frames: 2", "Frames: 3"), mt.TruncatedError, 21, "the header says 3 frames but the data holds 2"),
+        (("Frames: 2", "Frames: 1"), mt.SequenceError, 20, "the header says 1 frames but the data holds more"),
+        (
+            ("Zrotation Xrotation Yrotation\n\tJOINT", "Zrotation Xrotation Wrotation\n\tJOINT"),
+            mt.FormatError,
+            5,
+            "unknown or repeated channel 'Wrotation'",
+        ),
+        (("\t\t}\n\t}\n}", "\t\t}\n\t}"), mt.TruncatedError, 14, "joint 'hips bone' is not closed"),
+        (("MOTION\n", "MOTON\n"), mt.MissingError, 21, "no MOTION section"),
+        (
+            ("JOINT arm.L:upper", "JOINT arm}upper"),
+            mt.FormatError,
+            6,
+            "joint name 'arm}upper' cannot be written to BVH",
+        ),
+        (("1 2 3 90", "1 2 x 90"), mt.NumberError, 20, "expected a number as value 3 of the frame, found 'x'"),
+    ],
+)
 def test_bad_bvh(tmp_path, change, error, line, words):
     bad = TINY.replace(*change)
     assert bad != TINY

@@ -25,10 +25,7 @@ def test_help_names_the_verbs(capsys):
 def test_demo_smoothing_beats_the_noise(capsys):
     assert main(["demo", "--seconds", "2", "--size", "5"]) == 0
     out = capsys.readouterr().out
-    rms = {
-        m.group(1): float(m.group(2))
-        for m in re.finditer(r"^\| ([a-z, ]+) \| ([\d.]+) \|", out, re.MULTILINE)
-    }
+    rms = {m.group(1): float(m.group(2)) for m in re.finditer(r"^\| ([a-z, ]+) \| ([\d.]+) \|", out, re.MULTILINE)}
     assert set(rms) == {"unfiltered", "median", "mean", "binomial", "median, then binomial"}
     assert all(rms[name] < rms["unfiltered"] for name in rms if name != "unfiltered")
     assert rms["median, then binomial"] < rms["median"]
@@ -41,7 +38,5 @@ def test_bad_demo_argument_is_one_line_and_nonzero(capsys):
 
 
 def test_console_script_runs_as_module():
-    done = subprocess.run(
-        [sys.executable, "-m", "motiontheater", "--help"], capture_output=True, text=True, check=True
-    )
+    done = subprocess.run([sys.executable, "-m", "motiontheater", "--help"], capture_output=True, text=True, check=True)
     assert "usage: motiontheater" in done.stdout

@@ -5,8 +5,8 @@ import warnings
 import numpy as np
 import pytest
 
-import motiontheater as mt
 import euler_twin
+import motiontheater as mt
 from combine_twins import numpy_combine, python_combine
 from motiontheater.combine import combine, plan
 
@@ -18,7 +18,7 @@ def take(data_dir):
 
 def frames_of(take, first, last, number_from=None):
     """Frames first..last of the take as a motion numbered from number_from (default: first)."""
-    return take.replace(values=take.values[first - 1:last], first_frame=number_from or first)
+    return take.replace(values=take.values[first - 1 : last], first_frame=number_from or first)
 
 
 def test_thesis_worked_example(take):
@@ -75,12 +75,15 @@ def test_blend_into_a_gap(take):
     np.testing.assert_array_equal(result.values[199], new.values[49])
 
 
-@pytest.mark.parametrize("options", [
-    dict(cut=(50, 113), scale=(50, 140), blend=5),
-    dict(cut=(10, 60), scale=(120, 140), blend=2),
-    dict(cut=(1, 40), scale=(200, 280), blend=0, interpolate=True),
-    dict(cut=(1, 40), blend=0, discard_old=True),
-])
+@pytest.mark.parametrize(
+    "options",
+    [
+        dict(cut=(50, 113), scale=(50, 140), blend=5),
+        dict(cut=(10, 60), scale=(120, 140), blend=2),
+        dict(cut=(1, 40), scale=(200, 280), blend=0, interpolate=True),
+        dict(cut=(1, 40), blend=0, discard_old=True),
+    ],
+)
 def test_outside_blends_every_frame_is_exactly_old_or_source(take, options):
     old, new = frames_of(take, 45, 250), frames_of(take, 1001, 1113, 1)
     p = plan(old, new, **{k: v for k, v in options.items() if k != "interpolate"})
@@ -92,7 +95,8 @@ def test_outside_blends_every_frame_is_exactly_old_or_source(take, options):
         np.testing.assert_array_equal(result.values[pure_new], new.values[p.new_row[pure_new]])
     blends = p.weight[(p.weight > 0) & (p.weight < 1)]
     assert len(blends) == sum(b.left + b.right + 1 for b in p.borders if b.window) + (
-        len(range(p.gap[0], p.gap[1] + 1)) if p.gap and p.blend else 0)
+        len(range(p.gap[0], p.gap[1] + 1)) if p.gap and p.blend else 0
+    )
 
 
 def test_c_loop_equals_numpy_and_python_twins(take):
@@ -102,8 +106,9 @@ def test_c_loop_equals_numpy_and_python_twins(take):
     selected[old.columns("lfemur") + old.columns("root")] = 1
     from mtcore.combine import combine_frames
 
-    got = combine_frames(old.values, new.values, p.old_row, p.new_row, p.weight, next_row=p.next_row,
-                         ramp=p.ramp, selected=selected)
+    got = combine_frames(
+        old.values, new.values, p.old_row, p.new_row, p.weight, next_row=p.next_row, ramp=p.ramp, selected=selected
+    )
     np.testing.assert_array_equal(got, numpy_combine(old.values, new.values, p, selected))
     np.testing.assert_array_equal(got, np.array(python_combine(old.values.tolist(), new.values.tolist(), p, selected)))
 
@@ -147,8 +152,9 @@ def test_preserve_keeps_the_root_continuous(take, mode):
         # the piece moves rigidly: its own steps keep their ground-plane lengths
         raw = new.values[:100][:, new.columns("root", ("tx", "tz"))]
         moved = result.values[100:200][:, result.columns("root", ("tx", "tz"))]
-        np.testing.assert_allclose(np.linalg.norm(np.diff(moved, axis=0), axis=1),
-                                   np.linalg.norm(np.diff(raw, axis=0), axis=1), atol=1e-9)
+        np.testing.assert_allclose(
+            np.linalg.norm(np.diff(moved, axis=0), axis=1), np.linalg.norm(np.diff(raw, axis=0), axis=1), atol=1e-9
+        )
 
 
 def _headings(motion):
@@ -183,17 +189,20 @@ def test_slerp_blends_stay_on_the_shorter_arc(take):
     assert (np.abs(np.abs(slerp.values[window, column]) - 180) < 1.5).all()
 
 
-@pytest.mark.parametrize("kwargs,message", [
-    (dict(cut=(0, 500)), r"cut=\(0, 500\) is outside the new motion's frames 1..113"),
-    (dict(cut=(50, 20)), r"cut=\(50, 20\) is outside"),
-    (dict(scale=(90, 90)), r"scale=\(90, 90\) needs its first frame before its last"),
-    (dict(scale=(90, 10)), r"scale=\(90, 10\)"),
-    (dict(joints=["tail"]), "joints: no joint 'tail'"),
-    (dict(blend=-1), "blend must be a depth of 0 frames or more, got -1"),
-    (dict(preserve="heading"), "preserve must be one of"),
-    (dict(rotation_blend="cubic"), "rotation_blend must be one of"),
-    (dict(cut="1-10"), "cut must be a pair of frame numbers"),
-])
+@pytest.mark.parametrize(
+    "kwargs,message",
+    [
+        (dict(cut=(0, 500)), r"cut=\(0, 500\) is outside the new motion's frames 1..113"),
+        (dict(cut=(50, 20)), r"cut=\(50, 20\) is outside"),
+        (dict(scale=(90, 90)), r"scale=\(90, 90\) needs its first frame before its last"),
+        (dict(scale=(90, 10)), r"scale=\(90, 10\)"),
+        (dict(joints=["tail"]), "joints: no joint 'tail'"),
+        (dict(blend=-1), "blend must be a depth of 0 frames or more, got -1"),
+        (dict(preserve="heading"), "preserve must be one of"),
+        (dict(rotation_blend="cubic"), "rotation_blend must be one of"),
+        (dict(cut="1-10"), "cut must be a pair of frame numbers"),
+    ],
+)
 def test_bad_requests_name_the_argument(take, kwargs, message):
     old, new = frames_of(take, 45, 150), frames_of(take, 1001, 1113, 1)
     with pytest.raises(ValueError, match=message):

@@ -33,8 +33,9 @@ def test_amc_to_bvh_keeps_every_point(amc, order, tmp_path):
     again = mt.read_bvh(tmp_path / "c.bvh")
     expected = motion.positions()
     scale = np.abs(expected).max()
-    np.testing.assert_allclose(again.positions()[:, asf_end_points_in_bvh(motion, again)], expected,
-                               rtol=0, atol=1e-6 * scale)
+    np.testing.assert_allclose(
+        again.positions()[:, asf_end_points_in_bvh(motion, again)], expected, rtol=0, atol=1e-6 * scale
+    )
 
 
 @pytest.mark.parametrize("bvh", BVHS, ids=ids(BVHS))
@@ -49,13 +50,24 @@ def test_bvh_to_amc_keeps_every_point(bvh, tmp_path):
     expected = motion.positions()
     names = again.skeleton.joint_names
     index = [0] + [names.index(n.replace(" ", "_")) for n in motion.skeleton.point_names[1:]]
-    np.testing.assert_allclose(again.positions()[:, index], expected, rtol=0,
-                               atol=1e-6 * max(1.0, np.abs(expected).max()))
+    np.testing.assert_allclose(
+        again.positions()[:, index], expected, rtol=0, atol=1e-6 * max(1.0, np.abs(expected).max())
+    )
 
 
 def test_convert_command(data_dir, tmp_path, capsys):
-    assert main(["convert", str(data_dir / "cmu" / "02_01.amc"), str(tmp_path / "w.bvh"), "--asf",
-                 str(data_dir / "cmu" / "02.asf")]) == 0
+    assert (
+        main(
+            [
+                "convert",
+                str(data_dir / "cmu" / "02_01.amc"),
+                str(tmp_path / "w.bvh"),
+                "--asf",
+                str(data_dir / "cmu" / "02.asf"),
+            ]
+        )
+        == 0
+    )
     assert main(["convert", str(tmp_path / "w.bvh"), str(tmp_path / "w.amc")]) == 0
     out = capsys.readouterr().out
     assert f"wrote 343 frames to {tmp_path / 'w.amc'} and its skeleton to {tmp_path / 'w.asf'}" in out
@@ -67,8 +79,12 @@ def test_convert_command(data_dir, tmp_path, capsys):
     names = back.skeleton.joint_names
     index = [0] + [names.index(n.replace(" ", "_")) for n in bvh.skeleton.point_names[1:]]
     expected = original.positions()
-    np.testing.assert_allclose(back.positions()[:, index][:, asf_end_points_in_bvh(original, bvh)], expected,
-                               rtol=0, atol=1e-6 * np.abs(expected).max())
+    np.testing.assert_allclose(
+        back.positions()[:, index][:, asf_end_points_in_bvh(original, bvh)],
+        expected,
+        rtol=0,
+        atol=1e-6 * np.abs(expected).max(),
+    )
     assert main(["convert", str(tmp_path / "w.bvh"), str(tmp_path / "w.txt")]) == 2
     assert "the output must end in .bvh or .amc" in capsys.readouterr().err
 

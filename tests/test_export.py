@@ -52,16 +52,28 @@ def test_trc_needs_a_named_unit(motion, tmp_path):
 
 def test_positions_command(data_dir, tmp_path, capsys):
     out = tmp_path / "walk.npz"
-    assert main(["positions", str(data_dir / "cmu" / "02.asf"), str(data_dir / "cmu" / "02_01.amc"),
-                 "-o", str(out), "--meters"]) == 0
+    assert (
+        main(
+            [
+                "positions",
+                str(data_dir / "cmu" / "02.asf"),
+                str(data_dir / "cmu" / "02_01.amc"),
+                "-o",
+                str(out),
+                "--meters",
+            ]
+        )
+        == 0
+    )
     assert capsys.readouterr().out.strip() == f"wrote 343 frames x 31 joints (metres, npz) to {out}"
     assert np.load(out)["positions"].shape == (343, 31, 3)
 
 
 def test_positions_command_fails_cleanly(data_dir, tmp_path, capsys):
     out = tmp_path / "bad.csv"
-    assert main(["positions", str(data_dir / "cmu" / "01.asf"), str(data_dir / "edge" / "test.amc"),
-                 "-o", str(out)]) == 2
+    assert (
+        main(["positions", str(data_dir / "cmu" / "01.asf"), str(data_dir / "edge" / "test.amc"), "-o", str(out)]) == 2
+    )
     err = capsys.readouterr().err
     assert err.startswith("motiontheater positions: ") and "test.amc, line 4: unknown bone 'Head'" in err
     assert not out.exists() and list(tmp_path.iterdir()) == []

@@ -62,7 +62,8 @@ def test_selected_joints_leave_every_other_channel_bit_identical(take):
     smoothed = take.filter("binomial", 5, ["lhumerus", "rhumerus", "root"], translation=False)
     changed = {take.channels[c] for c in np.where((smoothed.values != take.values).any(axis=0))[0]}
     assert changed == {(j, d) for j in ("lhumerus", "rhumerus") for d in ("rx", "ry", "rz")} | {
-        ("root", d) for d in ("rx", "ry", "rz")}
+        ("root", d) for d in ("rx", "ry", "rz")
+    }
     assert smoothed.values.tobytes() != take.values.tobytes()
     assert take.filter("mean", 3, []).values.tobytes() == take.values.tobytes()
 
@@ -80,15 +81,22 @@ def test_input_motion_is_untouched_and_metadata_kept(take):
     smoothed = take.filter("median", 3)
     np.testing.assert_array_equal(take.values, before)
     assert (smoothed.frame_rate, smoothed.first_frame, smoothed.header, smoothed.line_order) == (
-        take.frame_rate, take.first_frame, take.header, take.line_order)
+        take.frame_rate,
+        take.first_frame,
+        take.header,
+        take.line_order,
+    )
 
 
-@pytest.mark.parametrize("kind,size,joints,message", [
-    ("gauss", 3, None, "filter kind must be one of median, mean, binomial, got 'gauss'"),
-    ("median", 4, None, "filter size must be an odd number of frames"),
-    ("median", 0, None, "filter size must be an odd number of frames"),
-    ("mean", 3, ["lelbow"], "no bone 'lelbow'"),
-])
+@pytest.mark.parametrize(
+    "kind,size,joints,message",
+    [
+        ("gauss", 3, None, "filter kind must be one of median, mean, binomial, got 'gauss'"),
+        ("median", 4, None, "filter size must be an odd number of frames"),
+        ("median", 0, None, "filter size must be an odd number of frames"),
+        ("mean", 3, ["lelbow"], "no bone 'lelbow'"),
+    ],
+)
 def test_bad_arguments(take, kind, size, joints, message):
     with pytest.raises(ValueError, match=message):
         take.filter(kind, size, joints)
@@ -96,8 +104,23 @@ def test_bad_arguments(take, kind, size, joints, message):
 
 def test_filter_command(data_dir, tmp_path, capsys):
     out = tmp_path / "smooth.amc"
-    assert main(["filter", "--median", "5", "--joints", "lhumerus,rhumerus", str(data_dir / "cmu" / "01_01.amc"),
-                 "--asf", str(data_dir / "cmu" / "01.asf"), "-o", str(out)]) == 0
+    assert (
+        main(
+            [
+                "filter",
+                "--median",
+                "5",
+                "--joints",
+                "lhumerus,rhumerus",
+                str(data_dir / "cmu" / "01_01.amc"),
+                "--asf",
+                str(data_dir / "cmu" / "01.asf"),
+                "-o",
+                str(out),
+            ]
+        )
+        == 0
+    )
     assert capsys.readouterr().out.strip() == f"median 5 over 2751 frames of lhumerus, rhumerus: wrote {out}"
     skeleton = mt.read_asf(data_dir / "cmu" / "01.asf")
     expected = mt.read_amc(data_dir / "cmu" / "01_01.amc", skeleton).filter("median", 5, ["lhumerus", "rhumerus"])
@@ -106,12 +129,15 @@ def test_filter_command(data_dir, tmp_path, capsys):
 
 def test_filter_command_finds_the_skeleton_and_writes_nothing_on_failure(data_dir, tmp_path, capsys):
     out = tmp_path / "smooth.amc"
-    assert main(["filter", "--mean", "3", str(data_dir / "hdm05" / "HDM_bd_squat1Reps_003_120.amc"),
-                 "-o", str(out)]) == 0
+    assert (
+        main(["filter", "--mean", "3", str(data_dir / "hdm05" / "HDM_bd_squat1Reps_003_120.amc"), "-o", str(out)]) == 0
+    )
     capsys.readouterr()
     bad = tmp_path / "bad.amc"
-    assert main(["filter", "--mean", "3", "--joints", "nosuchbone", str(data_dir / "cmu" / "01_01.amc"),
-                 "-o", str(bad)]) == 2
+    assert (
+        main(["filter", "--mean", "3", "--joints", "nosuchbone", str(data_dir / "cmu" / "01_01.amc"), "-o", str(bad)])
+        == 2
+    )
     assert "no bone 'nosuchbone'" in capsys.readouterr().err
     assert main(["filter", "--mean", "3", "--median", "5", str(data_dir / "cmu" / "01_01.amc"), "-o", str(bad)]) == 2
     assert "give exactly one of --median N, --mean N, --binomial N" in capsys.readouterr().err

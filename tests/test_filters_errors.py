@@ -27,7 +27,11 @@ def filt(request):
         (dict(size=4, origin=-3), ValueError, r"origin must be in \[-2, 1\] for size 4, got -3"),
         (dict(size=3, axis=2), np.exceptions.AxisError, "axis 2 is out of bounds"),
         (dict(size=3, axis=-3), np.exceptions.AxisError, "axis -3 is out of bounds"),
-        (dict(size=3, output=np.zeros((4, 6))), ValueError, r"output must have the input's shape \(6, 4\), got \(4, 6\)"),
+        (
+            dict(size=3, output=np.zeros((4, 6))),
+            ValueError,
+            r"output must have the input's shape \(6, 4\), got \(4, 6\)",
+        ),
         (dict(size=3, output=np.complex128), TypeError, "got dtype complex128"),
         (dict(size=3, output="not a dtype"), TypeError, "output must be None, an ndarray or a dtype"),
         (dict(size=3, cval="a"), ValueError, "could not convert"),
@@ -68,6 +72,7 @@ def test_zero_dimensional_input_has_no_axis(filt):
 
 def test_c_status_codes_map_to_exceptions():
     from mtcore._mtcore import ffi, lib
+
     from mtcore._status import check
 
     check(lib.MT_OK, "noop")
@@ -84,7 +89,20 @@ def test_c_status_codes_map_to_exceptions():
         args = dict(filter=lib.MT_FILTER_MEDIAN, dtype=lib.MT_FLOAT64, size=3, origin=0, mode=0)
         args.update(change)
         status = lib.mt_filter1d(
-            args["filter"], args["dtype"], buf, buf, 1, 4, 1, 0, 4, args["size"], args["origin"], args["mode"], 0.0, ffi.NULL
+            args["filter"],
+            args["dtype"],
+            buf,
+            buf,
+            1,
+            4,
+            1,
+            0,
+            4,
+            args["size"],
+            args["origin"],
+            args["mode"],
+            0.0,
+            ffi.NULL,
         )
         with pytest.raises(exc, match=r"mt_filter1d: .* \(status -\d\)"):
             check(status, "mt_filter1d")

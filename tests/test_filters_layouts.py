@@ -101,7 +101,12 @@ def test_output_dtype(rng, pair, out_dtype):
 def test_output_array_is_filled_and_returned(rng, pair):
     ours, theirs = pair
     x = rng.standard_normal((20, 17))
-    for out in (np.empty_like(x), np.empty(x.shape, order="F"), np.empty((20, 34))[:, ::2], np.empty(x.shape, np.float32)):
+    for out in (
+        np.empty_like(x),
+        np.empty(x.shape, order="F"),
+        np.empty((20, 34))[:, ::2],
+        np.empty(x.shape, np.float32),
+    ):
         result = ours(x, 5, axis=1, output=out)
         assert result is out
         np.testing.assert_allclose(out, theirs(x, 5, axis=1, output=out.dtype), rtol=0, atol=1e-5)
@@ -143,8 +148,7 @@ def test_nan_in_means_propagates_like_scipy(rng):
 def test_infinities(rng):
     x = rng.standard_normal((12, 3))
     x[4, 0], x[5, 1] = np.inf, -np.inf
-    np.testing.assert_array_equal(
-        mtcore.median_filter1d(x, 3, axis=0), ndi.median_filter(x, size=3, axes=(0,)))
+    np.testing.assert_array_equal(mtcore.median_filter1d(x, 3, axis=0), ndi.median_filter(x, size=3, axes=(0,)))
 
 
 def test_lists_and_scalars_of_python(rng):
@@ -176,11 +180,21 @@ def _every_parallel_call(workers):
     from mtcore.text import scan_table
 
     a = np.ones((2, 3))
-    tree = JointTree(parent=[-1], order=[0], axis=[np.eye(3)], direction=[np.zeros(3)], segment=[np.zeros(3)],
-                     dof_start=[0, 0], dof_kind=[], dof_column=[])
-    return [lambda: combine_frames(a, a, [0, 1], [0, 1], [0.0, 1.0], workers=workers),
-            lambda: forward_kinematics(a, tree, workers=workers),
-            lambda: scan_table(b"1 2 3\n", 1, 3, workers=workers)]
+    tree = JointTree(
+        parent=[-1],
+        order=[0],
+        axis=[np.eye(3)],
+        direction=[np.zeros(3)],
+        segment=[np.zeros(3)],
+        dof_start=[0, 0],
+        dof_kind=[],
+        dof_column=[],
+    )
+    return [
+        lambda: combine_frames(a, a, [0, 1], [0, 1], [0.0, 1.0], workers=workers),
+        lambda: forward_kinematics(a, tree, workers=workers),
+        lambda: scan_table(b"1 2 3\n", 1, 3, workers=workers),
+    ]
 
 
 @pytest.mark.parametrize("workers,exc", [(0, ValueError), (-2, ValueError), (1.5, TypeError)])

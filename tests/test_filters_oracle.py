@@ -102,10 +102,16 @@ def test_large_windows_overhanging_short_lines(rng, mode, size):
             kw = dict(mode=mode, cval=CVAL, origin=origin)
             np.testing.assert_allclose(
                 mtcore.uniform_filter1d(x, size, axis, **kw),
-                ndi.uniform_filter1d(x, size, axis, **kw), rtol=0, atol=1e-12)
+                ndi.uniform_filter1d(x, size, axis, **kw),
+                rtol=0,
+                atol=1e-12,
+            )
             np.testing.assert_allclose(
                 mtcore.binomial_filter1d(x, size, axis, **kw),
-                ndi.correlate1d(x, mtcore.pascal_weights(size), axis, **kw), rtol=0, atol=1e-12)
+                ndi.correlate1d(x, mtcore.pascal_weights(size), axis, **kw),
+                rtol=0,
+                atol=1e-12,
+            )
             line = x[1, 2] if axis == 2 else x[:, 1, 2]
             got = mtcore.median_filter1d(x, size, axis, **kw)
             got_line = got[1, 2] if axis == 2 else got[:, 1, 2]
@@ -119,13 +125,20 @@ def test_realistic_shapes_against_scipy(rng, size, shape, axis):
     x = rng.standard_normal(shape)
     kw = dict(mode="nearest")
     np.testing.assert_array_equal(
-        mtcore.median_filter1d(x, size, axis, **kw), ndi.median_filter(x, size=size, axes=(axis,), **kw))
+        mtcore.median_filter1d(x, size, axis, **kw), ndi.median_filter(x, size=size, axes=(axis,), **kw)
+    )
     np.testing.assert_allclose(
-        mtcore.uniform_filter1d(x, size, axis, **kw), ndi.uniform_filter1d(x, size, axis, **kw),
-        rtol=0, atol=1e-12 * np.abs(x).max())
+        mtcore.uniform_filter1d(x, size, axis, **kw),
+        ndi.uniform_filter1d(x, size, axis, **kw),
+        rtol=0,
+        atol=1e-12 * np.abs(x).max(),
+    )
     np.testing.assert_allclose(
         mtcore.binomial_filter1d(x, size, axis, **kw),
-        ndi.correlate1d(x, mtcore.pascal_weights(size), axis, **kw), rtol=0, atol=1e-12 * np.abs(x).max())
+        ndi.correlate1d(x, mtcore.pascal_weights(size), axis, **kw),
+        rtol=0,
+        atol=1e-12 * np.abs(x).max(),
+    )
 
 
 @pytest.mark.parametrize("size", [3, 5, 7, 9])

@@ -26,8 +26,12 @@ def test_median_never_invents_values(x, size, mode, k):
     assert set(got.ravel().tolist()) <= allowed
 
 
-@given(value=finite, shape=array_shapes(min_dims=1, max_dims=3, max_side=10), size=sizes,
-       mode=st.sampled_from(["reflect", "nearest", "mirror", "wrap"]))
+@given(
+    value=finite,
+    shape=array_shapes(min_dims=1, max_dims=3, max_side=10),
+    size=sizes,
+    mode=st.sampled_from(["reflect", "nearest", "mirror", "wrap"]),
+)
 @settings(max_examples=200, deadline=None)
 def test_constant_in_constant_out(value, shape, size, mode):
     x = np.full(shape, value)

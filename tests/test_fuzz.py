@@ -21,8 +21,29 @@ def sample(path: Path) -> bytes:
 AMC = sample(DATA / "cmu" / "02_03.amc").split(b"\n21\n")[0] + b"\n"  # 20 whole frames
 ASF = sample(DATA / "cmu" / "02.asf")
 BVH = sample(DATA / "bvh" / "walk01.bvh")
-NOISE = st.sampled_from([b"", b" ", b"\t", b"\n", b"\r", b"x", b"-", b".", b"e", b"1e999", b"nan", b"{", b"}",
-                         b"#", b":", b"root", b"\xff", b"999999999999999999999", b"0" * 40])
+NOISE = st.sampled_from(
+    [
+        b"",
+        b" ",
+        b"\t",
+        b"\n",
+        b"\r",
+        b"x",
+        b"-",
+        b".",
+        b"e",
+        b"1e999",
+        b"nan",
+        b"{",
+        b"}",
+        b"#",
+        b":",
+        b"root",
+        b"\xff",
+        b"999999999999999999999",
+        b"0" * 40,
+    ]
+)
 
 
 @st.composite
@@ -31,7 +52,7 @@ def mutated(draw, text: bytes):
     for _ in range(draw(st.integers(1, 4))):
         at = draw(st.integers(0, len(data)))
         cut = draw(st.integers(0, 8))
-        data[at:at + cut] = draw(NOISE)
+        data[at : at + cut] = draw(NOISE)
     return bytes(data)
 
 
@@ -75,8 +96,7 @@ def test_c_scanners_take_any_bytes(data, rows, columns):
     from mtcore.errors import FormatError
     from mtcore.text import scan_frames, scan_table
 
-    for scan in (lambda: scan_frames(data, [b"a", b"bb"], [0, 1], [1, 2], 3),
-                 lambda: scan_table(data, rows, columns)):
+    for scan in (lambda: scan_frames(data, [b"a", b"bb"], [0, 1], [1, 2], 3), lambda: scan_table(data, rows, columns)):
         try:
             scan()
         except FormatError:

@@ -12,8 +12,11 @@ EPS = 0.1
 
 
 def one_joint(values, unit="rad"):
-    skeleton = mt.Skeleton(bones=(mt.Bone(name="arm", direction=(1, 0, 0), length=1, dofs=("rx", "ry", "rz")),),
-                           hierarchy=(("root", ("arm",)),), units=(("angle", unit),))
+    skeleton = mt.Skeleton(
+        bones=(mt.Bone(name="arm", direction=(1, 0, 0), length=1, dofs=("rx", "ry", "rz")),),
+        hierarchy=(("root", ("arm",)),),
+        units=(("angle", unit),),
+    )
     return mt.Motion(skeleton, values, first_frame=1)
 
 
@@ -27,12 +30,14 @@ def cs838():
 
 
 def total_turn(motion, first, last):
-    q = rot.euler_to_quaternions(motion.values[first - 1:last, 6:9], "xyz", extrinsic=True)
+    q = rot.euler_to_quaternions(motion.values[first - 1 : last, 6:9], "xyz", extrinsic=True)
     return (2 * np.arccos(np.clip(np.abs(np.sum(q[1:] * q[:-1], -1)), 0, 1))).sum()
 
 
-@pytest.mark.parametrize("kind,turn", [("slerp", 2 * EPS), ("expmap", 2 * (np.pi - EPS)),
-                                       ("euler", 2 * (np.pi - EPS)), ("aligned_expmap", 2 * EPS)])
+@pytest.mark.parametrize(
+    "kind,turn",
+    [("slerp", 2 * EPS), ("expmap", 2 * (np.pi - EPS)), ("euler", 2 * (np.pi - EPS)), ("aligned_expmap", 2 * EPS)],
+)
 def test_cs838_comparison(cs838, kind, turn):
     result = interpolate(cs838, 100, 150, kind, ["arm"])
     assert total_turn(result, 100, 150) == pytest.approx(turn, abs=1e-9)
@@ -72,13 +77,14 @@ def test_median3_touches_only_its_range(data_dir):
     np.testing.assert_array_equal(result.values[:49], motion.values[:49])
     np.testing.assert_array_equal(result.values[80:], motion.values[80:])
     column = motion.values[49:80, 5]
-    np.testing.assert_array_equal(result.values[50:79, 5], np.median(np.stack([column[:-2], column[1:-1], column[2:]]), 0))
+    np.testing.assert_array_equal(
+        result.values[50:79, 5], np.median(np.stack([column[:-2], column[1:-1], column[2:]]), 0)
+    )
 
 
 def test_pipeline_applies_steps_in_order(data_dir):
     motion = mt.read_amc(data_dir / "cmu" / "02_01.amc", mt.read_asf(data_dir / "cmu" / "02.asf"))
-    pipeline = Pipeline().then("median3", 1, 343).then("slerp", 100, 140, ["lfemur"]).then("binomial", 200, 300,
-                                                                                            size=5)
+    pipeline = Pipeline().then("median3", 1, 343).then("slerp", 100, 140, ["lfemur"]).then("binomial", 200, 300, size=5)
     expected = interpolate(median3(motion, 1, 343), 100, 140, "slerp", ["lfemur"])
     piece = expected.replace(values=expected.values[199:300], first_frame=200).filter("binomial", 5)
     values = expected.values.copy()
@@ -87,13 +93,16 @@ def test_pipeline_applies_steps_in_order(data_dir):
     assert len(pipeline.steps) == 3
 
 
-@pytest.mark.parametrize("call,message", [
-    (lambda m: interpolate(m, 150, 100), r"the range 150..100 must lie within the motion's frames 1..200"),
-    (lambda m: interpolate(m, 0, 100), r"the range 0..100"),
-    (lambda m: interpolate(m, 10, 20, "cubic"), "kind must be one of euler, slerp, expmap, aligned_expmap"),
-    (lambda m: Pipeline().then("spline", 1, 5), "step kind must be one of"),
-    (lambda m: interpolate(m, 10, 20, "slerp", ["leg"]), "no bone 'leg'"),
-])
+@pytest.mark.parametrize(
+    "call,message",
+    [
+        (lambda m: interpolate(m, 150, 100), r"the range 150..100 must lie within the motion's frames 1..200"),
+        (lambda m: interpolate(m, 0, 100), r"the range 0..100"),
+        (lambda m: interpolate(m, 10, 20, "cubic"), "kind must be one of euler, slerp, expmap, aligned_expmap"),
+        (lambda m: Pipeline().then("spline", 1, 5), "step kind must be one of"),
+        (lambda m: interpolate(m, 10, 20, "slerp", ["leg"]), "no bone 'leg'"),
+    ],
+)
 def test_bad_requests(cs838, call, message):
     with pytest.raises(ValueError, match=message):
         call(cs838)

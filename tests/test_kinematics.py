@@ -59,8 +59,10 @@ def test_rest_pose_is_parent_plus_direction_times_length(data_dir):
             d = np.asarray(bone.direction)
             expected = rest[names.index(skeleton.parent(bone.name))] + d / np.linalg.norm(d) * bone.length
             np.testing.assert_allclose(rest[names.index(bone.name)], expected, rtol=0, atol=1e-9, err_msg=bone.name)
-        np.testing.assert_array_equal(skeleton.rest_positions(start=True)[names.index(skeleton.bone_names[0])],
-                                      rest[names.index(skeleton.parent(skeleton.bone_names[0]))])
+        np.testing.assert_array_equal(
+            skeleton.rest_positions(start=True)[names.index(skeleton.bone_names[0])],
+            rest[names.index(skeleton.parent(skeleton.bone_names[0]))],
+        )
 
 
 @pytest.fixture
@@ -118,14 +120,29 @@ def test_motion_of_another_skeleton_is_refused(data_dir, cmu):
 
 
 def single_joint(kind, scale=1.0):
-    return JointTree(parent=[-1], order=[0], axis=[np.eye(3)], direction=[np.zeros(3)], segment=[np.zeros(3)],
-                     dof_start=[0, 1], dof_kind=[kind], dof_column=[0], angle_scale=scale)
+    return JointTree(
+        parent=[-1],
+        order=[0],
+        axis=[np.eye(3)],
+        direction=[np.zeros(3)],
+        segment=[np.zeros(3)],
+        dof_start=[0, 1],
+        dof_kind=[kind],
+        dof_column=[0],
+        angle_scale=scale,
+    )
 
 
 def test_sin_and_cos_to_an_ulp(rng):
     """The kernel's own sin/cos (vectorised over frames) against libm, large angles included."""
-    x = np.concatenate([rng.uniform(-10, 10, 20000), rng.uniform(-1e6, 1e6, 20000), np.linspace(-7, 7, 10001),
-                        [0.0, -0.0, np.pi / 4, np.pi / 2, np.pi, 2.0**30, 2.0**31, 1e300, 5e-324]])
+    x = np.concatenate(
+        [
+            rng.uniform(-10, 10, 20000),
+            rng.uniform(-1e6, 1e6, 20000),
+            np.linspace(-7, 7, 10001),
+            [0.0, -0.0, np.pi / 4, np.pi / 2, np.pi, 2.0**30, 2.0**31, 1e300, 5e-324],
+        ]
+    )
     _, _, local = forward_kinematics(x[:, None], single_joint(2), local=True)
     np.testing.assert_allclose(local[:, 0, 0, 0], np.cos(x), rtol=0, atol=2.3e-16)
     np.testing.assert_allclose(local[:, 0, 1, 0], np.sin(x), rtol=0, atol=2.3e-16)
@@ -135,8 +152,12 @@ def test_sin_and_cos_to_an_ulp(rng):
 
 def test_quaternions_equal_scipy(rng):
     rotations = Rotation.random(5000, random_state=1)
-    matrices = np.concatenate([rotations.as_matrix(), Rotation.from_rotvec([[np.pi, 0, 0], [0, np.pi, 0],
-                                                                            [0, 0, np.pi], [0, 0, 0]]).as_matrix()])
+    matrices = np.concatenate(
+        [
+            rotations.as_matrix(),
+            Rotation.from_rotvec([[np.pi, 0, 0], [0, np.pi, 0], [0, 0, np.pi], [0, 0, 0]]).as_matrix(),
+        ]
+    )
     q = rotations_to_quaternions(matrices)
     expected = Rotation.from_matrix(matrices).as_quat(scalar_first=True)
     assert (q[:, 0] >= 0).all()
@@ -145,10 +166,26 @@ def test_quaternions_equal_scipy(rng):
 
 def test_bad_tables_are_refused():
     with pytest.raises(ValueError, match=r"order must have shape \(2,\), got \(1,\)"):
-        JointTree(parent=[-1, 0], order=[0], axis=[np.eye(3)] * 2, direction=np.zeros((2, 3)),
-                  segment=np.zeros((2, 3)), dof_start=[0, 0, 0], dof_kind=[], dof_column=[])
-    tree = JointTree(parent=[1, -1], order=[0, 1], axis=[np.eye(3)] * 2, direction=np.zeros((2, 3)),
-                     segment=np.zeros((2, 3)), dof_start=[0, 0, 0], dof_kind=[], dof_column=[])
+        JointTree(
+            parent=[-1, 0],
+            order=[0],
+            axis=[np.eye(3)] * 2,
+            direction=np.zeros((2, 3)),
+            segment=np.zeros((2, 3)),
+            dof_start=[0, 0, 0],
+            dof_kind=[],
+            dof_column=[],
+        )
+    tree = JointTree(
+        parent=[1, -1],
+        order=[0, 1],
+        axis=[np.eye(3)] * 2,
+        direction=np.zeros((2, 3)),
+        segment=np.zeros((2, 3)),
+        dof_start=[0, 0, 0],
+        dof_kind=[],
+        dof_column=[],
+    )
     with pytest.raises(ValueError, match="mt_forward_kinematics: an argument is outside its documented range"):
         forward_kinematics(np.zeros((3, 1)), tree)  # a child before its parent
     with pytest.raises(ValueError, match="reads column 0 but values have 0 channels"):

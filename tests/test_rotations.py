@@ -46,13 +46,15 @@ def total_turn(q):
 
 # --- Euler angles -------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("extrinsic", KINDS)
 @pytest.mark.parametrize("order", ORDERS)
 def test_euler_to_matrices_equals_scipy_and_the_twin(rng, order, extrinsic):
     angles = euler_samples(rng, order)
     m = rot.euler_to_matrices(angles, order, extrinsic=extrinsic)
-    np.testing.assert_allclose(m, Rotation.from_euler(scipy_seq(order, extrinsic), angles).as_matrix(), rtol=0,
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        m, Rotation.from_euler(scipy_seq(order, extrinsic), angles).as_matrix(), rtol=0, atol=1e-12
+    )
     np.testing.assert_allclose(m, twin_matrices(angles, order, extrinsic), rtol=0, atol=1e-14)
     degrees = rot.euler_to_matrices(np.degrees(angles), order, extrinsic=extrinsic, degrees=True)
     np.testing.assert_allclose(degrees, m, rtol=0, atol=1e-14)
@@ -68,8 +70,9 @@ def test_matrices_to_euler_equals_scipy(rng, order, extrinsic):
         expected = Rotation.from_matrix(general).as_euler(seq)
     assert np.abs(wrapped(angles - expected)).max() < 1e-10  # scipy's own angles are good to ~1e-14
     np.testing.assert_allclose(Rotation.from_euler(seq, angles).as_matrix(), general, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(rot.matrices_to_euler(general, order, extrinsic=extrinsic, degrees=True),
-                               np.degrees(angles), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        rot.matrices_to_euler(general, order, extrinsic=extrinsic, degrees=True), np.degrees(angles), rtol=0, atol=1e-12
+    )
     # scipy's ranges
     middle = angles[:, 1]
     if order[0] == order[2]:
@@ -119,14 +122,16 @@ def test_euler_round_trip_property(angles, order, extrinsic):
 
 # --- quaternions and rotation vectors -----------------------------------------------------
 
+
 def test_quaternions_and_matrices_equal_scipy():
     r = Rotation.random(5000, random_state=1)
     m = np.concatenate([r.as_matrix(), Rotation.from_rotvec(np.pi * np.eye(3)).as_matrix(), np.eye(3)[None]])
     q = rot.matrices_to_quaternions(m)
     expected = Rotation.from_matrix(m).as_quat(scalar_first=True, canonical=True)
     assert (q[:, 0] >= 0).all()
-    np.testing.assert_allclose(np.minimum(np.abs(q - expected).max(-1), np.abs(q + expected).max(-1)), 0,
-                               atol=1e-15)  # w = 0 at a half turn: either sign
+    np.testing.assert_allclose(
+        np.minimum(np.abs(q - expected).max(-1), np.abs(q + expected).max(-1)), 0, atol=1e-15
+    )  # w = 0 at a half turn: either sign
     unnormalised = r.as_quat(scalar_first=True) * np.linspace(0.1, 10, 5000)[:, None]
     np.testing.assert_allclose(rot.quaternions_to_matrices(unnormalised), r.as_matrix(), rtol=0, atol=1e-15)
 
@@ -134,8 +139,9 @@ def test_quaternions_and_matrices_equal_scipy():
 def test_rotvecs_equal_scipy():
     r = Rotation.random(5000, random_state=2)
     v = r.as_rotvec()
-    np.testing.assert_allclose(rot.rotvecs_to_quaternions(v), r.as_quat(scalar_first=True, canonical=True),
-                               rtol=0, atol=1e-15)
+    np.testing.assert_allclose(
+        rot.rotvecs_to_quaternions(v), r.as_quat(scalar_first=True, canonical=True), rtol=0, atol=1e-15
+    )
     q = r.as_quat(scalar_first=True) * np.where(np.arange(5000) % 2, -3.0, 0.5)[:, None]  # any sign and norm
     np.testing.assert_allclose(rot.quaternions_to_rotvecs(q), v, rtol=0, atol=1e-14)
     np.testing.assert_allclose(rot.rotvecs_to_matrices(v), r.as_matrix(), rtol=0, atol=1e-14)
@@ -146,8 +152,27 @@ def test_rotvecs_equal_scipy():
 
 
 # the series end at an angle of 1e-4 (to quaternions) and 2e-4 (back)
-@pytest.mark.parametrize("angle", [0.0, 1e-300, 1e-20, 1e-9, 9.99e-5, 1e-4, 1.001e-4, 1.999e-4, 2e-4, 2.001e-4, 1e-3,
-                                   0.5, np.pi - 1e-3, np.pi - 1e-9, np.pi - 4e-16, np.pi])
+@pytest.mark.parametrize(
+    "angle",
+    [
+        0.0,
+        1e-300,
+        1e-20,
+        1e-9,
+        9.99e-5,
+        1e-4,
+        1.001e-4,
+        1.999e-4,
+        2e-4,
+        2.001e-4,
+        1e-3,
+        0.5,
+        np.pi - 1e-3,
+        np.pi - 1e-9,
+        np.pi - 4e-16,
+        np.pi,
+    ],
+)
 def test_rotvecs_near_zero_and_half_turns(rng, angle):
     """Series at small angles (no 0/0), atan2 rather than acos near pi: accurate throughout,
     against the closed form in extended precision."""
@@ -178,8 +203,10 @@ def test_conversions_through_euler_equal_scipy(rng, order, extrinsic):
     np.testing.assert_allclose(q, r.as_quat(scalar_first=True, canonical=True), rtol=0, atol=1e-12)
     v = rot.euler_to_rotvecs(angles, order, extrinsic=extrinsic)
     np.testing.assert_allclose(Rotation.from_rotvec(v).as_matrix(), r.as_matrix(), rtol=0, atol=1e-12)
-    for back in (rot.quaternions_to_euler(q, order, extrinsic=extrinsic),
-                 rot.rotvecs_to_euler(v, order, extrinsic=extrinsic)):
+    for back in (
+        rot.quaternions_to_euler(q, order, extrinsic=extrinsic),
+        rot.rotvecs_to_euler(v, order, extrinsic=extrinsic),
+    ):
         np.testing.assert_allclose(Rotation.from_euler(seq, back).as_matrix(), r.as_matrix(), rtol=0, atol=1e-12)
 
 
@@ -195,8 +222,9 @@ def test_any_leading_shape_dtype_and_layout(rng):
     frozen = q.copy()
     frozen.flags.writeable = False
     for variant in variants + [frozen]:
-        np.testing.assert_allclose(rot.quaternions_to_matrices(variant), m, rtol=0, atol=1e-6 if
-                                   variant.dtype == np.float32 else 1e-15)
+        np.testing.assert_allclose(
+            rot.quaternions_to_matrices(variant), m, rtol=0, atol=1e-6 if variant.dtype == np.float32 else 1e-15
+        )
     np.testing.assert_array_equal(rot.euler_to_matrices(angles.tolist(), "zyx", extrinsic=False), m)
 
 
@@ -205,10 +233,16 @@ def test_inputs_are_never_modified(rng):
     v = rng.normal(size=(20, 2, 3))
     m = rot.quaternions_to_matrices(q)
     copies = [a.copy() for a in (q, v, m)]
-    for call in (lambda: rot.quaternions_to_matrices(q), lambda: rot.matrices_to_euler(m, "xyz", extrinsic=True),
-                 lambda: rot.quaternions_to_rotvecs(q), lambda: rot.rotvecs_to_quaternions(v),
-                 lambda: rot.unroll_quaternions(q), lambda: rot.unroll_euler(v, "zxz"),
-                 lambda: rot.slerp(q[0], q[1], 0.3), lambda: rot.interpolate_rotvecs(v[0], v[1], 0.3, aligned=True)):
+    for call in (
+        lambda: rot.quaternions_to_matrices(q),
+        lambda: rot.matrices_to_euler(m, "xyz", extrinsic=True),
+        lambda: rot.quaternions_to_rotvecs(q),
+        lambda: rot.rotvecs_to_quaternions(v),
+        lambda: rot.unroll_quaternions(q),
+        lambda: rot.unroll_euler(v, "zxz"),
+        lambda: rot.slerp(q[0], q[1], 0.3),
+        lambda: rot.interpolate_rotvecs(v[0], v[1], 0.3, aligned=True),
+    ):
         call()
     for a, b in zip((q, v, m), copies):
         np.testing.assert_array_equal(a, b)
@@ -222,6 +256,7 @@ def test_nan_and_zero_quaternions_give_nan():
 
 
 # --- continuity ---------------------------------------------------------------------------
+
 
 def unroll_quaternions_twin(q):
     out = q.copy()
@@ -288,8 +323,9 @@ def test_unroll_euler_equals_the_twin(rng, order, degrees):
     for i in range(2):
         np.testing.assert_allclose(out[i], unroll_euler_twin(raw[i], order[0] == order[2], half), rtol=0, atol=1e-9)
     m = rot.euler_to_matrices(raw, order, extrinsic=True, degrees=degrees)
-    np.testing.assert_allclose(rot.euler_to_matrices(out, order, extrinsic=True, degrees=degrees), m, rtol=0,
-                               atol=1e-12)  # the same rotations
+    np.testing.assert_allclose(
+        rot.euler_to_matrices(out, order, extrinsic=True, degrees=degrees), m, rtol=0, atol=1e-12
+    )  # the same rotations
 
 
 @pytest.mark.parametrize("extrinsic", KINDS)
@@ -308,6 +344,7 @@ def test_unroll_euler_recovers_a_smooth_path(rng, order, extrinsic):
 
 # --- interpolation ------------------------------------------------------------------------
 
+
 def test_slerp_equals_scipy(rng):
     r0, r1 = Rotation.random(1000, random_state=3), Rotation.random(1000, random_state=4)
     t = rng.uniform(-0.2, 1.2, 1000)
@@ -319,8 +356,7 @@ def test_slerp_equals_scipy(rng):
     inside = np.flatnonzero((t >= 0) & (t <= 1))  # scipy's Slerp does not extrapolate
     for i in inside[::20]:
         scipy_slerp = Slerp([0, 1], Rotation.concatenate([r0[i], r1[i]]))
-        np.testing.assert_allclose(rot.quaternions_to_matrices(q[i]), scipy_slerp(t[i]).as_matrix(), rtol=0,
-                                   atol=1e-14)
+        np.testing.assert_allclose(rot.quaternions_to_matrices(q[i]), scipy_slerp(t[i]).as_matrix(), rtol=0, atol=1e-14)
     np.testing.assert_allclose(rot.slerp(q0, q1, 0.0), q0, rtol=0, atol=1e-15)
     ends = rot.slerp(q0, q1, 1.0)
     np.testing.assert_allclose(ends * np.sign(np.sum(ends * q1, -1))[:, None], q1, rtol=0, atol=1e-15)
@@ -405,6 +441,7 @@ def test_cs838_keys_either_side_of_a_half_turn():
 
 # --- bad arguments ------------------------------------------------------------------------
 
+
 class NoC:
     """Stands in for the C library: any use fails the test."""
 
@@ -414,40 +451,76 @@ class NoC:
 
 Z3, Z4 = np.zeros(3), np.zeros(4)
 BAD_CALLS = [
-    (lambda: rot.euler_to_matrices(Z3, "xyw", extrinsic=True), ValueError,
-     r"order must be one of xyz, xzy, yxz, yzx, zxy, zyx, xyx, xzx, yxy, yzy, zxz, zyz, got 'xyw'$"),
-    (lambda: rot.euler_to_matrices(Z3, "XYZ", extrinsic=False), ValueError,
-     r"got 'XYZ' \(lowercase; extrinsic= says fixed or turning axes\)"),
+    (
+        lambda: rot.euler_to_matrices(Z3, "xyw", extrinsic=True),
+        ValueError,
+        r"order must be one of xyz, xzy, yxz, yzx, zxy, zyx, xyx, xzx, yxy, yzy, zxz, zyz, got 'xyw'$",
+    ),
+    (
+        lambda: rot.euler_to_matrices(Z3, "XYZ", extrinsic=False),
+        ValueError,
+        r"got 'XYZ' \(lowercase; extrinsic= says fixed or turning axes\)",
+    ),
     (lambda: rot.matrices_to_euler(np.eye(3), "xxy", extrinsic=True), ValueError, r"order must be one of"),
     (lambda: rot.quaternions_to_euler(Z4, "xy", extrinsic=True), ValueError, r"got 'xy'"),
     (lambda: rot.rotvecs_to_euler(Z3, 3, extrinsic=True), TypeError, r"order must be a string such as 'xyz', got int"),
     (lambda: rot.euler_to_matrices(Z3, "xyz"), TypeError, r"missing 1 required keyword-only argument: 'extrinsic'"),
-    (lambda: rot.euler_to_matrices(Z3, "xyz", extrinsic="yes"), TypeError,
-     r"extrinsic must be True or False, got 'yes'"),
+    (
+        lambda: rot.euler_to_matrices(Z3, "xyz", extrinsic="yes"),
+        TypeError,
+        r"extrinsic must be True or False, got 'yes'",
+    ),
     (lambda: rot.euler_to_matrices(Z3, "xyz", extrinsic=True, degrees=1), TypeError, r"degrees must be True or False"),
-    (lambda: rot.euler_to_matrices(np.zeros((5, 2)), "xyz", extrinsic=True), ValueError,
-     r"angles must have shape \(\.\.\., 3\), got \(5, 2\)"),
-    (lambda: rot.matrices_to_quaternions(np.zeros((5, 3, 4))), ValueError,
-     r"matrices must have shape \(\.\.\., 3, 3\), got \(5, 3, 4\)"),
-    (lambda: rot.matrices_to_euler(Z3, "xyz", extrinsic=True), ValueError,
-     r"matrices must have shape \(\.\.\., 3, 3\), got \(3,\)"),
-    (lambda: rot.quaternions_to_matrices(np.zeros((2, 3))), ValueError,
-     r"quaternions must have shape \(\.\.\., 4\), got \(2, 3\)"),
-    (lambda: rot.rotvecs_to_quaternions(np.float64(1.0)), ValueError,
-     r"rotvecs must have shape \(\.\.\., 3\), got \(\)"),
-    (lambda: rot.quaternions_to_rotvecs(Z4 + 0j), TypeError,
-     r"quaternions must hold real numbers, got dtype complex128"),
+    (
+        lambda: rot.euler_to_matrices(np.zeros((5, 2)), "xyz", extrinsic=True),
+        ValueError,
+        r"angles must have shape \(\.\.\., 3\), got \(5, 2\)",
+    ),
+    (
+        lambda: rot.matrices_to_quaternions(np.zeros((5, 3, 4))),
+        ValueError,
+        r"matrices must have shape \(\.\.\., 3, 3\), got \(5, 3, 4\)",
+    ),
+    (
+        lambda: rot.matrices_to_euler(Z3, "xyz", extrinsic=True),
+        ValueError,
+        r"matrices must have shape \(\.\.\., 3, 3\), got \(3,\)",
+    ),
+    (
+        lambda: rot.quaternions_to_matrices(np.zeros((2, 3))),
+        ValueError,
+        r"quaternions must have shape \(\.\.\., 4\), got \(2, 3\)",
+    ),
+    (
+        lambda: rot.rotvecs_to_quaternions(np.float64(1.0)),
+        ValueError,
+        r"rotvecs must have shape \(\.\.\., 3\), got \(\)",
+    ),
+    (
+        lambda: rot.quaternions_to_rotvecs(Z4 + 0j),
+        TypeError,
+        r"quaternions must hold real numbers, got dtype complex128",
+    ),
     (lambda: rot.euler_to_quaternions(Z3 + 0j, "xyz", extrinsic=True), TypeError, r"got dtype complex128"),
-    (lambda: rot.rotvecs_to_matrices(np.array(["a", "b", "c"])), TypeError,
-     r"rotvecs must hold real numbers, got dtype <U1"),
-    (lambda: rot.unroll_quaternions(np.zeros((5, 4)), axis=1), ValueError,
-     r"axis must be an axis of frames, not the last axis of quaternions \(its 4 components\)"),
+    (
+        lambda: rot.rotvecs_to_matrices(np.array(["a", "b", "c"])),
+        TypeError,
+        r"rotvecs must hold real numbers, got dtype <U1",
+    ),
+    (
+        lambda: rot.unroll_quaternions(np.zeros((5, 4)), axis=1),
+        ValueError,
+        r"axis must be an axis of frames, not the last axis of quaternions \(its 4 components\)",
+    ),
     (lambda: rot.unroll_quaternions(np.zeros((5, 4)), axis=2), ValueError, r"axis 2 is out of bounds"),
     (lambda: rot.unroll_quaternions(np.zeros((5, 4)), axis=0.0), TypeError, r"axis must be an integer, got 0.0"),
     (lambda: rot.unroll_euler(np.zeros((5, 3)), "xyz", axis=-1), ValueError, r"not the last axis of angles"),
     (lambda: rot.unroll_euler(np.zeros((5, 3)), "XYZ"), ValueError, r"order must be one of"),
-    (lambda: rot.slerp(np.zeros((3, 4)), np.zeros((2, 4)), 0.5), ValueError,
-     r"q0 \(3, 4\), q1 \(2, 4\) and t \(\) do not broadcast together"),
+    (
+        lambda: rot.slerp(np.zeros((3, 4)), np.zeros((2, 4)), 0.5),
+        ValueError,
+        r"q0 \(3, 4\), q1 \(2, 4\) and t \(\) do not broadcast together",
+    ),
     (lambda: rot.slerp(Z4, Z4, [0.5j]), TypeError, r"t must hold real numbers, got dtype complex128"),
     (lambda: rot.interpolate_rotvecs(Z3, Z4, 0.5), ValueError, r"v1 must have shape \(\.\.\., 3\)"),
     (lambda: rot.interpolate_rotvecs(Z3, Z3, 0.5, aligned=None), TypeError, r"aligned must be True or False"),

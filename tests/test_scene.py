@@ -6,9 +6,28 @@ import pytest
 import motiontheater as mt
 from motiontheater.cli import main
 
-UPPER = ["lowerback", "upperback", "thorax", "lowerneck", "upperneck", "head", "lclavicle", "lhumerus", "lradius",
-         "lwrist", "lhand", "lfingers", "lthumb", "rclavicle", "rhumerus", "rradius", "rwrist", "rhand",
-         "rfingers", "rthumb"]
+UPPER = [
+    "lowerback",
+    "upperback",
+    "thorax",
+    "lowerneck",
+    "upperneck",
+    "head",
+    "lclavicle",
+    "lhumerus",
+    "lradius",
+    "lwrist",
+    "lhand",
+    "lfingers",
+    "lthumb",
+    "rclavicle",
+    "rhumerus",
+    "rradius",
+    "rwrist",
+    "rhand",
+    "rfingers",
+    "rthumb",
+]
 
 
 @pytest.fixture
@@ -16,16 +35,16 @@ def recipe(data_dir, tmp_path):
     cmu = data_dir / "cmu"
     path = tmp_path / "tutorial.toml"
     path.write_text(f'''
-skeleton = "{cmu / '02.asf'}"
+skeleton = "{cmu / "02.asf"}"
 [base]
-motion = "{cmu / '02_01.amc'}"
+motion = "{cmu / "02_01.amc"}"
 [[track]]
-motion = "{cmu / '02_02.amc'}"
+motion = "{cmu / "02_02.amc"}"
 joints = {UPPER}
 cut = [1, 55]
 scale = [1, 66]
 [[track]]
-motion = "{cmu / '02_01.amc'}"
+motion = "{cmu / "02_01.amc"}"
 joints = {UPPER}
 cut = [67, 113]
 blend = 10
@@ -41,8 +60,11 @@ def test_thesis_tutorial(recipe, data_dir):
     second = mt.read_amc(data_dir / "cmu" / "02_02.amc", skeleton)
     result = mt.read_recipe(recipe).render()
     assert (result.first_frame, result.frames) == (1, 343)
-    legs = [c for j in ("lfemur", "ltibia", "lfoot", "ltoes", "rfemur", "rtibia", "rfoot", "rtoes", "root")
-            for c in result.columns(j)]
+    legs = [
+        c
+        for j in ("lfemur", "ltibia", "lfoot", "ltoes", "rfemur", "rtibia", "rfoot", "rtoes", "root")
+        for c in result.columns(j)
+    ]
     np.testing.assert_array_equal(result.values[:, legs], first.values[:, legs])
     upper = [c for j in UPPER for c in result.columns(j)]
     # frames 1..56 hold the second take's 1..55 stretched (frame 1 -> 1, frame 66 -> 55)
@@ -57,8 +79,11 @@ def test_scene_api_equals_recipe(recipe, data_dir):
     skeleton = mt.read_asf(data_dir / "cmu" / "02.asf")
     first = mt.read_amc(data_dir / "cmu" / "02_01.amc", skeleton)
     second = mt.read_amc(data_dir / "cmu" / "02_02.amc", skeleton)
-    scene = mt.Scene(first).add(second, joints=UPPER, cut=(1, 55), scale=(1, 66)).add(
-        first, joints=UPPER, cut=(67, 113), blend=10)
+    scene = (
+        mt.Scene(first)
+        .add(second, joints=UPPER, cut=(1, 55), scale=(1, 66))
+        .add(first, joints=UPPER, cut=(67, 113), blend=10)
+    )
     assert len(scene.tracks) == 2 and scene.tracks[0].motion is second
     assert scene.render().values.tobytes() == mt.read_recipe(recipe).render().values.tobytes()
     with pytest.raises(ValueError, match="unknown track option"):
@@ -70,7 +95,8 @@ def test_combine_command(recipe, tmp_path, capsys):
     assert main(["combine", str(recipe), "-o", str(out)]) == 0
     assert capsys.readouterr().out.strip() == f"2 track(s) over 343 frames: wrote 343 frames (1..343) to {out}"
     assert mt.read_amc(out, mt.read_recipe(recipe).base.skeleton).values.tobytes() == (
-        mt.read_recipe(recipe).render().values.tobytes())
+        mt.read_recipe(recipe).render().values.tobytes()
+    )
 
 
 def test_dry_run_prints_the_frame_maps(recipe, tmp_path, capsys):
@@ -83,11 +109,15 @@ def test_dry_run_prints_the_frame_maps(recipe, tmp_path, capsys):
 
 def test_bad_recipes(tmp_path, capsys, data_dir):
     bad = tmp_path / "bad.toml"
-    bad.write_text(f'[base]\nmotion = "{data_dir / "cmu" / "02_01.amc"}"\n[[track]]\nmotion = "{data_dir / "cmu" / "02_02.amc"}"\ncut = [0, 999]\n')
+    bad.write_text(
+        f'[base]\nmotion = "{data_dir / "cmu" / "02_01.amc"}"\n[[track]]\nmotion = "{data_dir / "cmu" / "02_02.amc"}"\ncut = [0, 999]\n'
+    )
     assert main(["combine", str(bad), "-o", str(tmp_path / "o.amc")]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("motiontheater combine: track 1 (") and "02_02.amc): cut=(0, 999) is outside the new " \
-        "motion's frames 1..298" in err
+    assert (
+        err.startswith("motiontheater combine: track 1 (")
+        and "02_02.amc): cut=(0, 999) is outside the new motion's frames 1..298" in err
+    )
     bad.write_text("this is = = not toml")
     assert main(["combine", str(bad), "--dry-run"]) == 2
     assert "not a valid TOML recipe" in capsys.readouterr().err

@@ -31,10 +31,10 @@ from .asf import read_asf, write_asf
 from .bvh import read_bvh, write_bvh
 from .combine import combine
 from .convert import to_asf, to_bvh
-from .scene import Scene, Track, read_recipe
 from .export import write_positions
 from .interpolate import Pipeline, interpolate
 from .motion import DEFAULT_FRAME_RATE, Motion
+from .scene import Scene, Track, read_recipe
 from .skeleton import Bone, Root, Skeleton
 
 __all__ = [
@@ -47,27 +47,27 @@ __all__ = [
     "MissingError",
     "Motion",
     "NumberError",
+    "Pipeline",
     "Root",
+    "Scene",
     "SequenceError",
     "Skeleton",
+    "Track",
     "TruncatedError",
     "UnknownNameError",
     "__version__",
     "binomial_filter1d",
     "combine",
     "interpolate",
-    "Pipeline",
-    "Scene",
-    "Track",
-    "read_recipe",
-    "to_asf",
-    "to_bvh",
     "median_filter1d",
     "pascal_weights",
     "read_amc",
     "read_asf",
     "read_bvh",
+    "read_recipe",
     "skeleton_path_for",
+    "to_asf",
+    "to_bvh",
     "uniform_filter1d",
     "write_amc",
     "write_asf",

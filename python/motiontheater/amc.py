@@ -27,7 +27,7 @@ def skeleton_path_for(amc_path: str | os.PathLike) -> Path:
         if asf.suffix.lower() != ".asf":
             continue
         stem = asf.stem.split("-")[0]
-        rest = amc.stem[len(stem):]
+        rest = amc.stem[len(stem) :]
         if amc.stem.startswith(stem) and (rest == "" or rest[0] in "_-."):
             if best is None or len(stem) > len(best.stem.split("-")[0]):
                 best = asf
@@ -38,8 +38,11 @@ def skeleton_path_for(amc_path: str | os.PathLike) -> Path:
 
 def _layout(skeleton: Skeleton, joints) -> tuple[list[bytes], list[int], list[int]]:
     """Keys, first columns and channel counts of the given joints in the canonical layout."""
-    return ([encode(j) for j in joints], [skeleton.first_column(j) for j in joints],
-            [len(skeleton.dofs(j)) for j in joints])
+    return (
+        [encode(j) for j in joints],
+        [skeleton.first_column(j) for j in joints],
+        [len(skeleton.dofs(j)) for j in joints],
+    )
 
 
 def _split_header(data: bytes) -> tuple[list[tuple[int, str]], int, int]:
@@ -55,7 +58,7 @@ def _split_header(data: bytes) -> tuple[list[tuple[int, str]], int, int]:
         lines += 1
         if line:
             header.append((lines, decode(line)))
-        pos = end + (2 if data[end:end + 2] == b"\r\n" else 1)
+        pos = end + (2 if data[end : end + 2] == b"\r\n" else 1)
     return header, pos, lines
 
 
@@ -70,8 +73,9 @@ def _header_rate(header: list[tuple[int, str]]) -> float | None:
     return None
 
 
-def read_amc(source: Source, skeleton: Skeleton, frame_rate: float | None = None, *,
-             workers: int | None = None) -> Motion:
+def read_amc(
+    source: Source, skeleton: Skeleton, frame_rate: float | None = None, *, workers: int | None = None
+) -> Motion:
     """Read an AMC file (path or file object) of ``skeleton`` into a :class:`Motion`.
 
     Bones may come in any order within a frame (and in another order than
@@ -90,8 +94,9 @@ def read_amc(source: Source, skeleton: Skeleton, frame_rate: float | None = None
         return _read(data, name, skeleton, frame_rate, workers)
 
 
-def _read_header(data: bytes, name: str | None, skeleton: Skeleton,
-                 frame_rate: float | None) -> tuple[list[tuple[int, str]], int, int, float]:
+def _read_header(
+    data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None
+) -> tuple[list[tuple[int, str]], int, int, float]:
     """The header lines as :func:`_split_header` gives them, where the frames
     begin, the lines before them, and the frame rate (the header's, else
     ``frame_rate``, else the default), checked against the skeleton."""
@@ -106,14 +111,14 @@ def _read_header(data: bytes, name: str | None, skeleton: Skeleton,
     return header, body, header_lines, rate or frame_rate or DEFAULT_FRAME_RATE
 
 
-def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None,
-          workers: int | None) -> Motion:
+def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None, workers: int | None) -> Motion:
     header, body, header_lines, rate = _read_header(data, name, skeleton, frame_rate)
     joints = skeleton.joint_names
     keys, offsets, counts = _layout(skeleton, joints)
     try:
-        values, first = scan_frames(data, keys, offsets, counts, len(skeleton.channels),
-                                    start=body, noun="bone", workers=workers)
+        values, first = scan_frames(
+            data, keys, offsets, counts, len(skeleton.channels), start=body, noun="bone", workers=workers
+        )
     except FormatError as e:
         raise e.at(name, header_lines) from None
     values.flags.writeable = False
@@ -141,7 +146,7 @@ _NEXT_FRAME_LINE = re.compile(rb"[\r\n][ \t]*\d+[ \t]*(?=[\r\n]|$)")
 def _first_frame_order(data: bytes, body: int, joints: set[str]) -> tuple[str, ...]:
     """The bone lines of the first frame, in order."""
     following = _NEXT_FRAME_LINE.search(data, body + 1)
-    block = data[body:following.start() if following else len(data)]
+    block = data[body : following.start() if following else len(data)]
     order = []
     for line in re.split(rb"\r\n|\r|\n", block)[1:]:
         words = line.split(None, 1)
@@ -183,4 +188,3 @@ def _header_lines(motion: Motion) -> list[str]:
     if not rate_written and motion.frame_rate != DEFAULT_FRAME_RATE:
         lines.append(f":SAMPLES-PER-SECOND {format_number(motion.frame_rate)}")
     return lines
-

@@ -82,7 +82,7 @@ def _parse(lines: _Lines) -> Skeleton:
         keyword = tokens[0].lower()
         if not keyword.startswith(":"):
             raise FormatError(f"expected a section such as :root or :bonedata, found '{text[:40]}'", number)
-        rest = text[len(tokens[0]):].strip()
+        rest = text[len(tokens[0]) :].strip()
         if keyword == ":version":
             fields["version"] = rest
         elif keyword == ":name":
@@ -124,8 +124,13 @@ def _parse(lines: _Lines) -> Skeleton:
             raise DuplicateError(f"bone '{bone.name}' is defined twice (first at line {first_line[bone.name]})", line)
         first_line[bone.name] = line
     try:
-        return Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs), root=root,
-                        sections=tuple(sections), **fields)
+        return Skeleton(
+            bones=tuple(bones),
+            hierarchy=canonical_hierarchy(tuple(bones), pairs),
+            root=root,
+            sections=tuple(sections),
+            **fields,
+        )
     except FormatError as e:
         e.line = e.line or hierarchy_line
         raise
@@ -198,7 +203,7 @@ def _parse_bone(lines: _Lines, begin: int) -> tuple[Bone, int]:
                 raise FormatError(f"dof takes distinct channels of {' '.join(BONE_DOFS)}, found '{' '.join(args)}'", n)
             values["dofs"] = dofs
         elif key == "limits":
-            limit_text, limit_line = text[len(toks[0]):], n
+            limit_text, limit_line = text[len(toks[0]) :], n
             while lines.more_in_section() and lines.items[lines.pos][1].startswith("("):
                 limit_text += " " + lines.next()[1]
         else:
@@ -208,10 +213,12 @@ def _parse_bone(lines: _Lines, begin: int) -> tuple[Bone, int]:
     if limit_text is not None:
         found = _LIMIT.findall(limit_text)
         if len(found) != len(values.get("dofs", ())):
-            raise CountError(f"bone '{values['name']}' has {len(values.get('dofs', ()))} dofs "
-                             f"but {len(found)} limits", limit_line)
-        values["limits"] = tuple((_number(lo, limit_line, "a limit"), _number(hi, limit_line, "a limit"))
-                                 for lo, hi in found)
+            raise CountError(
+                f"bone '{values['name']}' has {len(values.get('dofs', ()))} dofs but {len(found)} limits", limit_line
+            )
+        values["limits"] = tuple(
+            (_number(lo, limit_line, "a limit"), _number(hi, limit_line, "a limit")) for lo, hi in found
+        )
     return Bone(extra=tuple(extra), **values), name_line
 
 
@@ -280,5 +287,3 @@ def _asf_lines(s: Skeleton):
     for keyword, body in s.sections:
         yield keyword
         yield from (f"  {line}" for line in body)
-
-

@@ -29,8 +29,16 @@ from mtcore import format_frames, scan_frames
 from mtcore.errors import FormatError, SequenceError
 
 from ._io import PARTIAL_PREFIX, encode, output
-from .amc import (_first_frame_order, _header_lines, _layout, _read_header, _write_order, read_amc, skeleton_path_for,
-                  write_amc)
+from .amc import (
+    _first_frame_order,
+    _header_lines,
+    _layout,
+    _read_header,
+    _write_order,
+    read_amc,
+    skeleton_path_for,
+    write_amc,
+)
 from .asf import read_asf
 from .bvh import read_bvh, write_bvh
 from .filtering import Smoother, TakeStats
@@ -52,8 +60,9 @@ class Recipe:
     mode: str = "nearest"
 
     def smoother(self, skeleton, workers: int | None = 1) -> Smoother:
-        return Smoother(skeleton, self.kind, self.size, self.joints, translation=self.translation, mode=self.mode,
-                        workers=workers)
+        return Smoother(
+            skeleton, self.kind, self.size, self.joints, translation=self.translation, mode=self.mode, workers=workers
+        )
 
 
 @dataclass(frozen=True)
@@ -106,9 +115,17 @@ def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
     return list(found.items())
 
 
-def plan_jobs(inputs: Iterable[str], out: str | os.PathLike, recipe: Recipe, *, skeleton: str | None = None,
-              frame_rate: float | None = None, resume: bool = False, stream_above: int = STREAM_ABOVE,
-              chunk_frames: int = CHUNK_FRAMES) -> tuple[list[Job], list[Result]]:
+def plan_jobs(
+    inputs: Iterable[str],
+    out: str | os.PathLike,
+    recipe: Recipe,
+    *,
+    skeleton: str | None = None,
+    frame_rate: float | None = None,
+    resume: bool = False,
+    stream_above: int = STREAM_ABOVE,
+    chunk_frames: int = CHUNK_FRAMES,
+) -> tuple[list[Job], list[Result]]:
     """The jobs to run, and the takes skipped or failed before running (no skeleton, already done)."""
     jobs, settled = [], []
     for take, relative in find_takes(inputs):
@@ -122,8 +139,9 @@ def plan_jobs(inputs: Iterable[str], out: str | os.PathLike, recipe: Recipe, *, 
         if resume and target.exists() and target.stat().st_mtime >= inputs_time:
             settled.append(Result(str(take), str(target), skipped=True, bytes=take.stat().st_size))
             continue
-        jobs.append(Job(str(take), str(target), str(asf) if asf else "", recipe, frame_rate, stream_above,
-                        chunk_frames))
+        jobs.append(
+            Job(str(take), str(target), str(asf) if asf else "", recipe, frame_rate, stream_above, chunk_frames)
+        )
     return jobs, settled
 
 
@@ -142,8 +160,7 @@ def run_job(job: Job) -> Result:
         skeleton = _skeleton(job.skeleton, *_stamp(job.skeleton))
         _copy_skeleton(job.skeleton, os.path.dirname(job.output))
         if result.bytes > job.stream_above:
-            result.frames = stream_filter(job.input, job.output, skeleton, job.recipe, job.frame_rate,
-                                          job.chunk_frames)
+            result.frames = stream_filter(job.input, job.output, skeleton, job.recipe, job.frame_rate, job.chunk_frames)
             result.streamed = True
         else:
             motion = read_amc(job.input, skeleton, job.frame_rate, workers=1)
@@ -156,8 +173,9 @@ def run_job(job: Job) -> Result:
 
 
 def _smooth(motion: Motion, recipe: Recipe) -> Motion:
-    return motion.filter(recipe.kind, recipe.size, recipe.joints, translation=recipe.translation, mode=recipe.mode,
-                         workers=1)
+    return motion.filter(
+        recipe.kind, recipe.size, recipe.joints, translation=recipe.translation, mode=recipe.mode, workers=1
+    )
 
 
 def _stamp(path: str) -> tuple[int, int]:
@@ -207,8 +225,9 @@ def _frames_of(path: str, skeleton, keys, offsets, counts, frame_rate):
                 else:
                     piece, pending = text, b""
                 try:
-                    values, first = scan_frames(piece, keys, offsets, counts, len(skeleton.channels), noun="bone",
-                                                workers=1)
+                    values, first = scan_frames(
+                        piece, keys, offsets, counts, len(skeleton.channels), noun="bone", workers=1
+                    )
                 except FormatError as e:
                     raise e.at(path, lines_done) from None
                 if len(values):
@@ -231,8 +250,9 @@ def _last_frame_start(text: bytes, limit: int) -> int:
     return 0
 
 
-def stream_filter(path: str, target: str, skeleton, recipe: Recipe, frame_rate: float | None = None,
-                  chunk_frames: int = CHUNK_FRAMES) -> int:
+def stream_filter(
+    path: str, target: str, skeleton, recipe: Recipe, frame_rate: float | None = None, chunk_frames: int = CHUNK_FRAMES
+) -> int:
     """Filter a take of any length in chunks of frames; the same bytes as filtering it whole.
 
     Two passes over the file: the first gathers what smoothing needs of the
@@ -248,15 +268,22 @@ def stream_filter(path: str, target: str, skeleton, recipe: Recipe, frame_rate: 
         if first_frame is None:
             first_frame = first
         elif first != first_frame + frames:
-            raise SequenceError(f"frame number {first} out of sequence: expected {first_frame + frames}",
-                                lines + 1, path)
+            raise SequenceError(
+                f"frame number {first} out of sequence: expected {first_frame + frames}", lines + 1, path
+            )
         if stats is None:
             stats = TakeStats.of(values)
         else:
             stats.update(values)
         frames += len(values)
-    header_motion = Motion(skeleton, np.zeros((0, len(skeleton.channels))), rate, first_frame or 1,
-                           tuple(text for _, text in header), order)
+    header_motion = Motion(
+        skeleton,
+        np.zeros((0, len(skeleton.channels))),
+        rate,
+        first_frame or 1,
+        tuple(text for _, text in header),
+        order,
+    )
     write_keys, write_offsets, write_counts = _layout(skeleton, _write_order(skeleton, order))
     block = smoother.block
     chunk = max(block, chunk_frames // block * block)
@@ -271,10 +298,10 @@ def stream_filter(path: str, target: str, skeleton, recipe: Recipe, frame_rate: 
         current = next(unwrapped)
         start = 0
         for following in itertools.chain(unwrapped, [None]):  # one chunk of lookahead, no more
-            after = following[:smoother.halo] if following is not None else tail[:0]
-            buffer = np.concatenate([tail[len(tail) - min(lead, start):], current, after])
+            after = following[: smoother.halo] if following is not None else tail[:0]
+            buffer = np.concatenate([tail[len(tail) - min(lead, start) :], current, after])
             before = min(lead, start)
-            smoothed = smoother.smooth(buffer, stats)[before:before + len(current)]
+            smoothed = smoother.smooth(buffer, stats)[before : before + len(current)]
             format_frames(smoothed, first_frame + start, write_keys, write_offsets, write_counts, f.write)
             tail = np.concatenate([tail, current])[-lead:] if lead else tail
             start += len(current)
@@ -320,9 +347,11 @@ class Progress:
         eta = (self.total - self.done_bytes) / rate if rate else 0
         width = 24
         filled = int(width * self.done_bytes / max(self.total, 1))
-        sys.stderr.write(f"\r[{'=' * filled}{' ' * (width - filled)}] {self.done_files}/{self.files} files, "
-                         f"{self.done_bytes / 1e6:.1f}/{self.total / 1e6:.1f} MB, {rate / 1e6:.1f} MB/s, "
-                         f"ETA {eta:.0f} s ")
+        sys.stderr.write(
+            f"\r[{'=' * filled}{' ' * (width - filled)}] {self.done_files}/{self.files} files, "
+            f"{self.done_bytes / 1e6:.1f}/{self.total / 1e6:.1f} MB, {rate / 1e6:.1f} MB/s, "
+            f"ETA {eta:.0f} s "
+        )
         sys.stderr.flush()
 
     def close(self) -> None:
@@ -343,20 +372,28 @@ class Summary:
         done = [r for r in self.results if r.ok and not r.skipped]
         processed = sum(r.bytes for r in done)
         return {
-            "files": len(self.results), "processed": len(done), "skipped": sum(r.skipped for r in self.results),
-            "failed": len(self.failed), "streamed": sum(r.streamed for r in self.results),
-            "megabytes": processed / 1e6, "seconds": self.seconds,
+            "files": len(self.results),
+            "processed": len(done),
+            "skipped": sum(r.skipped for r in self.results),
+            "failed": len(self.failed),
+            "streamed": sum(r.streamed for r in self.results),
+            "megabytes": processed / 1e6,
+            "seconds": self.seconds,
             "megabytes_per_second": processed / 1e6 / self.seconds if self.seconds else 0.0,
             "failures": [{"file": r.input, "error": r.error} for r in self.failed],
         }
 
     def text(self) -> str:
         d = self.as_dict()
-        lines = [f"{d['processed']} processed, {d['skipped']} skipped (already done), {d['failed']} failed "
-                 f"of {d['files']} takes; {d['megabytes']:.1f} MB in {d['seconds']:.1f} s "
-                 f"({d['megabytes_per_second']:.1f} MB/s)"]
-        lines += [f"FAILED {f['error']}" if f['file'] in f['error'] else f"FAILED {f['file']}: {f['error']}"
-                  for f in d["failures"]]
+        lines = [
+            f"{d['processed']} processed, {d['skipped']} skipped (already done), {d['failed']} failed "
+            f"of {d['files']} takes; {d['megabytes']:.1f} MB in {d['seconds']:.1f} s "
+            f"({d['megabytes_per_second']:.1f} MB/s)"
+        ]
+        lines += [
+            f"FAILED {f['error']}" if f["file"] in f["error"] else f"FAILED {f['file']}: {f['error']}"
+            for f in d["failures"]
+        ]
         return "\n".join(lines)
 
 
@@ -369,8 +406,16 @@ def remove_partials(folder: str | os.PathLike) -> int:
     return removed
 
 
-def run(jobs: list[Job], settled: list[Result], *, workers: int = 0, scheduler: str | None = None,
-        dask_local: bool = False, progress: Progress | None = None, out: str | os.PathLike = ".") -> Summary:
+def run(
+    jobs: list[Job],
+    settled: list[Result],
+    *,
+    workers: int = 0,
+    scheduler: str | None = None,
+    dask_local: bool = False,
+    progress: Progress | None = None,
+    out: str | os.PathLike = ".",
+) -> Summary:
     """Run the jobs on local processes (``workers``, 0 for every core), a Dask cluster at
     ``scheduler``, or a local Dask cluster; the summary lists every take's result."""
     summary = Summary(list(settled))
@@ -423,8 +468,13 @@ def _run_dask(jobs: list[Job], workers: int, scheduler: str | None):
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError:
         raise RuntimeError('Dask is not installed: pip install "motiontheater[dask]"') from None
-    cluster = None if scheduler else LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                                                  processes=True, dashboard_address=None)
+    cluster = (
+        None
+        if scheduler
+        else LocalCluster(
+            n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True, dashboard_address=None
+        )
+    )
     client = Client(scheduler or cluster)
     try:
         futures = client.map(run_job, jobs, pure=False)

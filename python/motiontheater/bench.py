@@ -66,8 +66,12 @@ def peers() -> dict[str, Callable | None]:
         bn = importlib.import_module("bottleneck")
         # Trailing windows with partial edges: a speed peer, not the same result.
         found["bottleneck"] = lambda kind, x, size: (
-            bn.move_median(x, size, axis=0, min_count=1) if kind == "median"
-            else bn.move_mean(x, size, axis=0, min_count=1) if kind == "mean" else None)
+            bn.move_median(x, size, axis=0, min_count=1)
+            if kind == "median"
+            else bn.move_mean(x, size, axis=0, min_count=1)
+            if kind == "mean"
+            else None
+        )
     except ImportError:
         found["bottleneck"] = None
     return found
@@ -86,11 +90,16 @@ def best_time(fn: Callable[[], object], repeat: int) -> float:
 def scene_from_take(motion) -> np.ndarray:
     """The thesis-like scene from a real take: its first 267 frames, rotation channels only."""
     columns = [i for i, (_, dof) in enumerate(motion.channels) if dof.startswith("r")]
-    return np.ascontiguousarray(motion.values[:THESIS_SCENE[0], columns])
+    return np.ascontiguousarray(motion.values[: THESIS_SCENE[0], columns])
 
 
-def measure(scene: np.ndarray | None = None, source: str = "synthetic", hour_frames: int = HOUR[0],
-            sizes=(3, 5, 7), repeat: int = 5) -> dict:
+def measure(
+    scene: np.ndarray | None = None,
+    source: str = "synthetic",
+    hour_frames: int = HOUR[0],
+    sizes=(3, 5, 7),
+    repeat: int = 5,
+) -> dict:
     """Time every filter on the scene and on a long capture; returns a JSON-ready report."""
     if scene is None:
         scene = noisy_rotations(seconds=THESIS_SCENE[0] / 120, channels=THESIS_SCENE[1])[1]
@@ -101,11 +110,18 @@ def measure(scene: np.ndarray | None = None, source: str = "synthetic", hour_fra
         for size in sizes:
             fresh = best_time(lambda: OURS[kind](scene, size, axis=0, mode="nearest"), repeat * 20)
             slow_repeat = max(1, repeat // 2)
-            row = {"filter": kind, "size": size, "mtcore": fresh,
-                   "python": best_time(lambda: python_filter(kind, rows_of_scene, size), slow_repeat)}
+            row = {
+                "filter": kind,
+                "size": size,
+                "mtcore": fresh,
+                "python": best_time(lambda: python_filter(kind, rows_of_scene, size), slow_repeat),
+            }
             for name, peer in available.items():
-                row[name] = None if peer is None or peer(kind, scene, size) is None else best_time(
-                    lambda: peer(kind, scene, size), repeat * 4)
+                row[name] = (
+                    None
+                    if peer is None or peer(kind, scene, size) is None
+                    else best_time(lambda: peer(kind, scene, size), repeat * 4)
+                )
             row["mel_2004"], row["cpp_2004"] = THESIS_2004[kind] if size == 3 else (None, None)
             scene_rows.append(row)
 
@@ -116,12 +132,18 @@ def measure(scene: np.ndarray | None = None, source: str = "synthetic", hour_fra
     hour_rows = []
     for kind in KINDS:
         for size in sizes:
-            row = {"filter": kind, "size": size,
-                   "mtcore": best_time(lambda: OURS[kind](hour, size, axis=0, mode="nearest"), repeat),
-                   "mtcore_output": best_time(lambda: OURS[kind](hour, size, 0, out, mode="nearest"), repeat)}
+            row = {
+                "filter": kind,
+                "size": size,
+                "mtcore": best_time(lambda: OURS[kind](hour, size, axis=0, mode="nearest"), repeat),
+                "mtcore_output": best_time(lambda: OURS[kind](hour, size, 0, out, mode="nearest"), repeat),
+            }
             for name, peer in available.items():
-                row[name] = None if peer is None or peer(kind, hour[:10], size) is None else best_time(
-                    lambda: peer(kind, hour, size), max(2, repeat // 2))
+                row[name] = (
+                    None
+                    if peer is None or peer(kind, hour[:10], size) is None
+                    else best_time(lambda: peer(kind, hour, size), max(2, repeat // 2))
+                )
             hour_rows.append(row)
     return {
         "scene": {"source": source, "shape": list(scene.shape), "rows": scene_rows},
@@ -158,7 +180,8 @@ def markdown(report: dict) -> str:
             f"| {r['filter']} | {r['size']} | {_t(r['mel_2004'])} | {_t(r['cpp_2004'])} | "
             f"{_x(r['mel_2004'], r['cpp_2004'])} | {_t(r['mtcore'])} | {_t(r['python'])} | "
             f"{_x(r['python'], r['mtcore'])} | {_t(r.get('scipy'))} | {_x(r.get('scipy'), r['mtcore'])} | "
-            f"{_t(r.get('bottleneck'))} | {_x(r.get('bottleneck'), r['mtcore'])} |")
+            f"{_t(r.get('bottleneck'))} | {_x(r.get('bottleneck'), r['mtcore'])} |"
+        )
     frames, channels = hour["shape"]
     lines += [
         "",
@@ -174,11 +197,11 @@ def markdown(report: dict) -> str:
         lines.append(
             f"| {r['filter']} | {r['size']} | {_t(r['mtcore'])} | {values / r['mtcore'] / 1e6:,.0f} | "
             f"{hour['copyto'] / r['mtcore_output']:.0%} | {hour['copy'] / r['mtcore']:.0%} | {_t(r.get('scipy'))} | "
-            f"{_x(r.get('scipy'), r['mtcore'])} | {_t(r.get('bottleneck'))} | {_x(r.get('bottleneck'), r['mtcore'])} |")
+            f"{_x(r.get('scipy'), r['mtcore'])} | {_t(r.get('bottleneck'))} | {_x(r.get('bottleneck'), r['mtcore'])} |"
+        )
     missing = [name for name, present in report["peers"].items() if not present]
     if missing:
-        lines += ["", f"Not installed, so not measured: {', '.join(missing)} "
-                      "(pip install \"motiontheater[bench]\")."]
+        lines += ["", f'Not installed, so not measured: {", ".join(missing)} (pip install "motiontheater[bench]").']
     return "\n".join(lines)
 
 

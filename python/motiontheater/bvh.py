@@ -21,8 +21,14 @@ from ._io import LINE_BREAK, Source, decode, encode, output, read_source
 from .motion import Motion
 from .skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem
 
-CHANNELS = {"xposition": "tx", "yposition": "ty", "zposition": "tz",
-            "xrotation": "rx", "yrotation": "ry", "zrotation": "rz"}
+CHANNELS = {
+    "xposition": "tx",
+    "yposition": "ty",
+    "zposition": "tz",
+    "xrotation": "rx",
+    "yrotation": "ry",
+    "zrotation": "rz",
+}
 NAMES = {dof: name.capitalize() for name, dof in CHANNELS.items()}
 _FRAMES = re.compile(rb"^[ \t]*Frames[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECASE | re.MULTILINE)
 _FRAME_TIME = re.compile(rb"^[ \t]*Frame[ \t]+Time[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECASE | re.MULTILINE)
@@ -48,7 +54,7 @@ def _read(data) -> Motion:
     motion_at = re.search(rb"^[ \t]*MOTION[ \t]*\r?$", data, re.MULTILINE)
     if motion_at is None:
         raise MissingError("no MOTION section", data.count(b"\n") + 1)
-    head = decode(data[:motion_at.start()])
+    head = decode(data[: motion_at.start()])
     lines = [(n, line.strip()) for n, line in enumerate(LINE_BREAK.split(head), start=1) if line.strip()]
     skeleton = _hierarchy(lines)
     motion_line = data.count(b"\n", 0, motion_at.start()) + 1
@@ -62,8 +68,9 @@ def _read(data) -> Motion:
     except ValueError:
         raise FormatError("expected a whole number of frames and a frame time in seconds", motion_line + 1) from None
     if frames < 0 or not frame_time > 0:
-        raise FormatError(f"expected frames >= 0 and a positive frame time, got {frames} and {frame_time}",
-                          motion_line + 1)
+        raise FormatError(
+            f"expected frames >= 0 and a positive frame time, got {frames} and {frame_time}", motion_line + 1
+        )
     start = max(frames_match.end(), time_match.end())
     start = data.find(b"\n", start) + 1 if data.find(b"\n", start) != -1 else len(data)
     lines_before = data.count(b"\n", 0, start)
@@ -72,8 +79,14 @@ def _read(data) -> Motion:
     except FormatError as e:
         raise e.at(None, lines_before) from None
     values.flags.writeable = False
-    return Motion(skeleton, values, frame_rate=1.0 / frame_time, first_frame=1,
-                  header=(f"Frame Time: {decode(time_match.group(1))}",), line_order=None)
+    return Motion(
+        skeleton,
+        values,
+        frame_rate=1.0 / frame_time,
+        first_frame=1,
+        header=(f"Frame Time: {decode(time_match.group(1))}",),
+        line_order=None,
+    )
 
 
 def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
@@ -128,8 +141,11 @@ def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
                 raise CountError(f"CHANNELS says {count} but names {len(names)}", number)
             unknown = [n for n in names if n.lower() not in CHANNELS]
             if unknown or len({n.lower() for n in names}) != len(names):
-                raise FormatError(f"unknown or repeated channel '{(unknown or names)[0]}'; expected "
-                                  "Xposition Yposition Zposition Xrotation Yrotation Zrotation", number)
+                raise FormatError(
+                    f"unknown or repeated channel '{(unknown or names)[0]}'; expected "
+                    "Xposition Yposition Zposition Xrotation Yrotation Zrotation",
+                    number,
+                )
             stack[-1]["channels"] = tuple(CHANNELS[n.lower()] for n in names)
         elif key == "}":
             if not stack:
@@ -140,12 +156,17 @@ def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
             if not stack:
                 root = Root(order=joint["channels"], axis="XYZ", position=joint["offset"], name=joint["name"])
             else:
-                bones.append(Bone(name=joint["name"], direction=joint["offset"],
-                                  length=float(np.linalg.norm(joint["offset"])), dofs=joint["channels"],
-                                  end_site=joint["end"]))
+                bones.append(
+                    Bone(
+                        name=joint["name"],
+                        direction=joint["offset"],
+                        length=float(np.linalg.norm(joint["offset"])),
+                        dofs=joint["channels"],
+                        end_site=joint["end"],
+                    )
+                )
         else:
-            raise FormatError(f"expected ROOT, JOINT, End Site, OFFSET, CHANNELS or '}}', found '{text[:40]}'",
-                              number)
+            raise FormatError(f"expected ROOT, JOINT, End Site, OFFSET, CHANNELS or '}}', found '{text[:40]}'", number)
     if stack:
         raise TruncatedError(f"joint '{stack[-1]['name']}' is not closed with '}}' before MOTION", lines[-1][0])
     if root is None:
@@ -153,8 +174,13 @@ def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
     # bones were appended as their blocks closed; the file's order is the order they opened
     opened = {child: i for i, child in enumerate(child for _, children in pairs for child in children)}
     bones.sort(key=lambda b: opened[b.name])
-    return Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs), root=root,
-                    units=(("angle", "deg"),), convention="bvh")
+    return Skeleton(
+        bones=tuple(bones),
+        hierarchy=canonical_hierarchy(tuple(bones), pairs),
+        root=root,
+        units=(("angle", "deg"),),
+        convention="bvh",
+    )
 
 
 def _expect_brace(lines, pos: int, number: int) -> int:
@@ -190,8 +216,12 @@ def write_bvh(motion: Motion, target: Source) -> None:
         if bone is not None and bone.end_site:
             lines.extend([f"{pad}End Site", f"{pad}{{"])
         else:
-            lines.extend([f"{pad}{'ROOT' if bone is None else 'JOINT'} {skeleton.root.name if bone is None else name}",
-                          f"{pad}{{"])
+            lines.extend(
+                [
+                    f"{pad}{'ROOT' if bone is None else 'JOINT'} {skeleton.root.name if bone is None else name}",
+                    f"{pad}{{",
+                ]
+            )
         offset = skeleton.root.position if bone is None else bone.direction
         lines.append(f"{pad}\tOFFSET {' '.join(format_number(v) for v in offset)}")
         dofs = skeleton.dofs(name)

@@ -53,8 +53,9 @@ def _positions(args: argparse.Namespace) -> int:
     motion = read_amc(args.motion, read_asf(args.skeleton), frame_rate=args.frame_rate)
     written = write_positions(motion, args.output, meters=args.meters, format=args.format)
     unit = "metres" if args.meters else "file units"
-    print(f"wrote {motion.frames} frames x {len(motion.skeleton.joint_names)} joints ({unit}, {written}) "
-          f"to {args.output}")
+    print(
+        f"wrote {motion.frames} frames x {len(motion.skeleton.joint_names)} joints ({unit}, {written}) to {args.output}"
+    )
     return 0
 
 
@@ -67,8 +68,11 @@ def _chosen_filter(args: argparse.Namespace) -> tuple[str, int]:
 
 def _filter_options(parser: argparse.ArgumentParser) -> None:
     """The filter flags shared by filter and batch."""
-    for kind, what in (("median", "moving median"), ("mean", "moving average"),
-                       ("binomial", "Pascal-weighted average (1 2 1 / 4 for 3)")):
+    for kind, what in (
+        ("median", "moving median"),
+        ("mean", "moving average"),
+        ("binomial", "Pascal-weighted average (1 2 1 / 4 for 3)"),
+    ):
         parser.add_argument(f"--{kind}", type=int, metavar="N", help=f"{what} over N frames (odd)")
     parser.add_argument("--asf", help="the skeleton (default: the ASF beside each take, by the CMU/HDM05 naming)")
     parser.add_argument("--joints", help="comma-separated joints to smooth (default: all)")
@@ -81,16 +85,31 @@ def _batch(args: argparse.Namespace) -> int:
     from . import batch
 
     kind, size = _chosen_filter(args)
-    recipe = batch.Recipe(kind, size, tuple(args.joints.split(",")) if args.joints else None,
-                          not args.no_translation, args.mode)
+    recipe = batch.Recipe(
+        kind, size, tuple(args.joints.split(",")) if args.joints else None, not args.no_translation, args.mode
+    )
     recipe.smoother(read_asf(args.asf)) if args.asf else None  # bad joints fail before any work
-    jobs, settled = batch.plan_jobs(args.inputs, args.output, recipe, skeleton=args.asf,
-                                    frame_rate=args.frame_rate, resume=args.resume,
-                                    stream_above=int(args.stream_above * 1e6))
-    progress = batch.Progress(len(jobs), sum(os.path.getsize(j.input) for j in jobs),
-                              enabled=False if args.quiet or args.json else None)
-    summary = batch.run(jobs, settled, workers=args.jobs, scheduler=args.scheduler, dask_local=args.dask,
-                        progress=progress, out=args.output)
+    jobs, settled = batch.plan_jobs(
+        args.inputs,
+        args.output,
+        recipe,
+        skeleton=args.asf,
+        frame_rate=args.frame_rate,
+        resume=args.resume,
+        stream_above=int(args.stream_above * 1e6),
+    )
+    progress = batch.Progress(
+        len(jobs), sum(os.path.getsize(j.input) for j in jobs), enabled=False if args.quiet or args.json else None
+    )
+    summary = batch.run(
+        jobs,
+        settled,
+        workers=args.jobs,
+        scheduler=args.scheduler,
+        dask_local=args.dask,
+        progress=progress,
+        out=args.output,
+    )
     if args.json:
         print(batch.report_json(summary))
     elif not args.quiet or summary.failed:
@@ -147,8 +166,9 @@ def _bench(args: argparse.Namespace) -> int:
         take = read_amc(args.amc, read_asf(args.asf or skeleton_path_for(args.amc)))
         scene = bench.scene_from_take(take)
         source = f"first {scene.shape[0]} frames of {args.amc}, rotation channels"
-    report = bench.measure(scene, source, hour_frames=bench.HOUR[0] // (20 if args.quick else 1),
-                           repeat=2 if args.quick else 5)
+    report = bench.measure(
+        scene, source, hour_frames=bench.HOUR[0] // (20 if args.quick else 1), repeat=2 if args.quick else 5
+    )
     print(bench.as_json(report) if args.json else bench.markdown(report))
     return 0
 
@@ -166,8 +186,10 @@ def _combine(args: argparse.Namespace) -> int:
         raise ValueError("give -o OUT.amc (or --dry-run)")
     result = scene.render()
     write_amc(result, args.output)
-    print(f"{len(scene.tracks)} track(s) over {scene.base.frames} frames: wrote {result.frames} frames "
-          f"({result.first_frame}..{result.first_frame + result.frames - 1}) to {args.output}")
+    print(
+        f"{len(scene.tracks)} track(s) over {scene.base.frames} frames: wrote {result.frames} frames "
+        f"({result.first_frame}..{result.first_frame + result.frames - 1}) to {args.output}"
+    )
     return 0
 
 
@@ -252,8 +274,13 @@ def build_parser() -> argparse.ArgumentParser:
     many.add_argument("--json", action="store_true", help="print a JSON summary")
     many.add_argument("--dask", action="store_true", help="run on a local Dask cluster of --jobs workers")
     many.add_argument("--scheduler", help="run on the Dask cluster at this address (tcp://HOST:PORT)")
-    many.add_argument("--stream-above", type=float, default=256.0, metavar="MB",
-                      help="stream takes larger than this many MB in chunks (default 256)")
+    many.add_argument(
+        "--stream-above",
+        type=float,
+        default=256.0,
+        metavar="MB",
+        help="stream takes larger than this many MB in chunks (default 256)",
+    )
     many.set_defaults(run=_batch)
 
     conversion = verbs.add_parser(

@@ -75,16 +75,25 @@ class Plan:
 
     def describe(self) -> str:
         """The frame map and borders in words (``motiontheater combine --dry-run``)."""
-        lines = [f"output frames {self.frames[0]}..{self.frames[-1]}" if len(self.frames) else "no output frames",
-                 f"piece {self.piece[0]}..{self.piece[1]} from source frames {self.source[0]}..{self.source[1]}"]
+        lines = [
+            f"output frames {self.frames[0]}..{self.frames[-1]}" if len(self.frames) else "no output frames",
+            f"piece {self.piece[0]}..{self.piece[1]} from source frames {self.source[0]}..{self.source[1]}",
+        ]
         for b in self.borders:
             window = b.window
-            lines.append(f"{b.side} border at {b.frame}: " + (
-                f"blend {window[0]}..{window[1]} (depth {b.left} + {b.right}, step 1/{round(1 / b.step)})"
-                if window else "no blend"))
+            lines.append(
+                f"{b.side} border at {b.frame}: "
+                + (
+                    f"blend {window[0]}..{window[1]} (depth {b.left} + {b.right}, step 1/{round(1 / b.step)})"
+                    if window
+                    else "no blend"
+                )
+            )
         if self.gap:
-            lines.append(f"gap {self.gap[0]}..{self.gap[1]}: " + (
-                "smooth transition" if self.blend else "holds the last pose before it"))
+            lines.append(
+                f"gap {self.gap[0]}..{self.gap[1]}: "
+                + ("smooth transition" if self.blend else "holds the last pose before it")
+            )
         if self.preserve:
             lines.append(f"root preserved ({self.preserve})")
         return "\n".join(lines)
@@ -107,8 +116,16 @@ def _pair(value, name: str) -> tuple[int, int] | None:
     return first, last
 
 
-def plan(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserve: str | None = None,
-         discard_old: bool = False, interpolate: bool = False) -> Plan:
+def plan(
+    old: Motion,
+    new: Motion,
+    cut=None,
+    scale=None,
+    blend: int = 0,
+    preserve: str | None = None,
+    discard_old: bool = False,
+    interpolate: bool = False,
+) -> Plan:
     """The frame map of :func:`combine` (see there for the arguments)."""
     if new.skeleton.channels != old.skeleton.channels:
         raise ValueError("new: a motion of another skeleton (its channels differ from the old motion's)")
@@ -126,8 +143,9 @@ def plan(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserv
     if preserve not in PRESERVE:
         raise ValueError(f"preserve must be one of {PRESERVE}, got {preserve!r}")
     if blend and preserve:
-        warnings.warn("blend and preserve exclude each other: blending is off (blend=0), the root is preserved",
-                      stacklevel=3)
+        warnings.warn(
+            "blend and preserve exclude each other: blending is off (blend=0), the root is preserved", stacklevel=3
+        )
         blend = 0
     old_present = not discard_old and old.frames > 0
 
@@ -146,8 +164,10 @@ def plan(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserv
     if old_present and blend and o1 <= st + 1 <= o2:
         needed = source(st + blend)
         depth = blend if needed <= n2 else _half_up((n2 - ct) * blend, needed - ct)
-        end_depth = (min(blend, st - o1, st - sf - start_depth[1] - 1 if start_depth != (0, 0) else st - sf),
-                     min(depth, o2 - st))
+        end_depth = (
+            min(blend, st - o1, st - sf - start_depth[1] - 1 if start_depth != (0, 0) else st - sf),
+            min(depth, o2 - st),
+        )
         end_depth = (max(end_depth[0], 0), end_depth[1])
     for side, frame, (left, right) in (("start", sf, start_depth), ("end", st, end_depth)):
         if old_present and (o1 <= frame - 1 <= o2 if side == "start" else o1 <= frame + 1 <= o2):
@@ -161,11 +181,15 @@ def plan(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserv
         return frame - first  # output frames are consecutive: index arithmetic, no masks
 
     weight = np.zeros(count)
-    weight[at(sf):at(st) + 1] = 1.0
+    weight[at(sf) : at(st) + 1] = 1.0
     if old_present:  # each output frame's old row, held at the ends: one pass
-        old_row = np.concatenate([np.zeros(max(0, o1 - first), np.int64),
-                                  np.arange(max(0, first - o1), min(old.frames, last - o1 + 1), dtype=np.int64),
-                                  np.full(max(0, last - o2), old.frames - 1, np.int64)])
+        old_row = np.concatenate(
+            [
+                np.zeros(max(0, o1 - first), np.int64),
+                np.arange(max(0, first - o1), min(old.frames, last - o1 + 1), dtype=np.int64),
+                np.full(max(0, last - o2), old.frames - 1, np.int64),
+            ]
+        )
     else:
         old_row = np.full(count, -1, np.int64)
     lo, hi = sf, st  # the frames that read the new motion: piece, blends, gap
@@ -173,12 +197,12 @@ def plan(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserv
     if old_present and sf > o2 + 1:  # the piece after the old motion
         gap, gap_pose = (o2 + 1, sf - 1), sf
         k = np.arange(1, sf - o2)
-        weight[at(gap[0]):at(gap[1]) + 1] = k / (sf - o2) if blend else 0.0
+        weight[at(gap[0]) : at(gap[1]) + 1] = k / (sf - o2) if blend else 0.0
         lo = gap[0] if blend else sf
     elif old_present and st < o1 - 1:  # the piece before the old motion
         gap, gap_pose = (st + 1, o1 - 1), st
         k = np.arange(1, o1 - st)
-        weight[at(gap[0]):at(gap[1]) + 1] = 1.0 - k / (o1 - st) if blend else 1.0
+        weight[at(gap[0]) : at(gap[1]) + 1] = 1.0 - k / (o1 - st) if blend else 1.0
         hi = gap[1]
     blends = [np.arange(at(gap[0]), at(gap[1]) + 1)] if gap and blend else []
     for border in borders:
@@ -186,11 +210,11 @@ def plan(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserv
             continue
         w0, w1 = border.window
         rise = np.arange(1, w1 - w0 + 2) * border.step
-        weight[at(w0):at(w1) + 1] = rise if border.side == "start" else 1.0 - rise
+        weight[at(w0) : at(w1) + 1] = rise if border.side == "start" else 1.0 - rise
         blends.append(np.arange(at(w0), at(w1) + 1))
         lo, hi = min(lo, w0), max(hi, w1)
 
-    x = frames[at(lo):at(hi) + 1] - sf  # source frames of lo..hi, in place: halves up
+    x = frames[at(lo) : at(hi) + 1] - sf  # source frames of lo..hi, in place: halves up
     if st == sf:
         x[:] = cf
     else:
@@ -200,20 +224,31 @@ def plan(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserv
         x += st - sf
         x //= 2 * (st - sf)
     if gap_pose is not None:
-        x[at(max(gap[0], lo)) - at(lo):at(min(gap[1], hi)) - at(lo) + 1] = source(gap_pose)
+        x[at(max(gap[0], lo)) - at(lo) : at(min(gap[1], hi)) - at(lo) + 1] = source(gap_pose)
     new_row = np.full(count, -1, np.int64)
     x -= n1
-    new_row[at(lo):at(hi) + 1] = np.clip(x, 0, new.frames - 1, out=x)
+    new_row[at(lo) : at(hi) + 1] = np.clip(x, 0, new.frames - 1, out=x)
     x += n1
     next_row = ramp = None
     if interpolate and st - sf > ct - cf:
         next_row, ramp = new_row.copy(), np.zeros(count)
         piece = slice(at(sf), at(st) + 1)
         _ramps(new_row[piece], next_row[piece], ramp[piece])
-    return Plan(frames=frames, old_row=old_row, new_row=new_row, next_row=next_row, ramp=ramp, weight=weight,
-                piece=(sf, st), source=(int(x.min()), int(x.max())), borders=tuple(borders), gap=gap,
-                blend=blend, preserve=preserve,
-                blend_rows=np.concatenate(blends) if blends else np.zeros(0, np.int64))
+    return Plan(
+        frames=frames,
+        old_row=old_row,
+        new_row=new_row,
+        next_row=next_row,
+        ramp=ramp,
+        weight=weight,
+        piece=(sf, st),
+        source=(int(x.min()), int(x.max())),
+        borders=tuple(borders),
+        gap=gap,
+        blend=blend,
+        preserve=preserve,
+        blend_rows=np.concatenate(blends) if blends else np.zeros(0, np.int64),
+    )
 
 
 def _ramps(rows: np.ndarray, next_row: np.ndarray, ramp: np.ndarray) -> None:
@@ -230,9 +265,20 @@ def _ramps(rows: np.ndarray, next_row: np.ndarray, ramp: np.ndarray) -> None:
     ramp[:] = np.where(has_next, position / lengths[for_run], 0.0)
 
 
-def combine(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserve: str | None = None,
-            joints: Iterable[str] | None = None, discard_old: bool = False, interpolate: bool = False,
-            rotation_blend: str = "slerp", up: str = "y", workers: int | None = None) -> Motion:
+def combine(
+    old: Motion,
+    new: Motion,
+    cut=None,
+    scale=None,
+    blend: int = 0,
+    preserve: str | None = None,
+    joints: Iterable[str] | None = None,
+    discard_old: bool = False,
+    interpolate: bool = False,
+    rotation_blend: str = "slerp",
+    up: str = "y",
+    workers: int | None = None,
+) -> Motion:
     """Lay ``new`` over ``old``: a new Motion (the inputs are not modified).
 
     - ``cut=(cf, ct)``: use frames cf..ct of ``new`` (default all of it).
@@ -259,13 +305,25 @@ def combine(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, pres
       channels) or "linear" on the stored Euler angles (the thesis).
     Raises ValueError naming the argument at fault.
     """
-    return combine_planned(old, new, cut, scale, blend, preserve, joints, discard_old, interpolate, rotation_blend,
-                           up, workers)[1]
+    return combine_planned(
+        old, new, cut, scale, blend, preserve, joints, discard_old, interpolate, rotation_blend, up, workers
+    )[1]
 
 
-def combine_planned(old: Motion, new: Motion, cut=None, scale=None, blend: int = 0, preserve: str | None = None,
-                    joints: Iterable[str] | None = None, discard_old: bool = False, interpolate: bool = False,
-                    rotation_blend: str = "slerp", up: str = "y", workers: int | None = None) -> tuple[Plan, Motion]:
+def combine_planned(
+    old: Motion,
+    new: Motion,
+    cut=None,
+    scale=None,
+    blend: int = 0,
+    preserve: str | None = None,
+    joints: Iterable[str] | None = None,
+    discard_old: bool = False,
+    interpolate: bool = False,
+    rotation_blend: str = "slerp",
+    up: str = "y",
+    workers: int | None = None,
+) -> tuple[Plan, Motion]:
     """:func:`combine`, returning the frame map it followed as well."""
     if rotation_blend not in ROTATION_BLENDS:
         raise ValueError(f"rotation_blend must be one of {ROTATION_BLENDS}, got {rotation_blend!r}")
@@ -283,9 +341,20 @@ def combine_planned(old: Motion, new: Motion, cut=None, scale=None, blend: int =
     offset_row, offsets, offset_channels = None, None, ()
     if p.preserve and "root" in chosen and not discard_old:
         offset_row, offsets, offset_channels = _root_offsets(old, new, p, up)
-    values = combine_frames(None if discard_old else old.values, new.values, p.old_row, p.new_row, p.weight,
-                            next_row=p.next_row, ramp=p.ramp, selected=selected, offset_row=offset_row,
-                            offsets=offsets, offset_channels=offset_channels, workers=workers)
+    values = combine_frames(
+        None if discard_old else old.values,
+        new.values,
+        p.old_row,
+        p.new_row,
+        p.weight,
+        next_row=p.next_row,
+        ramp=p.ramp,
+        selected=selected,
+        offset_row=offset_row,
+        offsets=offsets,
+        offset_channels=offset_channels,
+        workers=workers,
+    )
     if rotation_blend == "slerp":
         _slerp_blends(values, old, new, p, chosen)
     values.flags.writeable = False
@@ -312,8 +381,7 @@ def _slerp_blends(values: np.ndarray, old: Motion, new: Motion, p: Plan, joints)
         if p.ramp is not None:
             b = b + p.ramp[frames, None] * (new.values[p.next_row[frames]][:, columns] - b)
         b = b * scale
-        q = _euler.slerp(_euler.quaternions(_euler.matrices(a, axes)), _euler.quaternions(_euler.matrices(b, axes)),
-                         u)
+        q = _euler.slerp(_euler.quaternions(_euler.matrices(a, axes)), _euler.quaternions(_euler.matrices(b, axes)), u)
         angles = _euler.angles(_euler.quaternion_matrices(q), axes) / scale
         linear = values[np.ix_(frames, columns)]
         values[np.ix_(frames, columns)] = _euler.nearest_equivalent(angles, linear, period)
@@ -349,8 +417,11 @@ def _root_offsets(old: Motion, new: Motion, p: Plan, up: str, rotations=_euler):
             return new.values[p.new_row[i][:, None], root]
         if not uses_new.any():
             return old.values[p.old_row[i][:, None], root]
-        return np.where(uses_new[:, None], new.values[np.maximum(p.new_row[i], 0)[:, None], root],
-                        old.values[np.maximum(p.old_row[i], 0)[:, None], root])
+        return np.where(
+            uses_new[:, None],
+            new.values[np.maximum(p.new_row[i], 0)[:, None], root],
+            old.values[np.maximum(p.old_row[i], 0)[:, None], root],
+        )
 
     def old_root(frame: int) -> np.ndarray:
         return old.values[frame - o1, root]
@@ -376,8 +447,9 @@ def _root_offsets(old: Motion, new: Motion, p: Plan, up: str, rotations=_euler):
     return offset_row, np.concatenate(tables), root.tolist()
 
 
-def _ground_moved(motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: np.ndarray, up: str,
-                  rotations) -> np.ndarray:
+def _ground_moved(
+    motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: np.ndarray, up: str, rotations
+) -> np.ndarray:
     """Root channel rows moved rigidly so that ``start`` lands on ``anchor``: translated on the
     ground plane, turned about the ``up`` axis to the anchor's heading.  ``rotations`` converts
     Euler angles and matrices (``matrices``, ``angles``)."""

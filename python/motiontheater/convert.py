@@ -12,7 +12,6 @@ axis.  Angles are degrees in BVH; lengths keep their units.
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from mtcore.kinematics import euler_angles, forward_kinematics
@@ -34,8 +33,9 @@ def to_bvh(motion: Motion, order: str = "ZXY") -> Motion:
         raise ValueError(f"order must be one of {', '.join(BVH_ORDERS)}, got {order!r}")
     for bone in skeleton.bones:
         if set(bone.dofs) - set(ROTATIONS):
-            raise ValueError(f"bone '{bone.name}' has translation dofs {bone.dofs}: BVH conversion supports "
-                             "rotation dofs only")
+            raise ValueError(
+                f"bone '{bone.name}' has translation dofs {bone.dofs}: BVH conversion supports rotation dofs only"
+            )
     rotation_dofs = tuple("r" + a.lower() for a in order)
     fixed = order[::-1].lower()  # BVH's R = R1 R2 R3 applies R3 first about fixed axes
     tree = joint_tree(skeleton)
@@ -45,16 +45,34 @@ def to_bvh(motion: Motion, order: str = "ZXY") -> Motion:
         parent = skeleton.parent(bone.name)
         offset = segments[parent] if parent != "root" else np.zeros(3)
         turns = bool(bone.dofs)
-        bones.append(Bone(name=bone.name, direction=tuple(offset), length=float(np.linalg.norm(offset)),
-                          dofs=rotation_dofs if turns else ()))
+        bones.append(
+            Bone(
+                name=bone.name,
+                direction=tuple(offset),
+                length=float(np.linalg.norm(offset)),
+                dofs=rotation_dofs if turns else (),
+            )
+        )
         pairs.append((parent, (bone.name,)))
         if not skeleton.children(bone.name):
-            bones.append(Bone(name=f"{bone.name}_End", direction=tuple(segments[bone.name]),
-                              length=float(np.linalg.norm(segments[bone.name])), end_site=True))
+            bones.append(
+                Bone(
+                    name=f"{bone.name}_End",
+                    direction=tuple(segments[bone.name]),
+                    length=float(np.linalg.norm(segments[bone.name])),
+                    end_site=True,
+                )
+            )
             pairs.append((bone.name, (f"{bone.name}_End",)))
     root = Root(order=("tx", "ty", "tz", *rotation_dofs), position=(0.0, 0.0, 0.0), name="root")
-    target = Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs), root=root,
-                      name=skeleton.name, units=(("angle", "deg"),), convention="bvh")
+    target = Skeleton(
+        bones=tuple(bones),
+        hierarchy=canonical_hierarchy(tuple(bones), pairs),
+        root=root,
+        name=skeleton.name,
+        units=(("angle", "deg"),),
+        convention="bvh",
+    )
     positions, _, local = forward_kinematics(motion.values, tree, local=True)
     turning = [j for j, name in enumerate(skeleton.joint_names) if name == "root" or skeleton.bone(name).dofs]
     angles = np.degrees(euler_angles(local[:, turning], fixed))[..., ::-1]  # in the listed order
@@ -70,8 +88,9 @@ def to_asf(motion: Motion) -> Motion:
         return motion
     for bone in skeleton.bones:
         if set(bone.dofs) - set(ROTATIONS):
-            raise ValueError(f"joint '{bone.name}' has position channels: ASF conversion supports them on the "
-                             "root only")
+            raise ValueError(
+                f"joint '{bone.name}' has position channels: ASF conversion supports them on the root only"
+            )
     root = skeleton.root
     root_rotations = tuple(d for d in root.order if d in ROTATIONS)[::-1]
     root_translations = tuple(d for d in root.order if d in TRANSLATIONS)
@@ -81,23 +100,38 @@ def to_asf(motion: Motion) -> Motion:
         parent = skeleton.parent(bone.name)
         turner = () if parent == "root" else tuple(d for d in skeleton.bone(parent).dofs)[::-1]
         name = bone.name.replace(" ", "_")
-        bones.append(Bone(name=name, direction=bone.direction, length=float(np.linalg.norm(bone.direction)),
-                          dofs=turner, axis=(0.0, 0.0, 0.0), axis_order="XYZ"))
+        bones.append(
+            Bone(
+                name=name,
+                direction=bone.direction,
+                length=float(np.linalg.norm(bone.direction)),
+                dofs=turner,
+                axis=(0.0, 0.0, 0.0),
+                axis_order="XYZ",
+            )
+        )
         pairs.append(("root" if parent == "root" else parent.replace(" ", "_"), (name,)))
-    target = Skeleton(bones=tuple(bones), hierarchy=canonical_hierarchy(tuple(bones), pairs),
-                      root=Root(order=(*root_translations, *root_rotations), position=position),
-                      name=skeleton.name or "converted",
-                      units=(("mass", "1.0"), ("length", "1.0"), ("angle", "deg")))
+    target = Skeleton(
+        bones=tuple(bones),
+        hierarchy=canonical_hierarchy(tuple(bones), pairs),
+        root=Root(order=(*root_translations, *root_rotations), position=position),
+        name=skeleton.name or "converted",
+        units=(("mass", "1.0"), ("length", "1.0"), ("angle", "deg")),
+    )
     columns = [motion.values[:, motion.columns("root", root_translations)]] if root_translations else []
-    columns.append(motion.values[:, motion.columns("root", root_rotations)] if root_rotations else
-                   np.zeros((motion.frames, 0)))
+    columns.append(
+        motion.values[:, motion.columns("root", root_rotations)] if root_rotations else np.zeros((motion.frames, 0))
+    )
     for bone in skeleton.bones:
         parent = skeleton.parent(bone.name)
         if parent != "root" and skeleton.bone(parent).dofs:
             columns.append(motion.values[:, motion.columns(parent, skeleton.bone(parent).dofs[::-1])])
     values = np.concatenate(columns, axis=1)
     values.flags.writeable = False
-    return Motion(target, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame,
-                  header=(":FULLY-SPECIFIED", ":DEGREES"))
-
-
+    return Motion(
+        target,
+        values,
+        frame_rate=motion.frame_rate,
+        first_frame=motion.first_frame,
+        header=(":FULLY-SPECIFIED", ":DEGREES"),
+    )

@@ -14,13 +14,14 @@ _NAMED_UNITS = {1.0: "m", 0.01: "cm", 0.001: "mm", 0.0254: "in"}
 
 
 def length_unit_name(motion: Motion, meters: bool) -> str | None:
-    """"m" with meters, else the name of the skeleton's unit if it has one (None for
+    """ "m" with meters, else the name of the skeleton's unit if it has one (None for
     the Acclaim convention's inch / L units of CMU and HDM05)."""
     return "m" if meters else _NAMED_UNITS.get(motion.skeleton.meters_per_unit)
 
 
-def write_positions(motion: Motion, target: Source, *, meters: bool = False, format: str | None = None,
-                    workers: int | None = None) -> str:
+def write_positions(
+    motion: Motion, target: Source, *, meters: bool = False, format: str | None = None, workers: int | None = None
+) -> str:
     """Write the world position of every joint (``Motion.positions()``) to a file.
 
     ``format`` is "csv", "npz" or "trc" (default: the target's suffix).  CSV:
@@ -39,16 +40,24 @@ def write_positions(motion: Motion, target: Source, *, meters: bool = False, for
         raise ValueError(f"format must be one of {', '.join(FORMATS)} (or a target ending in one), got {format!r}")
     unit = length_unit_name(motion, meters)
     if format == "trc" and unit is None:
-        raise ValueError(f"TRC needs a named length unit, and this skeleton's unit is "
-                         f"{motion.skeleton.meters_per_unit:.6g} m: write it in metres (meters=True, --meters)")
+        raise ValueError(
+            f"TRC needs a named length unit, and this skeleton's unit is "
+            f"{motion.skeleton.meters_per_unit:.6g} m: write it in metres (meters=True, --meters)"
+        )
     positions = motion.positions(meters=meters, workers=workers)
     frames = motion.first_frame + np.arange(motion.frames)
     names = motion.skeleton.joint_names
     with output(target) as f:
         if format == "npz":
-            np.savez(f, positions=positions, joint_names=np.array(names), frames=frames, times=motion.times,
-                     frame_rate=motion.frame_rate,
-                     meters_per_unit=1.0 if meters else motion.skeleton.meters_per_unit)
+            np.savez(
+                f,
+                positions=positions,
+                joint_names=np.array(names),
+                frames=frames,
+                times=motion.times,
+                frame_rate=motion.frame_rate,
+                meters_per_unit=1.0 if meters else motion.skeleton.meters_per_unit,
+            )
         else:
             table = np.column_stack([frames, motion.times, positions.reshape(motion.frames, -1)])
             fmt = ["%d", "%.10g"] + ["%.10g"] * (3 * len(names))

@@ -52,8 +52,17 @@ class Smoother:
     frames from either end of the stretch, unless that end is the take's).
     """
 
-    def __init__(self, skeleton: Skeleton, kind: str, size: int, joints: Iterable[str] | None = None, *,
-                 translation: bool = True, mode: str = "nearest", workers: int | None = None):
+    def __init__(
+        self,
+        skeleton: Skeleton,
+        kind: str,
+        size: int,
+        joints: Iterable[str] | None = None,
+        *,
+        translation: bool = True,
+        mode: str = "nearest",
+        workers: int | None = None,
+    ):
         if kind not in FILTERS:
             raise ValueError(f"filter kind must be one of {', '.join(FILTERS)}, got {kind!r}")
         if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or size < 1 or size % 2 == 0:
@@ -61,7 +70,7 @@ class Smoother:
         self.kind, self.size, self.mode, self.workers = kind, int(size), mode, workers
         self.rotations: list[int] = []
         self.others: list[int] = []
-        for joint in (skeleton.joint_names if joints is None else tuple(joints)):
+        for joint in skeleton.joint_names if joints is None else tuple(joints):
             start = skeleton.first_column(joint)
             for i, dof in enumerate(skeleton.dofs(joint)):
                 if dof in ROTATIONS:
@@ -111,11 +120,13 @@ class Smoother:
                 values[:, columns] = smooth(block, self.size, axis=0, mode=self.mode, workers=self.workers)
             else:  # relative to the take's first frame: exact for constants, no loss far from zero
                 base = stats.first[columns]
-                values[:, columns] = smooth(block - base, self.size, axis=0, mode=self.mode,
-                                            workers=self.workers) + base
+                values[:, columns] = (
+                    smooth(block - base, self.size, axis=0, mode=self.mode, workers=self.workers) + base
+                )
         if self.rotations:
-            values[:, self.rotations] = _wrap_into(values[:, self.rotations], stats.low[self.rotations],
-                                                   stats.high[self.rotations], self.period)
+            values[:, self.rotations] = _wrap_into(
+                values[:, self.rotations], stats.low[self.rotations], stats.high[self.rotations], self.period
+            )
         return values
 
 

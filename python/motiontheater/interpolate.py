@@ -30,8 +30,9 @@ def _convention(motion: Motion, dofs: tuple[str, ...]) -> tuple[str, bool]:
     return "".join(d[1] for d in dofs), motion.skeleton.convention != "bvh"
 
 
-def interpolate(motion: Motion, first: int, last: int, kind: str = "slerp",
-                joints: Iterable[str] | None = None) -> Motion:
+def interpolate(
+    motion: Motion, first: int, last: int, kind: str = "slerp", joints: Iterable[str] | None = None
+) -> Motion:
     """A new motion whose frames first+1 .. last-1 (frame numbers) interpolate the keys at
     ``first`` and ``last``: "euler" (linear on the stored angles), "slerp" (quaternions, the
     short arc), "expmap" (linear on exponential maps) or "aligned_expmap" (the start key
@@ -42,29 +43,29 @@ def interpolate(motion: Motion, first: int, last: int, kind: str = "slerp",
     values = motion.values.copy()
     t = (np.arange(a + 1, b) - a) / (b - a)
     skeleton = motion.skeleton
-    for joint in (skeleton.joint_names if joints is None else tuple(joints)):
+    for joint in skeleton.joint_names if joints is None else tuple(joints):
         dofs = skeleton.dofs(joint)
         columns = motion.columns(joint)
         rotations = tuple(d for d in dofs if d in ROTATIONS)
         rotation_columns = [c for c, d in zip(columns, dofs) if d in ROTATIONS]
         linear = [c for c in columns if kind == "euler" or len(rotations) != 3 or c not in rotation_columns]
-        values[a + 1:b, linear] = values[a, linear] + t[:, None] * (values[b, linear] - values[a, linear])
+        values[a + 1 : b, linear] = values[a, linear] + t[:, None] * (values[b, linear] - values[a, linear])
         if kind == "euler" or len(rotations) != 3:
             continue
         order, extrinsic = _convention(motion, rotations)
         degrees = skeleton.angle_unit == "deg"
-        keys = rot.euler_to_quaternions(values[[a, b]][:, rotation_columns], order, extrinsic=extrinsic,
-                                        degrees=degrees)
+        keys = rot.euler_to_quaternions(
+            values[[a, b]][:, rotation_columns], order, extrinsic=extrinsic, degrees=degrees
+        )
         if kind == "slerp":
             q = rot.slerp(keys[0], keys[1], t)
         else:
             v = rot.quaternions_to_rotvecs(keys)
-            q = rot.rotvecs_to_quaternions(rot.interpolate_rotvecs(v[0], v[1], t,
-                                                                   aligned=kind == "aligned_expmap"))
+            q = rot.rotvecs_to_quaternions(rot.interpolate_rotvecs(v[0], v[1], t, aligned=kind == "aligned_expmap"))
         angles = rot.quaternions_to_euler(q, order, extrinsic=extrinsic, degrees=degrees)
         # of the equivalent Euler triples, each frame's nearest the one before, from the first key on
-        path = rot.unroll_euler(np.concatenate([values[a:a + 1, rotation_columns], angles]), order, degrees=degrees)
-        values[a + 1:b, rotation_columns] = path[1:]
+        path = rot.unroll_euler(np.concatenate([values[a : a + 1, rotation_columns], angles]), order, degrees=degrees)
+        values[a + 1 : b, rotation_columns] = path[1:]
     values.flags.writeable = False
     return motion.replace(values=values)
 
@@ -74,7 +75,7 @@ def median3(motion: Motion, first: int, last: int, joints: Iterable[str] | None 
     a, b = _rows(motion, first, last)
     columns = [c for j in (motion.skeleton.joint_names if joints is None else tuple(joints)) for c in motion.columns(j)]
     values = motion.values.copy()
-    values[a:b + 1, columns] = median_filter1d(values[a:b + 1][:, columns], 3, axis=0, mode="nearest")
+    values[a : b + 1, columns] = median_filter1d(values[a : b + 1][:, columns], 3, axis=0, mode="nearest")
     values.flags.writeable = False
     return motion.replace(values=values)
 
@@ -104,10 +105,10 @@ class Step:
             return median3(motion, self.first, self.last, self.joints)
         if self.kind in FILTERS:
             a, b = _rows(motion, self.first, self.last)
-            piece = motion.replace(values=motion.values[a:b + 1], first_frame=self.first)
+            piece = motion.replace(values=motion.values[a : b + 1], first_frame=self.first)
             smoothed = filter_motion(piece, self.kind, self.size, self.joints)
             values = motion.values.copy()
-            values[a:b + 1] = smoothed.values
+            values[a : b + 1] = smoothed.values
             values.flags.writeable = False
             return motion.replace(values=values)
         raise ValueError(f"step kind must be one of {', '.join(STEPS)}, got {self.kind!r}")

@@ -67,9 +67,18 @@ def joint_tree(skeleton: Skeleton) -> JointTree:
             dof_column.append(col)
         column += len(dofs)
         dof_start.append(len(dof_kind))
-    return JointTree(parent=parent, order=order, axis=axis, direction=direction, segment=segment,
-                     dof_start=dof_start, dof_kind=dof_kind, dof_column=dof_column, angle_scale=scale,
-                     parent_frame=[0] + [1 if bvh else 0] * len(skeleton.bones))
+    return JointTree(
+        parent=parent,
+        order=order,
+        axis=axis,
+        direction=direction,
+        segment=segment,
+        dof_start=dof_start,
+        dof_kind=dof_kind,
+        dof_column=dof_column,
+        angle_scale=scale,
+        parent_frame=[0] + [1 if bvh else 0] * len(skeleton.bones),
+    )
 
 
 def _replaced(offset, dofs) -> np.ndarray:

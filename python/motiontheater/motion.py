@@ -49,8 +49,10 @@ class Motion:
         object.__setattr__(self, "values", values)
 
     def __repr__(self) -> str:
-        return (f"Motion(skeleton={self.skeleton.name!r}, frames={self.frames} from {self.first_frame}, "
-                f"channels={self.values.shape[1]}, frame_rate={self.frame_rate:g})")
+        return (
+            f"Motion(skeleton={self.skeleton.name!r}, frames={self.frames} from {self.first_frame}, "
+            f"channels={self.values.shape[1]}, frame_rate={self.frame_rate:g})"
+        )
 
     @property
     def frames(self) -> int:
@@ -75,7 +77,9 @@ class Motion:
         for dof in wanted:
             dof = dof.lower()
             if dof not in available:
-                raise UnknownNameError(f"joint '{joint}' has no channel '{dof}' (it has {', '.join(available) or 'none'})")
+                raise UnknownNameError(
+                    f"joint '{joint}' has no channel '{dof}' (it has {', '.join(available) or 'none'})"
+                )
             result.append(start + available.index(dof))
         return result
 
@@ -95,19 +99,27 @@ class Motion:
             positions = positions[:, np.maximum(tree.parent, 0)]
         return positions * self.skeleton.meters_per_unit if meters else positions
 
-    def rotations(self, *, local: bool = False, quaternions: bool = False,
-                  workers: int | None = None) -> np.ndarray:
+    def rotations(self, *, local: bool = False, quaternions: bool = False, workers: int | None = None) -> np.ndarray:
         """Each joint's rotation per frame: (frames, joints, 3, 3) matrices, or
         (frames, joints, 4) unit quaternions (w, x, y, z), w >= 0.  World
         rotations by default; ``local=True`` gives C M C^T, a joint's own
         rotation in world-aligned axes (what the HDM05 toolbox stores)."""
-        _, world, own = forward_kinematics(self.values, joint_tree(self.skeleton), world=not local, local=local,
-                                           workers=workers)
+        _, world, own = forward_kinematics(
+            self.values, joint_tree(self.skeleton), world=not local, local=local, workers=workers
+        )
         matrices = own if local else world
         return rotations_to_quaternions(matrices) if quaternions else matrices
 
-    def filter(self, kind: str, size: int, joints=None, *, translation: bool = True, mode: str = "nearest",
-               workers: int | None = None) -> Motion:
+    def filter(
+        self,
+        kind: str,
+        size: int,
+        joints=None,
+        *,
+        translation: bool = True,
+        mode: str = "nearest",
+        workers: int | None = None,
+    ) -> Motion:
         """Smoothed over frames: see :func:`motiontheater.filtering.filter_motion`."""
         from .filtering import filter_motion  # filtering builds on Motion
 
@@ -117,16 +129,19 @@ class Motion:
         """A new motion with some fields changed (values are copied if writeable)."""
         return replace(self, **changes)
 
-    def with_units(self, *, length_factor: float = 1.0, length: str | None = None,
-                   angle: str | None = None) -> Motion:
+    def with_units(self, *, length_factor: float = 1.0, length: str | None = None, angle: str | None = None) -> Motion:
         """Lengths times ``length_factor`` (unit text ``length``) and angles in ``angle``
         ("deg" or "rad"), for the skeleton and the values alike."""
         skeleton = self.skeleton.with_units(length_factor=length_factor, length=length, angle=angle)
         angle_factor = 1.0
         if angle is not None and angle != self.skeleton.angle_unit:
             angle_factor = np.pi / 180 if angle == "rad" else 180 / np.pi
-        factors = np.array([angle_factor if dof in ROTATIONS else length_factor if dof in (*TRANSLATIONS, "l") else 1.0
-                            for _, dof in self.channels])
+        factors = np.array(
+            [
+                angle_factor if dof in ROTATIONS else length_factor if dof in (*TRANSLATIONS, "l") else 1.0
+                for _, dof in self.channels
+            ]
+        )
         values = self.values * factors
         values.flags.writeable = False
         header = tuple(_angle_header(line, skeleton.angle_unit) for line in self.header)

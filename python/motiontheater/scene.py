@@ -44,7 +44,9 @@ class Scene:
     def add(self, motion: Motion, name: str = "", **options) -> Scene:
         unknown = set(options) - set(TRACK_OPTIONS)
         if unknown:
-            raise ValueError(f"unknown track option(s) {', '.join(sorted(unknown))}; expected {', '.join(TRACK_OPTIONS)}")
+            raise ValueError(
+                f"unknown track option(s) {', '.join(sorted(unknown))}; expected {', '.join(TRACK_OPTIONS)}"
+            )
         return replace(self, tracks=(*self.tracks, Track(motion, dict(options), name)))
 
     def render(self, workers: int | None = None) -> Motion:
@@ -70,20 +72,20 @@ class Scene:
 def read_recipe(path: str | os.PathLike) -> Scene:
     """A scene from a TOML recipe; paths in it are relative to the recipe's folder::
 
-        skeleton = "02.asf"            # optional: else the ASF beside the base motion
-        frame_rate = 120               # optional: for AMCs that do not say
-        [base]
-        motion = "02_01.amc"
-        [[track]]
-        motion = "02_02.amc"
-        joints = ["lowerback", "upperback", "thorax"]
-        cut = [1, 55]
-        scale = [1, 66]
-        [[track]]
-        motion = "02_01.amc"
-        joints = ["lowerback", "upperback", "thorax"]
-        cut = [67, 113]
-        blend = 10
+    skeleton = "02.asf"            # optional: else the ASF beside the base motion
+    frame_rate = 120               # optional: for AMCs that do not say
+    [base]
+    motion = "02_01.amc"
+    [[track]]
+    motion = "02_02.amc"
+    joints = ["lowerback", "upperback", "thorax"]
+    cut = [1, 55]
+    scale = [1, 66]
+    [[track]]
+    motion = "02_01.amc"
+    joints = ["lowerback", "upperback", "thorax"]
+    cut = [67, 113]
+    blend = 10
     """
     path = Path(path)
     with open(path, "rb") as f:
@@ -100,7 +102,7 @@ def read_recipe(path: str | os.PathLike) -> Scene:
 
     base = recipe.get("base", {}).get("motion")
     if base is None:
-        raise ValueError(f"{path}: the recipe needs [base] with motion = \"FILE.amc\"")
+        raise ValueError(f'{path}: the recipe needs [base] with motion = "FILE.amc"')
     base = where(base, "base.motion")
     skeleton = read_asf(where(recipe["skeleton"], "skeleton") if "skeleton" in recipe else skeleton_path_for(base))
     rate = recipe.get("frame_rate")
@@ -112,11 +114,12 @@ def read_recipe(path: str | os.PathLike) -> Scene:
     scene = Scene(motion(base))
     for n, track in enumerate(recipe.get("track", []), start=1):
         if "motion" not in track:
-            raise ValueError(f"{path}: track {n} needs motion = \"FILE.amc\"")
+            raise ValueError(f'{path}: track {n} needs motion = "FILE.amc"')
         options = {k: v for k, v in track.items() if k != "motion"}
         try:
-            scene = scene.add(motion(where(track["motion"], f"track {n} motion")),
-                              name=f"track {n} ({track['motion']})", **options)
+            scene = scene.add(
+                motion(where(track["motion"], f"track {n} motion")), name=f"track {n} ({track['motion']})", **options
+            )
         except ValueError as e:
             raise ValueError(f"{path}: track {n}: {e}") from None
     return scene

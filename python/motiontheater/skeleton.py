@@ -17,8 +17,18 @@ BONE_DOFS = (*ROTATIONS, *TRANSLATIONS, "l")  # "l": translation along the bone 
 ROOT_DOFS = (*TRANSLATIONS, *ROTATIONS)
 
 # Length units by name; a number L means the Acclaim convention: file unit = inch / L.
-_METERS_PER_NAMED_UNIT = {"m": 1.0, "meter": 1.0, "meters": 1.0, "metre": 1.0, "metres": 1.0,
-                          "cm": 0.01, "mm": 0.001, "in": 0.0254, "inch": 0.0254, "inches": 0.0254}
+_METERS_PER_NAMED_UNIT = {
+    "m": 1.0,
+    "meter": 1.0,
+    "meters": 1.0,
+    "metre": 1.0,
+    "metres": 1.0,
+    "cm": 0.01,
+    "mm": 0.001,
+    "in": 0.0254,
+    "inch": 0.0254,
+    "inches": 0.0254,
+}
 
 
 @dataclass(frozen=True)
@@ -63,8 +73,10 @@ def name_problem(name: str, convention: str) -> str | None:
         if not name.strip() or any(c in name for c in "{}\r\n"):
             return f"joint name {name!r} cannot be written to BVH"
     elif not name or name.split() != [name] or name[0] in "#:" or name.isdigit():
-        return (f"bone name {name!r} cannot be written to ASF/AMC: it must be one word, "
-                "not all digits, not starting with '#' or ':'")
+        return (
+            f"bone name {name!r} cannot be written to ASF/AMC: it must be one word, "
+            "not all digits, not starting with '#' or ':'"
+        )
     return None
 
 
@@ -187,7 +199,7 @@ class Skeleton:
 
     @property
     def angle_unit(self) -> str:
-        """"deg" or "rad": the unit of every angle in the skeleton and its motions."""
+        """ "deg" or "rad": the unit of every angle in the skeleton and its motions."""
         unit = (self.unit("angle") or "deg").lower()
         return "rad" if unit.startswith("rad") else "deg"
 
@@ -203,8 +215,9 @@ class Skeleton:
         except (ValueError, ZeroDivisionError):
             raise ValueError(f"unknown length unit '{text}'") from None
 
-    def with_units(self, *, length_factor: float = 1.0, length: str | None = None,
-                   angle: str | None = None) -> Skeleton:
+    def with_units(
+        self, *, length_factor: float = 1.0, length: str | None = None, angle: str | None = None
+    ) -> Skeleton:
         """The same skeleton with lengths multiplied by ``length_factor`` (unit text
         ``length``) and angles converted to ``angle`` ("deg" or "rad")."""
         angle_factor = _angle_factor(self.angle_unit, angle)
@@ -220,13 +233,18 @@ class Skeleton:
                 axis=_scaled(b.axis, angle_factor),
                 limits=tuple(
                     (lo * f, hi * f)
-                    for (lo, hi), f in zip(b.limits, (angle_factor if d in ROTATIONS else length_factor for d in b.dofs))
+                    for (lo, hi), f in zip(
+                        b.limits, (angle_factor if d in ROTATIONS else length_factor for d in b.dofs)
+                    )
                 ),
             )
             for b in self.bones
         )
-        root = replace(self.root, position=_scaled(self.root.position, length_factor),
-                       orientation=_scaled(self.root.orientation, angle_factor))
+        root = replace(
+            self.root,
+            position=_scaled(self.root.position, length_factor),
+            orientation=_scaled(self.root.orientation, angle_factor),
+        )
         return replace(self, bones=bones, root=root, units=tuple(units.items()))
 
 

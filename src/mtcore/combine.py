@@ -16,9 +16,21 @@ __all__ = ["combine_frames"]
 _PARALLEL_MIN_VALUES = 1 << 20
 
 
-def combine_frames(old: np.ndarray | None, new: np.ndarray | None, old_row, new_row, weight, *,
-                   next_row=None, ramp=None, selected=None, offset_row=None, offsets=None,
-                   offset_channels=(), workers: int | None = None) -> np.ndarray:
+def combine_frames(
+    old: np.ndarray | None,
+    new: np.ndarray | None,
+    old_row,
+    new_row,
+    weight,
+    *,
+    next_row=None,
+    ramp=None,
+    selected=None,
+    offset_row=None,
+    offsets=None,
+    offset_channels=(),
+    workers: int | None = None,
+) -> np.ndarray:
     """Output frames (len(weight), channels) from rows of ``old`` and ``new`` (see mt_combine).
 
     Per output frame: ``old_row`` and ``new_row`` index the motions (-1: none),
@@ -45,8 +57,13 @@ def combine_frames(old: np.ndarray | None, new: np.ndarray | None, old_row, new_
     else:
         ramp = np.ascontiguousarray(ramp, np.float64)
         next_row = new_row if next_row is None else ints(next_row)
-    for name, a in (("old_row", old_row), ("new_row", new_row), ("next_row", next_row), ("ramp", ramp),
-                    ("offset_row", offset_row)):
+    for name, a in (
+        ("old_row", old_row),
+        ("new_row", new_row),
+        ("next_row", next_row),
+        ("ramp", ramp),
+        ("offset_row", offset_row),
+    ):
         if a is not None and a.shape != (frames,):
             raise ValueError(f"{name} must have one entry per output frame ({frames}), got shape {a.shape}")
     selected = np.ones(channels, np.uint8) if selected is None else np.ascontiguousarray(selected, np.uint8)
@@ -58,10 +75,23 @@ def combine_frames(old: np.ndarray | None, new: np.ndarray | None, old_row, new_
     bounds = even_bounds(frames, thread_count(workers, out.size >= _PARALLEL_MIN_VALUES))
     rows = "long long[]"
     args = (
-        c_array(old), 0 if old is None else len(old), c_array(new), 0 if new is None else len(new), channels, frames,
-        c_array(old_row, rows), c_array(new_row, rows), c_array(next_row, rows), c_array(ramp), c_array(weight),
-        c_array(selected, "unsigned char[]"), c_array(offset_row, rows), c_array(offsets), len(offsets),
-        c_array(offset_channels, "size_t[]"), len(offset_channels),
+        c_array(old),
+        0 if old is None else len(old),
+        c_array(new),
+        0 if new is None else len(new),
+        channels,
+        frames,
+        c_array(old_row, rows),
+        c_array(new_row, rows),
+        c_array(next_row, rows),
+        c_array(ramp),
+        c_array(weight),
+        c_array(selected, "unsigned char[]"),
+        c_array(offset_row, rows),
+        c_array(offsets),
+        len(offsets),
+        c_array(offset_channels, "size_t[]"),
+        len(offset_channels),
     )
     out_buf = c_array(out)
 

@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, DTypeLike
 from ._mtcore import ffi, lib
 from ._parallel import run_ranges, thread_count
 
-__all__ = ["median_filter1d", "uniform_filter1d", "binomial_filter1d", "pascal_weights", "MODES"]
+__all__ = ["MODES", "binomial_filter1d", "median_filter1d", "pascal_weights", "uniform_filter1d"]
 
 MODES = {
     "reflect": lib.MT_MODE_REFLECT,
@@ -193,11 +193,9 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
     cval = float(cval)
     origin = operator.index(origin)
     if not -(size // 2) <= origin <= (size - 1) // 2:
-        raise ValueError(
-            f"origin must be in [{-(size // 2)}, {(size - 1) // 2}] for size {size}, got {origin}"
-        )
+        raise ValueError(f"origin must be in [{-(size // 2)}, {(size - 1) // 2}] for size {size}, got {origin}")
 
-    outer, n, inner = math.prod(a.shape[:axis]), a.shape[axis], math.prod(a.shape[axis + 1:])
+    outer, n, inner = math.prod(a.shape[:axis]), a.shape[axis], math.prod(a.shape[axis + 1 :])
     bounds = _split(workers, a.size, n, lib.mt_filter1d_block(size))
     target = _target(output, a)
 

@@ -14,11 +14,25 @@ from ._mtcore import lib
 from ._parallel import even_bounds, run_ranges, thread_count
 from .rotations import _sequence_matrices, matrices_to_euler, matrices_to_quaternions
 
-__all__ = ["JointTree", "axis_rotations", "euler_angles", "euler_matrices", "forward_kinematics",
-           "rotations_to_quaternions", "DOFS"]
+__all__ = [
+    "DOFS",
+    "JointTree",
+    "axis_rotations",
+    "euler_angles",
+    "euler_matrices",
+    "forward_kinematics",
+    "rotations_to_quaternions",
+]
 
-DOFS = {"rx": lib.MT_DOF_RX, "ry": lib.MT_DOF_RY, "rz": lib.MT_DOF_RZ, "tx": lib.MT_DOF_TX,
-        "ty": lib.MT_DOF_TY, "tz": lib.MT_DOF_TZ, "l": lib.MT_DOF_L}
+DOFS = {
+    "rx": lib.MT_DOF_RX,
+    "ry": lib.MT_DOF_RY,
+    "rz": lib.MT_DOF_RZ,
+    "tx": lib.MT_DOF_TX,
+    "ty": lib.MT_DOF_TY,
+    "tz": lib.MT_DOF_TZ,
+    "l": lib.MT_DOF_L,
+}
 _PARALLEL_MIN_TRANSFORMS = 20_000  # frames x joints below which one thread is faster
 
 
@@ -51,9 +65,15 @@ class JointTree:
     def __post_init__(self) -> None:
         n = len(self.parent)
         fields = dict(
-            parent=(np.int64, (n,)), order=(np.int64, (n,)), axis=(np.float64, (n, 3, 3)),
-            direction=(np.float64, (n, 3)), segment=(np.float64, (n, 3)), dof_start=(np.uintp, (n + 1,)),
-            dof_kind=(np.intc, None), dof_column=(np.uintp, None), parent_frame=(np.uint8, (n,)),
+            parent=(np.int64, (n,)),
+            order=(np.int64, (n,)),
+            axis=(np.float64, (n, 3, 3)),
+            direction=(np.float64, (n, 3)),
+            segment=(np.float64, (n, 3)),
+            dof_start=(np.uintp, (n + 1,)),
+            dof_kind=(np.intc, None),
+            dof_column=(np.uintp, None),
+            parent_frame=(np.uint8, (n,)),
         )
         if self.parent_frame is None:
             object.__setattr__(self, "parent_frame", np.zeros(n, np.uint8))
@@ -71,8 +91,9 @@ class JointTree:
         return len(self.parent)
 
 
-def forward_kinematics(values: np.ndarray, tree: JointTree, *, world: bool = False, local: bool = False,
-                       workers: int | None = None) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+def forward_kinematics(
+    values: np.ndarray, tree: JointTree, *, world: bool = False, local: bool = False, workers: int | None = None
+) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
     """Positions (frames, joints, 3) of each joint's end, and optionally world and
     local rotations (frames, joints, 3, 3), for values (frames, channels).
     Frames are split over the cores for large motions (``workers`` as for the filters)."""
@@ -88,15 +109,24 @@ def forward_kinematics(values: np.ndarray, tree: JointTree, *, world: bool = Fal
     local_out = np.empty((frames, n, 3, 3)) if local else None
     bounds = even_bounds(frames, thread_count(workers, frames * n >= _PARALLEL_MIN_TRANSFORMS))
     args = (
-        c_array(values), frames, channels, n, c_array(tree.parent, "long long[]"), c_array(tree.order, "long long[]"),
-        c_array(tree.axis), c_array(tree.direction), c_array(tree.segment), c_array(tree.dof_start, "size_t[]"),
-        c_array(tree.dof_kind, "int[]"), c_array(tree.dof_column, "size_t[]"),
-        c_array(tree.parent_frame, "unsigned char[]"), tree.angle_scale,
+        c_array(values),
+        frames,
+        channels,
+        n,
+        c_array(tree.parent, "long long[]"),
+        c_array(tree.order, "long long[]"),
+        c_array(tree.axis),
+        c_array(tree.direction),
+        c_array(tree.segment),
+        c_array(tree.dof_start, "size_t[]"),
+        c_array(tree.dof_kind, "int[]"),
+        c_array(tree.dof_column, "size_t[]"),
+        c_array(tree.parent_frame, "unsigned char[]"),
+        tree.angle_scale,
     )
     outs = (c_array(positions), c_array(world_out), c_array(local_out))
 
-    run_ranges(lambda begin, end: lib.mt_forward_kinematics(*args, begin, end, *outs), bounds,
-               "mt_forward_kinematics")
+    run_ranges(lambda begin, end: lib.mt_forward_kinematics(*args, begin, end, *outs), bounds, "mt_forward_kinematics")
     return positions, world_out, local_out
 
 

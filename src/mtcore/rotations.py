@@ -44,10 +44,23 @@ from ._mtcore import ffi, lib
 from ._status import check
 
 __all__ = [
-    "ORDERS", "euler_to_matrices", "euler_to_quaternions", "euler_to_rotvecs", "interpolate_rotvecs",
-    "matrices_to_euler", "matrices_to_quaternions", "matrices_to_rotvecs", "quaternions_to_euler",
-    "quaternions_to_matrices", "quaternions_to_rotvecs", "rotvecs_to_euler", "rotvecs_to_matrices",
-    "rotvecs_to_quaternions", "slerp", "unroll_euler", "unroll_quaternions",
+    "ORDERS",
+    "euler_to_matrices",
+    "euler_to_quaternions",
+    "euler_to_rotvecs",
+    "interpolate_rotvecs",
+    "matrices_to_euler",
+    "matrices_to_quaternions",
+    "matrices_to_rotvecs",
+    "quaternions_to_euler",
+    "quaternions_to_matrices",
+    "quaternions_to_rotvecs",
+    "rotvecs_to_euler",
+    "rotvecs_to_matrices",
+    "rotvecs_to_quaternions",
+    "slerp",
+    "unroll_euler",
+    "unroll_quaternions",
 ]
 
 ORDERS = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx", "xyx", "xzx", "yxy", "yzy", "zxz", "zyz")
@@ -59,7 +72,7 @@ def _real(a, name: str, trailing: tuple[int, ...]) -> np.ndarray:
     a = np.asarray(a)
     if a.dtype.kind not in "biuf":
         raise TypeError(f"{name} must hold real numbers, got dtype {a.dtype}")
-    if a.ndim < len(trailing) or a.shape[a.ndim - len(trailing):] != trailing:
+    if a.ndim < len(trailing) or a.shape[a.ndim - len(trailing) :] != trailing:
         wanted = ", ".join(["..."] + [str(n) for n in trailing])
         raise ValueError(f"{name} must have shape ({wanted}), got {a.shape}")
     return np.asarray(a, dtype=np.float64, order="C")
@@ -87,15 +100,21 @@ def _scale(degrees) -> float:
 def _sequence_matrices(angles: np.ndarray, codes: list[int], intrinsic: bool, scale: float) -> np.ndarray:
     """Matrices (..., 3, 3) of float64 angles (..., len(codes)) about the axes ``codes``."""
     out = np.empty(angles.shape[:-1] + (3, 3))
-    check(lib.mt_euler_to_matrices(c_array(angles), out.size // 9, ffi.new("int[]", codes), len(codes), intrinsic,
-                                   scale, c_array(out)), "mt_euler_to_matrices")
+    check(
+        lib.mt_euler_to_matrices(
+            c_array(angles), out.size // 9, ffi.new("int[]", codes), len(codes), intrinsic, scale, c_array(out)
+        ),
+        "mt_euler_to_matrices",
+    )
     return out
 
 
 def _euler(m: np.ndarray, codes: list[int], intrinsic: bool, scale: float) -> np.ndarray:
     out = np.empty(m.shape[:-2] + (3,))
-    check(lib.mt_matrices_to_euler(c_array(m), out.size // 3, ffi.new("int[]", codes), intrinsic, scale, c_array(out)),
-          "mt_matrices_to_euler")
+    check(
+        lib.mt_matrices_to_euler(c_array(m), out.size // 3, ffi.new("int[]", codes), intrinsic, scale, c_array(out)),
+        "mt_matrices_to_euler",
+    )
     return out
 
 
@@ -194,7 +213,7 @@ def _along(a: np.ndarray, axis, name: str, width: int) -> tuple[int, int, int]:
     axis = normalize_axis_index(int(axis), a.ndim)
     if axis == a.ndim - 1:
         raise ValueError(f"axis must be an axis of frames, not the last axis of {name} (its {width} components)")
-    return math.prod(a.shape[:axis]), a.shape[axis], math.prod(a.shape[axis + 1:-1])
+    return math.prod(a.shape[:axis]), a.shape[axis], math.prod(a.shape[axis + 1 : -1])
 
 
 def unroll_quaternions(quaternions, axis: int = 0) -> np.ndarray:
@@ -220,8 +239,10 @@ def unroll_euler(angles, order: str, *, axis: int = 0, degrees: bool = False) ->
     a = _real(angles, "angles", (3,))
     outer, n, inner = _along(a, axis, "angles", 3)
     out = np.empty_like(a)
-    check(lib.mt_unroll_euler(c_array(a), outer, n, inner, codes[0] == codes[2], half_turn, c_array(out)),
-          "mt_unroll_euler")
+    check(
+        lib.mt_unroll_euler(c_array(a), outer, n, inner, codes[0] == codes[2], half_turn, c_array(out)),
+        "mt_unroll_euler",
+    )
     return out
 
 
@@ -232,11 +253,15 @@ def _keys(k0, k1, t, names: tuple[str, str], width: int) -> tuple[np.ndarray, np
     try:
         shape = np.broadcast_shapes(k0.shape[:-1], k1.shape[:-1], t.shape)
     except ValueError:
-        raise ValueError(f"{names[0]} {k0.shape}, {names[1]} {k1.shape} and t {t.shape} do not broadcast "
-                         f"together (the keys' last axis aside)") from None
-    return (np.ascontiguousarray(np.broadcast_to(k0, shape + (width,))),
-            np.ascontiguousarray(np.broadcast_to(k1, shape + (width,))),
-            np.ascontiguousarray(np.broadcast_to(t, shape)))
+        raise ValueError(
+            f"{names[0]} {k0.shape}, {names[1]} {k1.shape} and t {t.shape} do not broadcast "
+            f"together (the keys' last axis aside)"
+        ) from None
+    return (
+        np.ascontiguousarray(np.broadcast_to(k0, shape + (width,))),
+        np.ascontiguousarray(np.broadcast_to(k1, shape + (width,))),
+        np.ascontiguousarray(np.broadcast_to(t, shape)),
+    )
 
 
 def slerp(q0, q1, t) -> np.ndarray:
@@ -260,6 +285,8 @@ def interpolate_rotvecs(v0, v1, t, *, aligned: bool = False) -> np.ndarray:
     v0, v1, t = _keys(v0, v1, t, ("v0", "v1"), 3)
     aligned = _flag(aligned, "aligned")
     out = np.empty_like(v0)
-    check(lib.mt_interpolate_rotvecs(c_array(v0), c_array(v1), c_array(t), t.size, aligned, c_array(out)),
-          "mt_interpolate_rotvecs")
+    check(
+        lib.mt_interpolate_rotvecs(c_array(v0), c_array(v1), c_array(t), t.size, aligned, c_array(out)),
+        "mt_interpolate_rotvecs",
+    )
     return out

@@ -18,7 +18,7 @@ from ._parallel import run_all, thread_count
 from ._status import check
 from .errors import SequenceError
 
-__all__ = ["scan_frames", "scan_table", "format_frames", "format_table", "format_number"]
+__all__ = ["format_frames", "format_number", "format_table", "scan_frames", "scan_table"]
 
 _FORMAT_CHUNK = 2048  # frames per C call when writing: bounds the text buffer
 
@@ -90,8 +90,17 @@ def scan_frames(
         def piece(i: int):
             begin, stop = pieces[i]
             return lambda: lib.mt_scan_frames(
-                c_text + begin, stop - begin, table.c_keys, table.c_lens, table.c_offsets, table.c_counts,
-                table.n, c_values + bases[i] * channels, capacities[i], channels, reports[i],
+                c_text + begin,
+                stop - begin,
+                table.c_keys,
+                table.c_lens,
+                table.c_offsets,
+                table.c_counts,
+                table.n,
+                c_values + bases[i] * channels,
+                capacities[i],
+                channels,
+                reports[i],
             )
 
         statuses = run_all([piece(i) for i in range(len(pieces))])
@@ -99,16 +108,18 @@ def scan_frames(
     for (begin, _), base, report, status in zip(pieces, bases, reports, statuses):
         check(status, "mt_scan_frames", _describer(text, start, begin, table, report, noun))
         if frames and report.frames and report.first_frame != first + frames:
-            raise SequenceError(f"frame number {report.first_frame} out of sequence: expected {first + frames}",
-                                _line_breaks(text, start, begin) + 1)
+            raise SequenceError(
+                f"frame number {report.first_frame} out of sequence: expected {first + frames}",
+                _line_breaks(text, start, begin) + 1,
+            )
         if not frames:
             first = report.first_frame
-        values[frames:frames + report.frames] = values[base:base + report.frames]
+        values[frames : frames + report.frames] = values[base : base + report.frames]
         frames += report.frames
     values.resize((frames, channels), refcheck=False)  # in place: realloc
     covered = np.zeros(channels, bool)
     for offset, count in zip(offsets, counts):
-        covered[offset:offset + count] = True
+        covered[offset : offset + count] = True
     values[:, ~covered] = np.nan
     return values, int(first) if frames else 0
 
@@ -141,15 +152,16 @@ def _line_breaks(text: bytes, begin: int, end: int) -> int:
     return part.count(b"\n") + part.count(b"\r") - part.count(b"\r\n")
 
 
-def _describer(text: bytes, start: int, begin: int, table: _KeyTable, report,
-               noun: str) -> Callable[[int], tuple[str, int, bool]]:
+def _describer(
+    text: bytes, start: int, begin: int, table: _KeyTable, report, noun: str
+) -> Callable[[int], tuple[str, int, bool]]:
     """What went wrong in the piece of text that starts at ``begin`` (line numbers from ``start``)."""
 
     def describe(status: int) -> tuple[str, int, bool]:
         line = _line_text(text, begin + report.offset)
         key = table.keys[report.key].decode("utf-8", "replace") if report.key >= 0 else None
         frame = report.first_frame + report.frames - 1
-        rest = text[begin + report.offset:]
+        rest = text[begin + report.offset :]
         # An error in a last line that has no line break: the file was cut there.
         truncated = not rest.strip() or not any(c in rest for c in b"\r\n")
         if status == lib.MT_ESYNTAX:
@@ -160,9 +172,11 @@ def _describer(text: bytes, start: int, begin: int, table: _KeyTable, report,
             reason = f"{noun} '{key}' takes {report.expected} value(s), found {report.found}: '{line[:80]}'"
         elif status == lib.MT_EUNKNOWN:
             token = line.split()[0] if line else ""
-            reason = f"unknown {noun} '{token}'; expected one of: " + ", ".join(
-                k.decode("utf-8", "replace") for k in table.keys[:8]
-            ) + (", ..." if len(table.keys) > 8 else "")
+            reason = (
+                f"unknown {noun} '{token}'; expected one of: "
+                + ", ".join(k.decode("utf-8", "replace") for k in table.keys[:8])
+                + (", ..." if len(table.keys) > 8 else "")
+            )
         elif status == lib.MT_EDUPLICATE:
             reason = f"{noun} '{key}' appears twice in frame {frame}"
         elif status == lib.MT_EMISSING:
@@ -203,8 +217,18 @@ def format_frames(
         for f0 in range(0, frames, chunk):
             n = min(chunk, frames - f0)
             status = lib.mt_format_frames(
-                c_values + f0 * channels, n, channels, first_frame + f0, table.c_keys, table.c_lens,
-                table.c_offsets, table.c_counts, table.n, c_buf, len(buf), written,
+                c_values + f0 * channels,
+                n,
+                channels,
+                first_frame + f0,
+                table.c_keys,
+                table.c_lens,
+                table.c_offsets,
+                table.c_counts,
+                table.n,
+                c_buf,
+                len(buf),
+                written,
             )
             check(status, "mt_format_frames")
             write(bytes(memoryview(buf)[: written[0]]))
@@ -226,8 +250,9 @@ def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers:
 
         def piece(i: int):
             begin, stop, first_row, count = pieces[i]
-            return lambda: lib.mt_scan_table(c_text + begin, stop - begin, count, columns,
-                                             c_values + first_row * columns, reports[i])
+            return lambda: lib.mt_scan_table(
+                c_text + begin, stop - begin, count, columns, c_values + first_row * columns, reports[i]
+            )
 
         statuses = run_all([piece(i) for i in range(len(pieces))])
     for (begin, _, _, count), report, status in zip(pieces, reports, statuses):
@@ -242,10 +267,17 @@ def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers:
                 token = tokens[report.found] if report.found < len(tokens) else ""
                 return f"expected a number as value {report.found + 1} of the frame, found '{token}'", at, False
             if code == lib.MT_ECOUNT:
-                return (f"a frame takes {report.expected} values (the channels declared), found {report.found}",
-                        at, False)
-            return (f"the header says {rows} frames but the data holds "
-                    f"{report.frames + sum(p[3] for p in pieces if p[0] < begin)} (truncated?)", at, True)
+                return (
+                    f"a frame takes {report.expected} values (the channels declared), found {report.found}",
+                    at,
+                    False,
+                )
+            return (
+                f"the header says {rows} frames but the data holds "
+                f"{report.frames + sum(p[3] for p in pieces if p[0] < begin)} (truncated?)",
+                at,
+                True,
+            )
 
         if status == lib.MT_ERANGE:
             raise SequenceError(f"the header says {rows} frames but the data holds more", lines_before + report.line)
@@ -263,8 +295,12 @@ def _table_pieces(text: bytes, start: int, rows: int, count: int) -> list[tuple[
     size = len(text) - start
     ends_open = not text.endswith(b"\n")
     crs = text.count(b"\r", start)
-    if (text.count(b"\n", start) + ends_open != rows or text.find(b"\n\n", start) != -1
-            or text.find(b"\n\r\n", start) != -1 or (crs and crs != text.count(b"\r\n", start))):
+    if (
+        text.count(b"\n", start) + ends_open != rows
+        or text.find(b"\n\n", start) != -1
+        or text.find(b"\n\r\n", start) != -1
+        or (crs and crs != text.count(b"\r\n", start))
+    ):
         return whole
     bounds, first = [start], [0]
     for i in range(1, count):
@@ -291,8 +327,7 @@ def format_table(values: np.ndarray, write: Callable[[bytes], object]) -> None:
     with ffi.from_buffer("double[]", values) as c_values, ffi.from_buffer(buf) as c_buf:
         for r0 in range(0, rows, chunk):
             n = min(chunk, rows - r0)
-            check(lib.mt_format_table(c_values + r0 * columns, n, columns, c_buf, len(buf), written),
-                  "mt_format_table")
+            check(lib.mt_format_table(c_values + r0 * columns, n, columns, c_buf, len(buf), written), "mt_format_table")
             write(bytes(memoryview(buf)[: written[0]]))
 
 
