@@ -113,12 +113,14 @@ def test_killing_a_run_leaves_no_partial_outputs_and_resume_completes_it(data_di
         str(out),
         "--quiet",
     ]
-    run = subprocess.Popen(command)
+    run = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
     deadline = time.time() + 60
     while time.time() < deadline and len(list(out.rglob("*.amc"))) < 20:
         time.sleep(0.01)
     run.send_signal(signal.SIGTERM)
-    run.wait(timeout=60)
+    _, stopped = run.communicate(timeout=60)
+    assert run.returncode == 130
+    assert "INTERRUPTED" in stopped and "--resume" in stopped
     done = list(out.rglob("*.amc"))
     assert 0 < len(done) < 12 * 33, "the run was not caught midway"
     assert not list(out.rglob(".mt-partial-*"))
@@ -129,7 +131,11 @@ def test_killing_a_run_leaves_no_partial_outputs_and_resume_completes_it(data_di
         assert take.read_bytes() == expected[relative], relative
     finished = subprocess.run(command[:-1] + ["--resume"], check=False, capture_output=True, text=True)
     assert finished.returncode == 0, finished.stderr
-    assert f"{len(done)} skipped (already done)" in finished.stdout
+    # the manifest holds every take the parent saw finish: at most those on disk (a worker may finish
+    # one in the moment the parent stops listening; resume does that one again)
+    skipped = int(re.search(r"(\d+) skipped \(already done\)", finished.stdout).group(1))
+    assert 0 < skipped <= len(done)
+    assert "Traceback" not in stopped + finished.stderr
     assert len(list(out.rglob("*.amc"))) == 12 * 33
     sample = out / "copy07" / "HDM_bd_squat1Reps_003_120.amc"
     assert sample.read_bytes() == expected_bytes(src / "copy07" / "HDM_bd_squat1Reps_003_120.amc")
@@ -272,7 +278,8 @@ def test_progress_bar(capsys):
     progress.advance(batch.Result("a", "b", bytes=1_000_000))
     progress.close()
     err = capsys.readouterr().err
-    assert "1/2 files, 1.0/2.0 MB" in err and "MB/s, ETA" in err
+    pytest.importorskip("tqdm")
+    assert "1/2 takes" in err and "50%" in err and "1.00M/2.00M" in err
     silent = batch.Progress(2, 10, enabled=False)
     silent.advance(batch.Result("a", "b", bytes=5))
     assert capsys.readouterr().err == ""

@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
+import threading
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -81,6 +83,7 @@ def _take_options(parser: argparse.ArgumentParser) -> None:
 def _output_options(parser: argparse.ArgumentParser, what: str) -> None:
     parser.add_argument("output_file", nargs="?", metavar="OUT", help=f"{what} (or give it with -o)")
     parser.add_argument("-o", "--output", help=f"{what}")
+    parser.add_argument("--in-place", action="store_true", help="allow the output to replace the input")
 
 
 def _inputs(args: argparse.Namespace) -> tuple[str, str | None]:
@@ -91,18 +94,22 @@ def _inputs(args: argparse.Namespace) -> tuple[str, str | None]:
     return take, asf
 
 
-def _output(args: argparse.Namespace) -> str:
+def _output(args: argparse.Namespace, source: str) -> str:
     chosen = [o for o in (args.output_file, args.output) if o]
     if len(chosen) != 1:
         raise ValueError("give the output file once: as the second argument or with -o OUT")
+    _refuse_overwriting(source, chosen[0], args.in_place)
     return chosen[0]
+
+
+def _refuse_overwriting(source: str, target: str, in_place: bool) -> None:
+    if not in_place and os.path.exists(target) and os.path.samefile(source, target):
+        raise ValueError(f"{target} is the input: write the result to another file, or pass --in-place")
 
 
 def _write(motion: Motion, result: Motion, source: str, target: str) -> str:
     """Write a step's result as its suffix says; an AMC of a new skeleton gets its ASF beside it.
     Returns what was written, in words."""
-    if os.path.exists(target) and os.path.samefile(source, target):
-        raise ValueError(f"{target} is the input: write the result to another file")
     write_take(result, target)
     if result.skeleton.convention == "asf" and result.skeleton is not motion.skeleton:
         skeleton = os.path.splitext(target)[0] + ".asf"
@@ -115,7 +122,7 @@ def _run_step(args: argparse.Namespace) -> int:
     step = lookup(args.step)
     options = {o.name: getattr(args, o.name) for o in step.all_options if getattr(args, o.name) is not None}
     source, asf = _inputs(args)
-    target = _output(args)
+    target = _output(args, source)
     if not step.is_exporter:
         take_suffix(target)
     motion = read_take(source, asf, args.frame_rate)
@@ -132,7 +139,7 @@ def _run_step(args: argparse.Namespace) -> int:
 def _apply(args: argparse.Namespace) -> int:
     pipeline = Pipeline.read(args.recipe)
     source, asf = _inputs(args)
-    target = _output(args)
+    target = _output(args, source)
     if pipeline.exporter is None:
         take_suffix(target)
     motion = read_take(source, asf, args.frame_rate)
@@ -150,7 +157,7 @@ def _apply(args: argparse.Namespace) -> int:
 def _filter(args: argparse.Namespace) -> int:
     pipeline = _filter_pipeline(args)
     source, asf = _inputs(args)
-    target = _output(args)
+    target = _output(args, source)
     take_suffix(target)
     motion = read_take(source, asf, args.frame_rate)
     written = _write(motion, pipeline.apply(motion), source, target)
@@ -208,11 +215,10 @@ def _batch(args: argparse.Namespace) -> int:
         skeleton=args.asf,
         frame_rate=args.frame_rate,
         resume=args.resume,
+        in_place=args.in_place,
         stream_above=int(args.stream_above * 1e6),
     )
-    progress = Progress(
-        len(jobs), sum(os.path.getsize(j.input) for j in jobs), enabled=False if args.quiet or args.json else None
-    )
+    progress = Progress(len(jobs), sum(j.bytes for j in jobs), enabled=False if args.quiet or args.json else None)
     summary = run(
         jobs,
         settled,
@@ -224,9 +230,12 @@ def _batch(args: argparse.Namespace) -> int:
     )
     if args.json:
         print(report_json(summary))
-    elif not args.quiet or summary.failed:
-        print(summary.text(), file=sys.stderr if summary.failed else sys.stdout)
-    return 1 if summary.failed else 0
+    elif not args.quiet or summary.failed or summary.stopped or summary.interrupted:
+        trouble = summary.failed or summary.stopped or summary.interrupted
+        print(summary.text(), file=sys.stderr if trouble else sys.stdout)
+    if summary.interrupted:
+        return 130
+    return 1 if summary.failed or summary.stopped else 0
 
 
 def _bench(args: argparse.Namespace) -> int:
@@ -389,7 +398,12 @@ def build_parser() -> argparse.ArgumentParser:
     many.add_argument("-o", "--output", required=True, help="the output folder")
     _take_options(many)
     many.add_argument("--jobs", type=int, default=0, help="processes (default: every core)")
-    many.add_argument("--resume", action="store_true", help="skip takes whose output is newer than the input")
+    many.add_argument(
+        "--resume",
+        action="store_true",
+        help="skip takes already done by this recipe from inputs unchanged since (the output folder's manifest says)",
+    )
+    many.add_argument("--in-place", action="store_true", help="allow outputs to replace their inputs")
     many.add_argument("--quiet", action="store_true", help="no progress bar or summary (failures still reported)")
     many.add_argument("--json", action="store_true", help="print a JSON summary")
     many.add_argument("--dask", action="store_true", help="run on a local Dask cluster of --jobs workers")
@@ -436,17 +450,37 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit status (2 with a one-line reason on failure)."""
+    """Run the command line; returns the exit status: 0 done, 1 some takes failed (batch), 2 a
+    one-line reason on failure, 130 interrupted (Ctrl-C or SIGTERM: nothing partial is left)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.verb is None:
         parser.print_help()
         return 0
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminated) if main_thread else None
     try:
         return int(args.run(args))
+    except KeyboardInterrupt:
+        print(f"motiontheater {args.verb}: interrupted; nothing was left half-written", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # the reader of our output went away (| head): say nothing more, to no one
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except MemoryError:
+        print(f"motiontheater {args.verb}: not enough memory for this take", file=sys.stderr)
+        return 2
     except (ValueError, TypeError, OSError, RuntimeError) as exc:
         print(f"motiontheater {args.verb}: {exc}", file=sys.stderr)
         return 2
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _terminated(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
 
 
 if __name__ == "__main__":

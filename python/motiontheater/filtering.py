@@ -76,13 +76,11 @@ class Smoother:
         self.kind, self.size, self.mode, self.workers = kind, int(size), mode, workers
         self.rotations: list[int] = []
         self.others: list[int] = []
-        for joint in skeleton.joint_names if joints is None else tuple(joints):
-            start = skeleton.first_column(joint)
-            for i, dof in enumerate(skeleton.dofs(joint)):
-                if dof in ROTATIONS:
-                    self.rotations.append(start + i)
-                elif translation:
-                    self.others.append(start + i)
+        for column in skeleton.columns_of(joints):
+            if skeleton.channels[column][1] in ROTATIONS:
+                self.rotations.append(column)
+            elif translation:
+                self.others.append(column)
         self.period = skeleton.period
 
     @property
