@@ -88,6 +88,9 @@ class OutputError(OSError):
     """A file could not be written (no permission, read-only, disk full): the message names the
     file the user asked for, never the temporary file."""
 
+    def __str__(self) -> str:
+        return str(self.strerror)
+
 
 def _umask() -> int:
     """The process's umask (read without changing it where /proc tells it)."""

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import signal
 import sys
+import textwrap
 import threading
 import time
 from collections.abc import Sequence
@@ -28,6 +30,8 @@ from .formats import read_take, take_suffix, write_take
 from .motion import Motion
 from .pipeline import Pipeline
 from .registry import Option, Step, lookup, steps
+from .scene import RECIPE_HELP as SCENE_HELP
+from .scene import read_recipe
 
 RECIPE_HELP = """\
 A recipe is a TOML file of [[step]] tables, applied in order; each names a step
@@ -180,7 +184,9 @@ def _filter_options(parser: argparse.ArgumentParser) -> None:
     for kind in FILTERS:
         parser.add_argument(f"--{kind}", type=int, metavar="N", help=f"{lookup(kind).summary} over N frames")
     names = Option("joints", "names", None, "")
-    parser.add_argument("--joints", type=names.parse, help="comma-separated joints to smooth (default: all)")
+    parser.add_argument(
+        "--joints", type=names.parse, metavar="A,B,...", help="comma-separated joints to smooth (default: all)"
+    )
     parser.add_argument("--no-translation", action="store_true", help="leave the root's translation alone")
     parser.add_argument(
         "--mode",
@@ -252,8 +258,6 @@ def _bench(args: argparse.Namespace) -> int:
 
 
 def _combine(args: argparse.Namespace) -> int:
-    from .scene import read_recipe
-
     scene = read_recipe(args.recipe)
     if args.dry_run:
         for track, plan in scene.plans():
@@ -281,7 +285,7 @@ def _step_verb(verbs: Any, step: Step) -> None:
         step.name,
         aliases=list(step.aliases),
         help=step.summary,
-        description=f"{step.summary[:1].upper()}{step.summary[1:]}. {step.description}".strip(),
+        description=_prose(f"{step.summary[:1].upper()}{step.summary[1:]}.", *step.description.split("\n\n")),
         epilog=example,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -307,6 +311,12 @@ def _step_verb(verbs: Any, step: Step) -> None:
                 help=help_text,
             )
     parser.set_defaults(run=_run_step, step=step.name)
+
+
+def _prose(*paragraphs: str) -> str:
+    """Paragraphs filled to the terminal's width, for --help texts that also hold examples."""
+    width = min(shutil.get_terminal_size().columns, 100) - 2
+    return "".join(textwrap.fill(" ".join(p.split()), width) + "\n\n" for p in paragraphs if p.strip())
 
 
 def _shown(value: Any) -> str:
@@ -363,7 +373,7 @@ def build_parser() -> argparse.ArgumentParser:
     recipe_run = verbs.add_parser(
         "apply",
         help="apply a recipe of steps (a TOML file) to a take",
-        description="Apply the steps of a recipe, in order, to a take and write the result.\n\n" + RECIPE_HELP,
+        description=_prose("Apply the steps of a recipe, in order, to a take and write the result.") + RECIPE_HELP,
         epilog="Example: motiontheater apply 01_01.amc --recipe steps.toml -o cleaned.amc",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -379,7 +389,7 @@ def build_parser() -> argparse.ArgumentParser:
     many = verbs.add_parser(
         "batch",
         help="apply a filter or a recipe to whole capture databases: folders, globs, all cores or a Dask cluster",
-        description=(
+        description=_prose(
             "Apply a filter (--median N, --mean N, --binomial N) or a recipe of steps (--recipe FILE) to "
             "every AMC and BVH take under the inputs (files, folders searched recursively, globs), writing "
             "into an output folder that mirrors the input tree, with each take's skeleton found by the "
@@ -387,8 +397,9 @@ def build_parser() -> argparse.ArgumentParser:
             "local one, --scheduler tcp://HOST:PORT). Each output is written under a temporary name and "
             "renamed when complete; --resume skips takes already done; a bad take is reported and the "
             "others go on; the exit status is 1 when any take failed. Takes above --stream-above MB are "
-            "streamed in chunks when the recipe is a single filter.\n\n" + RECIPE_HELP
-        ),
+            "streamed in chunks when the recipe is a single filter."
+        )
+        + RECIPE_HELP,
         epilog="Example: motiontheater batch --median 5 --jobs 2 captures/ -o smoothed/",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -419,13 +430,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     recipe = verbs.add_parser(
         "combine",
-        help="lay motion tracks over a base motion, as a TOML recipe says, and write an AMC",
-        description=(
+        help="lay motion tracks over a base motion, as a TOML recipe says, and write the result",
+        description=_prose(
             "Combine motions as the MotionTheater thesis's MotionCombiner does: each track of the "
             "recipe is cut, time-scaled, blended or root-preserved and applied to chosen joints over "
-            "the scene so far. --dry-run prints every track's frame map and borders instead. See "
-            "motiontheater.scene.read_recipe for the recipe's keys."
-        ),
+            "the scene so far. --dry-run prints every track's frame map and borders instead."
+        )
+        + SCENE_HELP,
+        epilog="Example: motiontheater combine scene.toml --dry-run; motiontheater combine scene.toml -o out.amc",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     recipe.add_argument("recipe", help="the TOML recipe")
     recipe.add_argument("-o", "--output", help="the take to write (.amc or .bvh, as the motions)")
@@ -460,7 +473,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminated) if main_thread else None
     try:
-        return int(args.run(args))
+        status = int(args.run(args))
+        sys.stdout.flush()  # here, where a closed pipe is caught, not at exit
+        return status
     except KeyboardInterrupt:
         print(f"motiontheater {args.verb}: interrupted; nothing was left half-written", file=sys.stderr)
         return 130

@@ -36,12 +36,12 @@ def interpolate(
     frames: Annotated[tuple[int, int], "the key frames A:B; the frames between them are replaced"],
     joints: Annotated[Joints, "joints to interpolate, comma-separated (default: all)"] = None,
 ) -> Motion:
-    """A new motion whose frames strictly between the keys interpolate them.
+    """A new motion whose frames strictly between the key frames A and B interpolate the keys.
 
-    ``method`` is "slerp" (quaternions, the short arc), "euler" (linear on
-    the stored angles), "expmap" (linear on exponential maps) or
-    "aligned_expmap" (the first key flipped to the second key's hemisphere,
-    so that it too takes the short way).  Joints with other than three
+    The interpolators (``method``): slerp (quaternions, the short arc),
+    euler (linear on the stored angles), expmap (linear on exponential
+    maps) and aligned_expmap (the first key flipped to the second key's
+    hemisphere, so that it too takes the short way).  Joints with other than three
     rotation channels, and every translation, interpolate linearly.  The
     Euler angles written continue from the first key (no 360-degree jumps).
     """
