@@ -68,7 +68,7 @@ def _split_header(data: Text) -> tuple[list[tuple[int, str]], int, int]:
         lines += 1
         if line:
             header.append((lines, decode(line)))
-        pos = end + (2 if data[end : end + 2] == b"\r\n" else 1)
+        pos = min(len(data), end + (2 if data[end : end + 2] == b"\r\n" else 1))
     return header, pos, lines
 
 

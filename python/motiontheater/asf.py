@@ -267,18 +267,20 @@ def _asf_lines(s: Skeleton):
     yield f"   position {_num(*s.root.position)}"
     yield f"   orientation {_num(*s.root.orientation)}"
     yield ":bonedata"
-    for i, bone in enumerate(s.bones, start=1):
+    for bone in s.bones:
         yield "  begin"
-        yield f"     id {bone.id if bone.id is not None else i}"
+        if bone.id is not None:  # an id the file did not give is not made up
+            yield f"     id {bone.id}"
         yield f"     name {bone.name}"
         yield f"     direction {_num(*bone.direction)}"
         yield f"     length {_num(bone.length)}"
         yield f"     axis {_num(*bone.axis)} {bone.axis_order}"
         if bone.dofs:
             yield f"     dof {' '.join(bone.dofs)}"
+        # other keys before the limits: a key line that looks like "(lo hi)" must not follow them
+        yield from (f"     {key} {value}".rstrip() for key, value in bone.extra)
         for j, (lo, hi) in enumerate(bone.limits):
             yield f"     {'limits' if j == 0 else '      '} ({_num(lo)} {_num(hi)})"
-        yield from (f"     {key} {value}".rstrip() for key, value in bone.extra)
         yield "  end"
     yield ":hierarchy"
     yield "  begin"
