@@ -372,6 +372,24 @@ static int to_binary(uint64_t w, int q, uint64_t *bits)
     return settled;
 }
 
+int number_decimal(uint64_t w, int64_t q, uint64_t *bits)
+{
+    if (w == 0 || q < POW10_MIN) { /* zero, or below 10^-324: nearer to zero than to any double */
+        *bits = 0;
+        return 1;
+    }
+    if (q > 308) {
+        *bits = EXP_BITS;
+        return 1;
+    }
+    if (w <= (UINT64_C(1) << 53) && q >= -22 && q <= 22) {
+        const double v = exact_decimal(w, (int)q);
+        memcpy(bits, &v, sizeof v);
+        return 1;
+    }
+    return to_binary(w, (int)q, bits);
+}
+
 /*
  * The double nearest the decimal whose mantissa characters are [p, end) (digits and at most
  * one '.') times 10^exp, found by comparing with the boundaries around `guess` (at most a
@@ -476,7 +494,7 @@ int number_parse(const char *p, const char *end, double *out)
     /* The first 19 significant digits go into w; the value is about w 10^q. */
     const char *mantissa = p;
     uint64_t w = 0;
-    int kept = 0, point = 0, any = 0, truncated = 0;
+    int kept = 0, point = 0, any = 0, truncated = 0; /* w has `kept` digits */
     int64_t q = 0;
     for (; p < end; p++) {
         if (is_digit(*p)) {
@@ -517,23 +535,11 @@ int number_parse(const char *p, const char *end, double *out)
     if (p != end)
         return 0;
     q += exp;
-    const int64_t lead = q + kept - 1; /* the value is in [10^lead, 10^(lead+1)) */
-    if (w == 0 || lead < -324) {       /* below half the smallest subnormal: zero */
-        bits = 0;
-    } else if (lead > 308) {
-        bits = EXP_BITS;
-    } else if (!truncated && w <= (UINT64_C(1) << 53) && q >= -22 && q <= 22) {
-        const double v = exact_decimal(w, (int)q);
-        memcpy(&bits, &v, sizeof bits);
-    } else {
-        /* The value lies in [w 10^q, (w + 1) 10^q) when digits were dropped: settled when
-           both ends round to the same double. */
-        uint64_t upper = 0;
-        const int settled = to_binary(w, (int)q, &bits) && (!truncated || (to_binary(w + 1, (int)q, &upper) &&
-                                                                            upper == bits));
-        if (!settled)
-            bits = exact_binary(mantissa, mantissa_end, exp, bits);
-    }
+    /* The value lies in [w 10^q, (w + 1) 10^q) when digits were dropped: settled when both
+       ends round to the same double. */
+    uint64_t upper;
+    if (!number_decimal(w, q, &bits) || (truncated && (!number_decimal(w + 1, q, &upper) || upper != bits)))
+        bits = exact_binary(mantissa, mantissa_end, exp, bits);
     bits |= sign;
     memcpy(out, &bits, sizeof bits);
     return 1;

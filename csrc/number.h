@@ -33,6 +33,12 @@ static inline double exact_decimal(uint64_t m, int e)
     return e < 0 ? (double)m / exact_pow10[-e] : (double)m * exact_pow10[e];
 }
 
+/*
+ * The bits of the double nearest w 10^q (any w and q), returning 1, where that takes no big
+ * integers (nearly always); else 0, *bits then at most one step off.
+ */
+int number_decimal(uint64_t w, int64_t q, uint64_t *bits);
+
 /* The token [p, end) read by the grammar above into *out; 1 if it is a number, 0 if not. */
 int number_parse(const char *p, const char *end, double *out);
 

@@ -89,13 +89,20 @@ static const char *parse_number(const char *p, const char *end, double *out)
             p = e;
         }
     }
-    if (digits > 0 && exact && (p == end || is_blank(*p) || is_eol(*p)) &&
-        mantissa <= ((uint64_t)1 << 53) && exp10 >= -22 && exp10 <= 22) {
-        const double v = exact_decimal(mantissa, exp10);
-        *out = negative ? -v : v;
-        return p;
+    if (digits > 0 && exact && (p == end || is_blank(*p) || is_eol(*p))) {
+        if (mantissa <= ((uint64_t)1 << 53) && exp10 >= -22 && exp10 <= 22) {
+            const double v = exact_decimal(mantissa, exp10);
+            *out = negative ? -v : v;
+            return p;
+        }
+        uint64_t bits; /* 16 to 19 digits, or large exponents */
+        if (number_decimal(mantissa, exp10, &bits)) {
+            bits |= (uint64_t)negative << 63;
+            memcpy(out, &bits, sizeof bits);
+            return p;
+        }
     }
-    const char *stop = token_end(start, end); /* inf, nan, long or odd forms */
+    const char *stop = token_end(start, end); /* inf, nan, long or odd forms, ties */
     return number_parse(start, stop, out) ? stop : NULL;
 }
 

@@ -345,7 +345,7 @@ def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers:
             )
 
         statuses = run_all([piece(i) for i in range(len(pieces))])
-    for (begin, _, _, count), report, status in zip(pieces, reports, statuses):
+    for (begin, _, _, _), report, status in zip(pieces, reports, statuses):
         if status == lib.MT_OK:
             continue
         lines_before = line_breaks(text, start, begin)
@@ -362,12 +362,8 @@ def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers:
                     at,
                     False,
                 )
-            return (
-                f"the header says {rows} frames but the data holds "
-                f"{report.frames + sum(p[3] for p in pieces if p[0] < begin)} (truncated?)",
-                at,
-                True,
-            )
+            held = report.frames + sum(p[3] for p in pieces if p[0] < begin)
+            return f"the header says {rows} frames but the data holds {held} (truncated?)", at, True
 
         if status == lib.MT_ERANGE:
             raise SequenceError(f"the header says {rows} frames but the data holds more", lines_before + report.line)
