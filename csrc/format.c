@@ -14,18 +14,24 @@ static const char digit_pairs[201] = "000102030405060708091011121314151617181920
                                      "50515253545556575859606162636465666768697071727374"
                                      "75767778798081828384858687888990919293949596979899";
 
+/* The eight digits of v < 10^8 at p, as two independent halves. */
+static inline void put_eight(char *p, uint32_t v)
+{
+    const uint32_t high = v / 10000, low = v % 10000;
+    memcpy(p, digit_pairs + 2 * (high / 100), 2);
+    memcpy(p + 2, digit_pairs + 2 * (high % 100), 2);
+    memcpy(p + 4, digit_pairs + 2 * (low / 100), 2);
+    memcpy(p + 6, digit_pairs + 2 * (low % 100), 2);
+}
+
 /* Writes the decimal digits of v so that they end at `end`; returns where they begin. */
 static char *digits_before(uint64_t v, char *end)
 {
     char *p = end;
-    while (v >= 100000000) { /* eight digits in 32-bit arithmetic */
-        uint32_t low = (uint32_t)(v % 100000000);
+    while (v >= 100000000) {
+        p -= 8;
+        put_eight(p, (uint32_t)(v % 100000000));
         v /= 100000000;
-        for (int i = 0; i < 4; i++) {
-            p -= 2;
-            memcpy(p, digit_pairs + 2 * (low % 100), 2);
-            low /= 100;
-        }
     }
     uint32_t rest = (uint32_t)v;
     while (rest >= 100) {
