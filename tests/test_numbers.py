@@ -4,6 +4,7 @@ every bit pattern class, the grammar, the locale, frame numbers and the buffer b
 Python's repr, '%.Ng' and float() are the slow twins: correctly rounded, locale-free.
 """
 
+import io
 import math
 import re
 import struct
@@ -18,6 +19,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from mtcore._mtcore import ffi, lib
 
+import motiontheater as mt
 from mtcore.errors import NumberError, SequenceError
 from mtcore.text import (
     FRAME_MAX,
@@ -517,3 +519,36 @@ def test_the_table_generator_is_committed():
         pytest.skip("csrc/ not beside the tests (an installed copy)")
     done = subprocess.run([sys.executable, str(csrc / "gen_pow10.py")], capture_output=True, text=True, check=True)
     assert done.stdout == (csrc / "number_pow10.h").read_text()
+
+
+# ---- the readers of header numbers use the same grammar --------------------------------------
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        (b"OFFSET 0.00 0.00 0.00", b"OFFSET 1_0 0.00 0.00"),
+        (b"OFFSET 0.00 0.00 0.00", b"OFFSET 0x10 0.00 0.00"),
+        (b"Frame Time: 0.033333", b"Frame Time: 0x1p-5"),
+        (b"Frame Time: 0.033333", b"Frame Time: 3_3e-3"),
+        (b"Frames: 2", b"Frames: 0_2"),
+    ],
+)
+def test_bvh_header_numbers_follow_the_grammar(change):
+    bvh = (
+        b"HIERARCHY\nROOT hip\n{\n\tOFFSET 0.00 0.00 0.00\n\tCHANNELS 3 Xposition Yposition Zposition\n"
+        b"\tEnd Site\n\t{\n\t\tOFFSET 0 1 0\n\t}\n}\nMOTION\nFrames: 2\nFrame Time: 0.033333\n1 2 3\n4 5 6\n"
+    )
+    assert mt.read_bvh(io.BytesIO(bvh)).frames == 2
+    with pytest.raises(mt.FormatError, match="expected"):
+        mt.read_bvh(io.BytesIO(bvh.replace(*change)))
+
+
+@pytest.mark.parametrize("token", ["1_0", "0x1p3", "nan(1)", "\u0661"])
+def test_asf_numbers_follow_the_grammar(data_dir, token):
+    asf = (data_dir / "cmu" / "01.asf").read_bytes()
+    line = re.compile(rb"(?m)^\s*length (\S+)").search(asf, asf.index(b":bonedata"))
+    bad = asf[: line.start(1)] + token.encode() + asf[line.end(1) :]
+    with pytest.raises(mt.NumberError, match=re.escape(f"expected a number for length, found '{token}'")) as caught:
+        mt.read_asf(io.BytesIO(bad))
+    assert caught.value.line == asf[: line.start(1)].count(b"\n") + 1
