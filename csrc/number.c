@@ -260,7 +260,8 @@ uint64_t number_shortest(double a, int *exp10)
     const int narrow_below = c == (UINT64_C(1) << 52) && q > -1074;
     const uint64_t cbl = narrow_below ? cb - 1 : cb - 2;
     /* 10^k is the largest power of ten not above the interval's width (3/4 2^q when narrow):
-       the interval then holds one or two multiples of 10^k and at most one of 10^(k+1). */
+       the interval then holds a multiple of 10^k (the nearest to a is s or s + 1 below) and
+       at most one of 10^(k+1). */
     const int k = narrow_below ? floor_log10_three_quarters_pow2(q) : floor_log10_pow2(q);
     const int h = q + floor_log2_pow10(-k) + 2;
     const uint64_t vb = round_to_odd(-k, cb << h); /* 4 a / 10^k, rounded to odd */
@@ -296,7 +297,7 @@ uint64_t number_rounded(double a, int digits, int *exp10)
         const int k = e10 - digits + 1, r = floor_log2_pow10(-k) - 125;
         int exact;
         const struct u192 prod = times_pow10(cn, -k, &exact);
-        const int s = -(qn + r + 1) - 128; /* 2x < 2^58 and prod >= 2^188 make 2 <= s <= 61 */
+        const int s = -(qn + r + 1) - 128; /* 2 <= 2x < 2^61, 2^188 <= prod < 2^190: 0 <= s <= 61 */
         uint64_t twice = prod.hi >> s;     /* floor(2x), unless x is too near a half-integer */
         const uint64_t rest_hi = prod.hi & ((UINT64_C(1) << s) - 1);
         int whole; /* 2x is an integer */

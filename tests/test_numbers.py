@@ -171,7 +171,11 @@ def test_digits_are_correctly_rounded(rng, digits):
     mocap = (rng.uniform(-400, 400, 5000) / 7).tolist()
     # exact ties at N digits: dyadic values with N + 1 significant digits ending in 5
     ties = [m / 2**j for j in range(1, 12) for m in range(1, 4000, 2)]
-    values = [x for x in patterns + mocap + ties if math.isfinite(x)]
+    # either side of each power of ten, where the decimal exponent is first guessed one too low
+    decades = [
+        y for e in range(-323, 309) for y in (10.0**e, math.nextafter(10.0**e, 0), math.nextafter(10.0**e, 1e309))
+    ]
+    values = [x for x in patterns + mocap + ties + decades if math.isfinite(x) and x != 0]
     values += [0.0, -0.0, 9.5, 0.95, 99.5, 9.9999999999999999e22, 5e-324, 1.7976931348623157e308]
     texts = written(values, digits=digits)
     bad = [(x.hex(), t, g_text(x, digits)) for x, t in zip(values, texts) if t != g_text(x, digits)]
