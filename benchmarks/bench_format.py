@@ -18,11 +18,11 @@ from pathlib import Path
 import cffi
 import numpy as np
 import pytest
-from mtcore._mtcore import ffi, lib
 
 import motiontheater as mt
 import mtcore
 from conftest import DATA, repeated_take
+from mtcore._mtcore import ffi, lib
 
 FRAMES = 125_000
 FAST = dict(rounds=5, iterations=1, warmup_rounds=1)

@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from mtcore._mtcore import ffi, lib
 
 import motiontheater as mt
+from mtcore._mtcore import ffi, lib
 from mtcore.errors import NumberError, SequenceError
 from mtcore.text import (
     FRAME_MAX,

@@ -432,7 +432,7 @@ def format_number(value: float, *, digits: int | None = None, exponent_digits: i
     buf = ffi.new("char[]", lib.MT_NUMBER_MAX)
     written = ffi.new("size_t *")
     check(lib.mt_format_double(float(value), _style(digits, exponent_digits), buf, written), "mt_format_double")
-    return ffi.unpack(buf, written[0]).decode("ascii")
+    return bytes(ffi.buffer(buf, written[0])).decode("ascii")
 
 
 def parse_number(token: str | bytes) -> float:
@@ -444,7 +444,9 @@ def parse_number(token: str | bytes) -> float:
     """
     data = token.encode("ascii", "replace") if isinstance(token, str) else bytes(token)
     value = ffi.new("double *")
-    if lib.mt_parse_number(data, len(data), value) != lib.MT_OK:
+    with ffi.from_buffer(data) as c_data:
+        status = lib.mt_parse_number(c_data, len(data), value)
+    if status != lib.MT_OK:
         shown = token if isinstance(token, str) else data.decode("ascii", "replace")
         raise NumberError(f"expected {_GRAMMAR}, found '{shown}'")
     return value[0]
