@@ -6,19 +6,20 @@ import re
 
 from mtcore import format_number
 from mtcore.errors import CountError, DuplicateError, FormatError, MissingError, NumberError, TruncatedError
+from mtcore.text import parse_number
 
 from ._io import LINE_BREAK, Source, decode, encode, output, read_source
 from ._version import __version__
 from .skeleton import BONE_DOFS, ROOT_DOFS, Bone, Root, Skeleton, canonical_hierarchy, name_problem
 
-_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|infinity|nan)", re.IGNORECASE)
 _LIMIT = re.compile(r"\(\s*(\S+)\s+(\S+)\s*\)")
 
 
 def _number(token: str, line: int, what: str) -> float:
-    if not _NUMBER.fullmatch(token):
-        raise NumberError(f"expected a number for {what}, found '{token}'", line)
-    return float(token)
+    try:
+        return parse_number(token)  # the grammar of every format's numbers
+    except NumberError:
+        raise NumberError(f"expected a number for {what}, found '{token}'", line) from None
 
 
 def _numbers(tokens: list[str], count: int, line: int, what: str) -> tuple[float, ...]:
