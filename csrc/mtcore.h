@@ -162,7 +162,7 @@ enum mt_newline {
 };
 
 /*
- * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF}.
+ * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF}.
  *
  *   digits           0: the shortest text that reads back as exactly the value, of
  *                    those the nearest to it (the digits of Python's repr); exponent
@@ -174,11 +174,14 @@ enum mt_newline {
  *   exponent_digits  the fewest digits of an exponent, 1 .. 3: 2 gives 1e-05 (Python,
  *                    C on Linux), 3 gives 1e-005 (HDM05 files, C on Windows).
  *   newline          the line ending of mt_format_frames and mt_format_table.
+ *   frame_newline    the ending of the lines that hold only a frame number
+ *                    (mt_format_frames): HDM05 ends those in LF, every other in CRLF.
  */
 struct mt_format_style {
     int digits;
     int exponent_digits;
     int newline;
+    int frame_newline;
 };
 
 /* Bytes a number can take: -1.2345678901234567e-308. */
