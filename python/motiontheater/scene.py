@@ -8,9 +8,8 @@ import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from .amc import read_amc, skeleton_path_for
-from .asf import read_asf
 from .combine import Plan, combine_planned
+from .formats import read_take
 from .motion import Motion
 
 if sys.version_info >= (3, 11):
@@ -104,12 +103,12 @@ def read_recipe(path: str | os.PathLike) -> Scene:
     if base is None:
         raise ValueError(f'{path}: the recipe needs [base] with motion = "FILE.amc"')
     base = where(base, "base.motion")
-    skeleton = read_asf(where(recipe["skeleton"], "skeleton") if "skeleton" in recipe else skeleton_path_for(base))
+    skeleton = where(recipe["skeleton"], "skeleton") if "skeleton" in recipe else None
     rate = recipe.get("frame_rate")
 
     @functools.cache  # a take used by several tracks is read once; motions are read-only
     def motion(file: Path) -> Motion:
-        return read_amc(file, skeleton, frame_rate=rate)
+        return read_take(file, skeleton, frame_rate=rate)
 
     scene = Scene(motion(base))
     for n, track in enumerate(recipe.get("track", []), start=1):
