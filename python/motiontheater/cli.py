@@ -8,6 +8,7 @@ apply, batch, combine, bench) are written out below.
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import sys
 import time
@@ -434,12 +435,23 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _show_notes() -> None:
+    """Print what steps note on the package's logger (a cut-off chosen, gaps left) to stderr."""
+    logger = logging.getLogger("motiontheater")
+    if not logger.handlers:
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("%(message)s"))
+        logger.addHandler(handler)
+        logger.setLevel(logging.INFO)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.verb is None:
         parser.print_help()
         return 0
+    _show_notes()
     try:
         return int(args.run(args))
     except (ValueError, TypeError, OSError, RuntimeError) as exc:

@@ -95,7 +95,7 @@ _BACKGROUNDS: dict[str, Callable[..., np.ndarray]] = {
     "minimum": np.min,
     "maximum": np.max,
 }
-_EXTENSIONS = ("constant", "line", "edge", "smooth", "symmetric", "reflect", "wrap")
+_EXTENSIONS = ("constant", "line", "edge", "smooth", "symmetric", "reflect", "wrap", "antisymmetric", "antireflect")
 
 
 # ---------------------------------------------------------------------------
@@ -536,21 +536,30 @@ def residual_cutoff(
 
 
 def rational_ratio(new_rate: float, old_rate: float, *, limit: int = 100_000) -> tuple[int, int]:
-    """(up, down), coprime, with new_rate / old_rate = up / down, the rates read as the decimals
-    they print as (119.875 -> 120 gives (960, 959); 29.97 from 120 gives (999, 4000)).  ValueError when
-    up or down would exceed ``limit`` (the FIR filter is 20 max(up, down) + 1 taps long)."""
+    """(up, down), coprime, with up / down = new_rate / old_rate.
+
+    The rates are read as the decimals they print as, so that 119.875 to 120
+    is exactly 960/959 and 120 to 29.97 is 999/4000.  Where that fraction needs
+    terms above ``limit`` (the FIR filter is 20 max(up, down) + 1 taps long),
+    the simplest fraction within 1e-6 of the ratio is taken: a BVH frame time
+    of 0.0416667 s is 24 frames per second to that precision, so 24 to 60 is
+    5/2.  ValueError when no fraction with terms up to ``limit`` is that close.
+    """
     for name, rate in (("new rate", new_rate), ("old rate", old_rate)):
         if not (isinstance(rate, (int, float, np.integer, np.floating)) and math.isfinite(rate) and rate > 0):
             raise ValueError(f"the {name} must be a positive number of frames per second, got {rate!r}")
     ratio = Fraction(repr(float(new_rate))) / Fraction(repr(float(old_rate)))
-    if max(ratio.numerator, ratio.denominator) > limit:
-        near = ratio.limit_denominator(1000)
-        raise ValueError(
-            f"resampling from {old_rate:g} to {new_rate:g} frames per second needs the ratio "
-            f"{ratio.numerator}/{ratio.denominator}, which makes too long a filter; "
-            f"a rate of {float(old_rate * near):g} ({near.numerator}/{near.denominator}) would do"
-        )
-    return ratio.numerator, ratio.denominator
+    if max(ratio.numerator, ratio.denominator) <= limit:
+        return ratio.numerator, ratio.denominator
+    # the continued fraction's convergents, simplest first, until one is within 1e-6
+    for terms in (2**k for k in range(int(math.log2(limit)) + 1)):
+        near = ratio.limit_denominator(terms)
+        if near and max(near.numerator, near.denominator) <= limit and abs(near / ratio - 1) <= 1e-6:
+            return near.numerator, near.denominator
+    raise ValueError(
+        f"resampling from {float(old_rate):g} to {float(new_rate):g} frames per second needs the ratio "
+        f"{ratio.numerator}/{ratio.denominator}, which makes too long a filter; give rates in a simpler ratio"
+    )
 
 
 def _lowpass_fir(taps: int, cutoff: float, window) -> np.ndarray:
@@ -591,6 +600,16 @@ def _extension(lines: np.ndarray, rows: np.ndarray, padtype: str, cval: float) -
         edge = np.where(before[:, None], lines[0], lines[-1])
         steps = np.where(before, rows, rows - (n - 1)).astype(np.float64)
         return edge + steps[:, None] * slopes
+    if padtype == "antireflect":  # point reflections about both ends: a shift of 2 (n - 1) rows adds 2 (last - first)
+        if n == 1:
+            return np.repeat(lines, len(rows), axis=0)
+        period = 2 * (n - 1)
+        turns, m = np.divmod(rows, period)
+        base = np.where((m <= n - 1)[:, None], lines[np.minimum(m, n - 1)], 2 * lines[-1] - lines[np.abs(period - m) % n])
+        return base + (2 * turns)[:, None] * (lines[-1] - lines[0])
+    if padtype == "antisymmetric":  # a b c d | -d -c -b -a | a b c d ...
+        m = rows % (2 * n)
+        return np.where((m < n)[:, None], lines[np.minimum(m, n - 1)], -lines[np.clip(2 * n - 1 - m, 0, n - 1)])
     if padtype == "edge":
         index = np.clip(rows, 0, n - 1)
     elif padtype == "wrap":
@@ -628,8 +647,11 @@ def resample_poly(
     towards 0, as scipy's default), "line" (the line through the first and
     last samples continued: a constant or a straight line stays exact),
     "edge", "smooth" (each end's slope continued), "symmetric", "reflect",
-    "wrap", or "mean", "median", "minimum", "maximum" (that value subtracted
-    before and added back after, the ends padded with zeros).
+    "wrap", "antisymmetric" (the mirrored line negated), "antireflect" (the
+    line turned half a turn about each end sample: slopes continue, so a
+    straight line stays straight), or "mean", "median", "minimum", "maximum"
+    (that value subtracted before and added back after, the ends padded with
+    zeros).
     """
     a = _float_array(x)
     axis = _axis(a, axis)
