@@ -11,24 +11,14 @@ here.
 
 from mtcore import binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
 
-from . import convert, export, filtering, interpolators, signal  # noqa: F401 (importing them registers their steps)
+from . import convert, errors, export, filtering, interpolators, signal  # noqa: F401 (importing them registers their steps)
 from ._version import __version__
 from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
 from .bvh import read_bvh, write_bvh
 from .combine import combine
 from .convert import to_asf, to_bvh
-from .errors import (
-    CountError,
-    DuplicateError,
-    FormatError,
-    HierarchyError,
-    MissingError,
-    NumberError,
-    SequenceError,
-    TruncatedError,
-    UnknownNameError,
-)
+from .errors import *  # the exceptions, errors.__all__
 from .export import write_positions
 from .filtering import filter_motion
 from .formats import read_take, write_take
@@ -42,22 +32,13 @@ from .skeleton import Bone, Root, Skeleton
 __all__ = [
     "DEFAULT_FRAME_RATE",
     "Bone",
-    "CountError",
-    "DuplicateError",
-    "FormatError",
-    "HierarchyError",
-    "MissingError",
     "Motion",
-    "NumberError",
     "Pipeline",
     "Root",
     "Scene",
-    "SequenceError",
     "Skeleton",
     "StepError",
     "Track",
-    "TruncatedError",
-    "UnknownNameError",
     "__version__",
     "binomial_filter1d",
     "combine",
@@ -82,3 +63,4 @@ __all__ = [
     "write_positions",
     "write_take",
 ]
+__all__ += errors.__all__

@@ -54,6 +54,8 @@ class Job:
 
 @dataclass
 class Result:
+    """What became of one take: where it went, whether it worked, and what it cost."""
+
     input: str
     output: str
     ok: bool = True
@@ -196,6 +198,7 @@ class Progress:
         self.enabled = sys.stderr.isatty() if enabled is None else enabled
 
     def advance(self, result: Result) -> None:
+        """Count a finished take and redraw the bar."""
         self.done_files += 1
         self.done_bytes += result.bytes
         if not self.enabled:
@@ -213,20 +216,25 @@ class Progress:
         sys.stderr.flush()
 
     def close(self) -> None:
+        """End the bar's line."""
         if self.enabled:
             sys.stderr.write("\n")
 
 
 @dataclass
 class Summary:
+    """Every take's result and the run's time: what the batch command reports."""
+
     results: list[Result] = field(default_factory=list)
     seconds: float = 0.0
 
     @property
     def failed(self) -> list[Result]:
+        """The takes that failed."""
         return [r for r in self.results if not r.ok]
 
     def as_dict(self) -> dict:
+        """The totals and failures, ready for JSON."""
         done = [r for r in self.results if r.ok and not r.skipped]
         processed = sum(r.bytes for r in done)
         return {
@@ -242,6 +250,7 @@ class Summary:
         }
 
     def text(self) -> str:
+        """The totals in a line, then a line per failure."""
         d = self.as_dict()
         lines = [
             f"{d['processed']} processed, {d['skipped']} skipped (already done), {d['failed']} failed "
@@ -345,6 +354,7 @@ def _run_dask(jobs: list[Job], workers: int, scheduler: str | None):
 
 
 def report_json(summary: Summary) -> str:
+    """The summary and every take's result as JSON text."""
     data = summary.as_dict()
     data["results"] = [asdict(r) for r in summary.results]
     return json.dumps(data, indent=2)

@@ -166,6 +166,7 @@ def _x(numerator: float | None, denominator: float | None) -> str:
 
 
 def markdown(report: dict) -> str:
+    """The report of :func:`measure` as Markdown tables, the thesis's table first."""
     scene, hour = report["scene"], report["hour"]
     frames, channels = scene["shape"]
     lines = [
@@ -207,4 +208,5 @@ def markdown(report: dict) -> str:
 
 
 def as_json(report: dict) -> str:
+    """The report of :func:`measure` as JSON text."""
     return json.dumps(report, indent=2)

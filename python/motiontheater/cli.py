@@ -308,6 +308,7 @@ def _shown(value: Any) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The parser of every verb: those written here and one per registered step."""
     parser = argparse.ArgumentParser(
         prog="motiontheater",
         description=(
@@ -446,6 +447,7 @@ def _show_notes() -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status (2 with a one-line reason on failure)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.verb is None:

@@ -15,6 +15,7 @@ import math
 import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -267,21 +268,7 @@ def _ramps(rows: np.ndarray, next_row: np.ndarray, ramp: np.ndarray) -> None:
     ramp[:] = np.where(has_next, position / lengths[for_run], 0.0)
 
 
-def combine(
-    old: Motion,
-    new: Motion,
-    *,
-    cut=None,
-    scale=None,
-    blend: int = 0,
-    preserve: str | None = None,
-    joints: Iterable[str] | None = None,
-    discard_old: bool = False,
-    interpolate: bool = False,
-    rotation_blend: str = "slerp",
-    up: str = "y",
-    workers: int | None = None,
-) -> Motion:
+def combine(old: Motion, new: Motion, **options: Any) -> Motion:
     """Lay ``new`` over ``old``: a new Motion (the inputs are not modified).
 
     - ``cut=(cf, ct)``: use frames cf..ct of ``new`` (default all of it).
@@ -306,60 +293,38 @@ def combine(
       of repeated frames become linear ramps to the next source frame.
     - ``rotation_blend``: "slerp" (quaternions, for joints with three rotation
       channels) or "linear" on the stored Euler angles (the thesis).
-    Raises ValueError naming the argument at fault.
+    - ``up``: the vertical axis for "ground" ("x", "y" or "z"; "y" by default).
+    - ``workers``: threads, as for the filters.
+    Raises ValueError naming the argument at fault.  The options and their
+    defaults are those of :func:`combine_planned` and :func:`plan`.
     """
-    return combine_planned(
-        old,
-        new,
-        cut=cut,
-        scale=scale,
-        blend=blend,
-        preserve=preserve,
-        joints=joints,
-        discard_old=discard_old,
-        interpolate=interpolate,
-        rotation_blend=rotation_blend,
-        up=up,
-        workers=workers,
-    )[1]
+    return combine_planned(old, new, **options)[1]
 
 
 def combine_planned(
     old: Motion,
     new: Motion,
     *,
-    cut=None,
-    scale=None,
-    blend: int = 0,
-    preserve: str | None = None,
     joints: Iterable[str] | None = None,
-    discard_old: bool = False,
-    interpolate: bool = False,
     rotation_blend: str = "slerp",
     up: str = "y",
     workers: int | None = None,
+    **frame_map: Any,
 ) -> tuple[Plan, Motion]:
-    """:func:`combine`, returning the frame map it followed as well."""
+    """:func:`combine`, returning the frame map it followed as well; the options that make the
+    frame map (cut, scale, blend, preserve, discard_old, interpolate) are :func:`plan`'s."""
     if rotation_blend not in ROTATION_BLENDS:
         raise ValueError(f"rotation_blend must be one of {ROTATION_BLENDS}, got {rotation_blend!r}")
     if up not in UP_AXES:
         raise ValueError(f"up must be one of {UP_AXES}, got {up!r}")
     skeleton = old.skeleton
+    discard_old = frame_map.get("discard_old", False)
     chosen = skeleton.joint_names if joints is None or discard_old else tuple(joints)
     chosen = tuple("root" if skeleton.is_root(joint) else joint for joint in chosen)
     for joint in chosen:
         if not skeleton.has_joint(joint):
             raise UnknownNameError(f"joints: no joint '{joint}' in skeleton '{skeleton.name}'")
-    p = plan(
-        old,
-        new,
-        cut=cut,
-        scale=scale,
-        blend=blend,
-        preserve=preserve,
-        discard_old=discard_old,
-        interpolate=interpolate,
-    )
+    p = plan(old, new, **frame_map)
     selected = np.zeros(len(skeleton.channels), np.uint8)
     for joint in chosen:
         selected[old.columns(joint)] = 1

@@ -40,6 +40,7 @@ class TakeStats:
 
     @classmethod
     def of(cls, values: np.ndarray) -> TakeStats:
+        """The statistics of the first frames of a take."""
         return cls(values.min(axis=0), values.max(axis=0), values[0].copy())
 
     def update(self, values: np.ndarray) -> None:
@@ -86,6 +87,7 @@ class Smoother:
 
     @property
     def halo(self) -> int:
+        """Frames either side of a frame that its smoothed value depends on."""
         return self.size // 2
 
     @property

@@ -132,26 +132,11 @@ class Motion:
             raise AttributeError(f"'Motion' object has no attribute {name!r}")
         return lambda **options: self.apply(name, **options)
 
-    def filter(
-        self,
-        kind: str,
-        size: int,
-        joints: Iterable[str] | None = None,
-        *,
-        translation: bool = True,
-        mode: str = "nearest",
-        workers: int | None = None,
-    ) -> Motion:
+    def filter(self, kind: str, size: int, joints: Iterable[str] | None = None, **options: Any) -> Motion:
         """Smoothed over frames by the filter step ``kind`` ("median", "mean" or "binomial") of
-        ``size`` frames: see :func:`motiontheater.filtering.filter_motion`."""
-        return self.apply(
-            kind,
-            size=size,
-            joints=None if joints is None else tuple(joints),
-            translation=translation,
-            mode=mode,
-            workers=workers,
-        )
+        ``size`` frames, the ``joints`` given or all; the options (translation, mode, workers) are
+        those of :func:`motiontheater.filtering.filter_motion`."""
+        return self.apply(kind, size=size, joints=None if joints is None else tuple(joints), **options)
 
     def crop(self, first: int, last: int) -> Motion:
         """Frames ``first`` .. ``last`` (frame numbers, both included) as a motion of their own."""

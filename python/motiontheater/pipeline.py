@@ -48,9 +48,11 @@ class Entry:
 
     @property
     def step(self) -> Step:
+        """The registered step."""
         return lookup(self.name)
 
     def apply(self, motion: Motion) -> Motion:
+        """The motion after this step."""
         return self.step(motion, **dict(self.options))
 
 

@@ -52,14 +52,17 @@ class Option:
 
     @property
     def required(self) -> bool:
+        """Whether the option has no default."""
         return self.default is REQUIRED
 
     @property
     def flag(self) -> str:
+        """The command-line flag: --name-with-dashes."""
         return "--" + self.name.replace("_", "-")
 
     @property
     def metavar(self) -> str | None:
+        """How the flag's value is shown in --help."""
         return {
             "int": "N",
             "float": "X",
@@ -187,6 +190,7 @@ class Step:
 
     @property
     def is_exporter(self) -> bool:
+        """Whether this writes a file (an exporter) rather than returning a motion."""
         return bool(self.suffixes)
 
     @property

@@ -41,6 +41,7 @@ class Scene:
     tracks: tuple[Track, ...] = ()
 
     def add(self, motion: Motion, name: str = "", **options) -> Scene:
+        """This scene with a track more: ``motion`` laid over it with :func:`~motiontheater.combine.combine` ``options``."""
         unknown = set(options) - set(TRACK_OPTIONS)
         if unknown:
             raise ValueError(
@@ -49,6 +50,7 @@ class Scene:
         return replace(self, tracks=(*self.tracks, Track(motion, dict(options), name)))
 
     def render(self, workers: int | None = None) -> Motion:
+        """The motion of the base with every track applied in order."""
         steps = self._apply(workers)
         return steps[-1][2] if steps else self.base
 

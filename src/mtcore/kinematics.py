@@ -79,6 +79,7 @@ class JointTree:
 
     @property
     def joints(self) -> int:
+        """The number of joints."""
         return len(self.parent)
 
 
