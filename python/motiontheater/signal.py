@@ -153,9 +153,7 @@ def equalize(
         )
     if not motion.frames or all(g == 1 for g in gains):  # every band as it is: the motion itself, exactly
         return motion.replace(values=motion.values)
-    values = _filtered(
-        motion, rotations, others, lambda x: sg.equalize(x, gains, axis=0, mode=mode, workers=workers)
-    )
+    values = _filtered(motion, rotations, others, lambda x: sg.equalize(x, gains, axis=0, mode=mode, workers=workers))
     return motion.replace(values=values)
 
 
@@ -311,13 +309,42 @@ def _resampled_lines(x: np.ndarray, up: int, down: int, workers: int | None) -> 
     and straight lines come out exact; the rest is filtered by resample_poly, its ends
     extended by point reflection (slopes continue, nothing rings)."""
     n = len(x)
-    n_out = -(-n * up // down)
+    n_out = (n - 1) * up // down + 1  # frames from the first to the last frame's time, no later
     if n < 2:
         return np.repeat(x, n_out, axis=0)
     slope = (x[-1] - x[0]) / (n - 1)
     line_in = x[0] + np.arange(n)[:, None] * slope
     line_out = x[0] + (np.arange(n_out) * down / up)[:, None] * slope
-    return sg.resample_poly(x - line_in, up, down, axis=0, padtype="antireflect", workers=workers) + line_out
+    rest = sg.resample_poly(x - line_in, up, down, axis=0, padtype="antireflect", workers=workers)
+    return rest[:n_out] + line_out
+
+
+def _steady_near_gimbal_lock(
+    path: np.ndarray,
+    angles: np.ndarray,
+    q_out: np.ndarray,
+    convention: tuple[str, bool, bool],
+    up: int,
+    down: int,
+    workers: int | None,
+) -> None:
+    """Near gimbal lock (the middle angle near +-90 degrees, or 0 and 180) a rotation's Euler angles
+    turn on a hair: the first and last angles of a rotation a fraction of a degree away can differ
+    by tens of degrees.  Where the angles from the resampled quaternions (``path``, frames x joints
+    x 3) leave the channels resampled one by one by more than 5 degrees while both give the same
+    rotation to within 0.5 degrees, the channels' own are kept (in place), so that no channel jumps."""
+    order, extrinsic, degrees = convention
+    n = len(angles)
+    direct = _resampled_lines(_unwrapped(angles.reshape(n, -1), 360.0 if degrees else 2 * math.pi), up, down, workers)
+    direct = direct.reshape(path.shape)
+    half = 180.0 if degrees else math.pi
+    apart = np.abs((path - direct + half) % (2 * half) - half).max(axis=-1)
+    if not np.any(apart > (5.0 if degrees else math.radians(5.0))):
+        return
+    q_direct = rot.euler_to_quaternions(direct, order, extrinsic=extrinsic, degrees=degrees)
+    turn = np.degrees(2 * np.arccos(np.clip(np.abs(np.sum(q_direct * q_out, axis=-1)), 0.0, 1.0)))
+    keep = (apart > (5.0 if degrees else math.radians(5.0))) & (turn < 0.5)
+    path[keep] = direct[keep]
 
 
 @step("resample", "change the frame rate (e.g. 120 to 30 Hz): anti-aliased, rotations as rotations", frames="none")
@@ -334,12 +361,14 @@ def resample(
 
     The rate ratio is taken exactly from the rates as written (119.875 to
     120 is 960/959), and frame j of the result lies at time j / rate from the
-    first frame, which keeps its number.  Translations and lone angles
+    first frame, which keeps its number, up to the time of the last frame (N
+    frames become floor((N - 1) new / old) + 1).  Translations and lone angles
     (joints with one or two rotation channels, unwrapped) go through the
     polyphase filter of ``scipy.signal.resample_poly`` (Kaiser window; it also
     removes what the lower rate cannot hold), less the line through the
     first and last frames, which is added back, so that a constant or a
-    straight line stays exact.  A joint with three rotation channels is
+    straight line stays exact (a joint that holds still is copied).  A joint
+    with three rotation channels is
     resampled as a rotation: its unit quaternions (signs made continuous) go
     through the same filter and are normalised, or, going to a higher rate
     with ``rotations="slerp"``, are interpolated by SLERP between the frames
@@ -358,7 +387,7 @@ def resample(
     n = motion.frames
     if n == 0:
         return motion.replace(values=motion.values, frame_rate=float(rate), header=header)
-    n_out = -(-n * up // down)
+    n_out = (n - 1) * up // down + 1  # the frames within the take's span (resample_poly may add up to one more)
     values = np.empty((n_out, len(motion.channels)))
     groups = skeleton.euler_groups()
     turned = {int(c) for _, _, cols in groups for c in cols.ravel()}
@@ -386,6 +415,9 @@ def resample(
         turned_angles = rot.quaternions_to_euler(q_out, order, extrinsic=extrinsic, degrees=degrees)
         # of the equivalent Euler triples, each frame's nearest the one before, from the take's first frame on
         path = rot.unroll_euler(np.concatenate([angles[:1], turned_angles]), order, degrees=degrees)[1:]
+        _steady_near_gimbal_lock(path, angles, q_out, (order, extrinsic, degrees), up, down, workers)
+        # a joint that holds still is copied: through quaternions its angles would come back to rounding
+        path[:, np.all(angles == angles[:1], axis=(0, 2))] = angles[0, np.all(angles == angles[:1], axis=(0, 2))]
         flat = path.reshape(n_out, -1)
         values[:, cols.ravel()] = _wrap_into(flat, *_ranges(angles.reshape(n, -1)), period)
     values.flags.writeable = False
@@ -410,8 +442,9 @@ class Gap(NamedTuple):
 
 def find_gaps(motion: Motion) -> list[Gap]:
     """Every run of NaN in the motion's channels, by channel then frame."""
+    channels = motion.channels
     return [
-        Gap(*motion.channels[column], motion.first_frame + first, motion.first_frame + stop - 1)
+        Gap(channels[column][0], channels[column][1], motion.first_frame + first, motion.first_frame + stop - 1)
         for column, first, stop in sg.nan_runs(motion.values).tolist()
     ]
 

@@ -37,6 +37,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._parallel import even_bounds, run_ranges, thread_count
 from ._status import check
@@ -126,7 +127,7 @@ def _axis(a: np.ndarray, axis) -> int:
 def _lines(a: np.ndarray, axis: int) -> np.ndarray:
     """``a`` as a C-contiguous float64 (n, channels) array, its axis ``axis`` first (a view where it can be)."""
     moved = np.moveaxis(a, axis, 0)
-    return np.ascontiguousarray(moved, dtype=np.float64).reshape(moved.shape[0], -1)
+    return np.ascontiguousarray(moved, dtype=np.float64).reshape(moved.shape[0], math.prod(moved.shape[1:]))
 
 
 def _unlines(lines: np.ndarray, a: np.ndarray, axis: int) -> np.ndarray:
@@ -145,7 +146,7 @@ def _channel_bounds(workers: int | None, lines: np.ndarray) -> list[int]:
 
 def _run_slabs(name: str, lines: np.ndarray, out: np.ndarray, workers: int | None, call: Callable[..., int]) -> None:
     """``call(in_pointer, out_pointer, channels)`` for each thread's slab of channels."""
-    src, dst = ffi.from_buffer("double[]", lines), ffi.from_buffer("double[]", out)
+    src, dst = c_array(lines), c_array(out)
     bounds = _channel_bounds(workers, lines)
     run_ranges(lambda c0, c1: call(src + c0, dst + c0, c1 - c0), bounds, name)
 
@@ -223,7 +224,7 @@ def equalize(
     lines = _lines(a, axis)
     out = np.empty_like(lines)
     if lines.size:
-        gp = ffi.from_buffer("double[]", g) if len(g) else ffi.NULL
+        gp = c_array(g) if len(g) else ffi.NULL
         stride, cval = lines.shape[1], float(cval)
         _run_slabs(
             "mt_equalize",
@@ -413,6 +414,8 @@ def sosfiltfilt(
     forward output, and cut back.  The magnitude response is the filter's
     squared, the phase zero.  Requires more samples along ``axis`` than
     ``padlen``.  NaN in a line spreads over the whole line (fill gaps first).
+    float64 input gives scipy's result bit for bit; other input is converted
+    to float64 first (scipy extends float32 input in float32).
     """
     s = _sos(sos)
     a = _float_array(x)
@@ -434,7 +437,7 @@ def sosfiltfilt(
     lines = _lines(a, axis)
     out = np.empty_like(lines)
     if lines.size:
-        sp, zp, channels = ffi.from_buffer("double[]", s), ffi.from_buffer("double[]", zi), lines.shape[1]
+        sp, zp, channels = c_array(s), c_array(zi), lines.shape[1]
         pad = edge if padtype is not None else 0
         _run_slabs(
             "mt_sosfiltfilt",
@@ -587,7 +590,7 @@ def _output_len(taps: int, n_in: int, up: int, down: int) -> int:
 def _extension(lines: np.ndarray, rows: np.ndarray, padtype: str, cval: float) -> np.ndarray:
     """Rows ``rows`` (< 0 or >= n) of the line extended by ``padtype`` (scipy.signal.upfirdn's modes)."""
     n = len(lines)
-    if padtype == "constant":
+    if padtype == "constant" or not len(rows):
         return np.full((len(rows), lines.shape[1]), cval)
     if padtype in ("line", "smooth"):
         before = rows < 0
@@ -605,7 +608,9 @@ def _extension(lines: np.ndarray, rows: np.ndarray, padtype: str, cval: float) -
             return np.repeat(lines, len(rows), axis=0)
         period = 2 * (n - 1)
         turns, m = np.divmod(rows, period)
-        base = np.where((m <= n - 1)[:, None], lines[np.minimum(m, n - 1)], 2 * lines[-1] - lines[np.abs(period - m) % n])
+        base = np.where(
+            (m <= n - 1)[:, None], lines[np.minimum(m, n - 1)], 2 * lines[-1] - lines[np.abs(period - m) % n]
+        )
         return base + (2 * turns)[:, None] * (lines[-1] - lines[0])
     if padtype == "antisymmetric":  # a b c d | -d -c -b -a | a b c d ...
         m = rows % (2 * n)
@@ -701,8 +706,8 @@ def resample_poly(
 
     out = np.empty((n_out, lines.shape[1]))
     if out.size:
-        hp, src, dst = (ffi.from_buffer("double[]", v) for v in (h, lines, out))
-        bp, ap = ffi.from_buffer("double[]", rows_before), ffi.from_buffer("double[]", rows_after)
+        hp, src, dst = c_array(h), c_array(lines), c_array(out)
+        bp, ap = c_array(rows_before), c_array(rows_after)
         channels = lines.shape[1]
         wanted = thread_count(workers, out.size + lines.size >= _PARALLEL_MIN_VALUES)
         run_ranges(
@@ -733,12 +738,12 @@ def _runs(lines: np.ndarray) -> np.ndarray:
     """(column, first, stop) of every NaN run of the (n, channels) lines, by column then first."""
     n, channels = lines.shape
     count = ffi.new("size_t *")
-    src = ffi.from_buffer("double[]", lines)
+    src = c_array(lines)
     check(lib.mt_nan_runs(src, n, channels, channels, ffi.NULL, 0, count), "mt_nan_runs")
     runs = np.empty((count[0], 3), dtype=np.uintp)
     if count[0]:
         check(
-            lib.mt_nan_runs(src, n, channels, channels, ffi.from_buffer("size_t[]", runs), count[0], count),
+            lib.mt_nan_runs(src, n, channels, channels, c_array(runs, "size_t[]"), count[0], count),
             "mt_nan_runs",
         )
     runs = runs.astype(np.intp)
