@@ -37,7 +37,7 @@ def equalize_twin(x, gains, mode="nearest", cval=0.0):
     """Bruderlin and Williams as defined: G_fb + sum_k g_k (G_k - G_{k+1}), fb = floor(log2 frames),
     gains after the last given 1."""
     n = len(x)
-    fb = int(math.floor(math.log2(n))) if n else 0
+    fb = math.floor(math.log2(n)) if n else 0
     g = list(gains) + [1.0] * (fb - len(gains))
     levels = levels_twin(x, fb, mode, cval)
     return levels[fb] + sum(g[k] * (levels[k] - levels[k + 1]) for k in range(fb))
@@ -205,9 +205,7 @@ def fill_gaps_twin(x, max_gap, method="linear"):
         if first == 0 or stop == n or stop - first > max_gap:
             continue
         # the stretch: from after the previous unfilled run to before the next
-        bounds = [
-            (f, s) for cc, f, s in nan_runs_twin(x[:, c : c + 1]) if f == 0 or s == n or s - f > max_gap
-        ]
+        bounds = [(f, s) for cc, f, s in nan_runs_twin(x[:, c : c + 1]) if f == 0 or s == n or s - f > max_gap]
         lo = max([s for f, s in bounds if s <= first], default=0)
         hi = min([f for f, s in bounds if f >= stop], default=n)
         frames = np.arange(lo, hi)

@@ -4,11 +4,11 @@ scipy.ndimage as an independent oracle, and what it does to real takes."""
 import numpy as np
 import pytest
 import scipy.ndimage as ndi
-from conftest import real_files
-from signal_twins import equalize_twin, levels_twin
 
 import motiontheater as mt
+from conftest import real_files
 from mtcore import signal as sg
+from signal_twins import equalize_twin, levels_twin
 
 MODES = ["nearest", "reflect", "mirror", "constant", "wrap"]
 SIZES = [1, 2, 3, 4, 5, 7, 8, 9, 16, 17, 31, 100, 513, 1000, 2049, 5000]
@@ -135,7 +135,9 @@ def mean_squared_jerk(motion):
     return float(np.mean(jerk**2))
 
 
-@pytest.mark.parametrize("name", ["cmu/07_05-walk.amc", "cmu/09_06-run.amc", "hdm05/HDM_bd_sneak2StepsLStart_001_120.amc"])
+@pytest.mark.parametrize(
+    "name", ["cmu/07_05-walk.amc", "cmu/09_06-run.amc", "hdm05/HDM_bd_sneak2StepsLStart_001_120.amc"]
+)
 def test_zeroing_the_two_finest_bands_halves_the_jerk_and_keeps_the_hips(data_dir, name):
     """The issue's measure on real (noisy as captured) takes: the mean squared jerk of the joints'
     world positions drops by at least half, the hips move by less than 1 cm and 1 degree RMS."""

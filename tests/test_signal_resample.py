@@ -5,13 +5,13 @@ import numpy as np
 import pytest
 import scipy.signal as ss
 from scipy.spatial.transform import Rotation
-from signal_twins import resample_poly_twin, upfirdn_twin
 
 import motiontheater as mt
 from mtcore import rotations as rot
 from mtcore import signal as sg
 from mtcore._cdata import c_array
 from mtcore._mtcore import lib
+from signal_twins import resample_poly_twin, upfirdn_twin
 
 RATIOS = [(1, 4), (1, 2), (4, 1), (2, 1), (1, 5), (5, 24), (3, 7), (960, 959), (2, 2)]
 PADTYPES = ["constant", "line", "edge", "smooth", "symmetric", "reflect", "wrap", "antisymmetric", "antireflect"]
@@ -70,7 +70,20 @@ def test_upfirdn_kernel_equals_its_twin(rng):
         expected = upfirdn_twin(h, x, up, down)
         out = np.empty_like(expected)
         status = lib.mt_upfirdn(
-            c_array(h), taps, up, down, c_array(x), frames, 3, c_array(None), 0, c_array(None), 0, 0, 0, len(out),
+            c_array(h),
+            taps,
+            up,
+            down,
+            c_array(x),
+            frames,
+            3,
+            c_array(None),
+            0,
+            c_array(None),
+            0,
+            0,
+            0,
+            len(out),
             c_array(out),
         )
         assert status == 0
@@ -176,7 +189,7 @@ def test_slerp_for_higher_rates_is_kept_as_an_option(walk):
     np.testing.assert_array_equal(slerped.values[:, :3], filtered.values[:, :3])
     assert rotation_error_degrees(slerped, smooth) > rotation_error_degrees(filtered, smooth)
     # every SLERP frame lies on the arc between the two 30 Hz frames around it
-    order, extrinsic, cols = smooth.skeleton.euler_groups()[0]
+    order, _, cols = smooth.skeleton.euler_groups()[0]
     q_low = Rotation.from_euler(order, low.values[:, cols].reshape(-1, 3), degrees=True).as_quat()
     q_low = q_low.reshape(low.frames, -1, 4)
     frame = 4 * 10 + 2  # halfway between 30 Hz frames 10 and 11

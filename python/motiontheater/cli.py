@@ -436,14 +436,12 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _show_notes() -> None:
-    """Print what steps note on the package's logger (a cut-off chosen, gaps left) to stderr."""
-    logger = logging.getLogger("motiontheater")
-    if not logger.handlers:
-        handler = logging.StreamHandler(sys.stderr)
-        handler.setFormatter(logging.Formatter("%(message)s"))
-        logger.addHandler(handler)
-        logger.setLevel(logging.INFO)
+def _notes() -> logging.Handler:
+    """A handler that prints what steps note on the package's logger (a cut-off chosen, gaps left) to stderr."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    handler.setLevel(logging.INFO)
+    return handler
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -453,12 +451,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.verb is None:
         parser.print_help()
         return 0
-    _show_notes()
+    logger, notes = logging.getLogger("motiontheater"), _notes()
+    logger.addHandler(notes)
+    level = logger.level
+    logger.setLevel(logging.INFO)
     try:
         return int(args.run(args))
     except (ValueError, TypeError, OSError, RuntimeError) as exc:
         print(f"motiontheater {args.verb}: {exc}", file=sys.stderr)
         return 2
+    finally:
+        logger.removeHandler(notes)
+        logger.setLevel(level)
 
 
 if __name__ == "__main__":
