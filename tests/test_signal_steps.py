@@ -9,6 +9,9 @@ import pytest
 import motiontheater as mt
 from motiontheater.cli import main
 from mtcore import signal as sg
+from mtcore._cdata import c_array
+from mtcore._mtcore import ffi, lib
+from mtcore._status import check
 
 
 @pytest.fixture(scope="module")
@@ -147,3 +150,35 @@ def test_no_function_modifies_its_input(rng):
     sg.nan_runs(x)
     sg.residual_cutoff(np.nan_to_num(x), 120)
     np.testing.assert_array_equal(x, keep)
+
+
+def test_kernels_check_their_arguments():
+    """Python validates first; the kernels check again and answer MT_EINVAL, never crash."""
+    x = np.ones((8, 2))
+    out = np.empty_like(x)
+    gains = np.array([0.5, 0.5, 0.5, 0.5])
+    sos = np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0]])
+    bad_sos = np.array([[1.0, 0.0, 0.0, 2.0, 0.0, 0.0]])
+    zi = np.zeros((1, 2))
+    count = ffi.new("size_t *")
+    einval = lib.MT_EINVAL
+    assert lib.mt_equalize(c_array(x), c_array(out), 8, 2, 2, 4, c_array(gains), lib.MT_MODE_NEAREST, 0.0) == einval
+    assert lib.mt_equalize(c_array(x), c_array(out), 8, 2, 1, 1, c_array(gains), lib.MT_MODE_NEAREST, 0.0) == einval
+    assert lib.mt_equalize(c_array(x), c_array(out), 8, 2, 2, 1, c_array(gains), 9, 0.0) == einval
+    assert lib.mt_equalize(c_array(x), c_array(out), 8, 2, 2, 3, ffi.NULL, lib.MT_MODE_NEAREST, 0.0) == einval
+    assert lib.mt_sosfiltfilt(c_array(bad_sos), 1, c_array(zi), c_array(x), c_array(out), 8, 2, 2, 3, 1) == einval
+    assert lib.mt_sosfiltfilt(c_array(sos), 1, c_array(zi), c_array(x), c_array(out), 8, 2, 2, 8, 1) == einval
+    assert lib.mt_sosfiltfilt(c_array(sos), 1, c_array(zi), c_array(x), c_array(out), 8, 2, 2, 3, 7) == einval
+    assert lib.mt_sosfiltfilt(c_array(sos), 0, c_array(zi), c_array(x), c_array(out), 8, 2, 2, 3, 1) == einval
+    h = np.ones(3)
+    null = c_array(None)
+    assert lib.mt_upfirdn(c_array(h), 3, 0, 1, c_array(x), 8, 2, null, 0, null, 0, 0, 0, 8, c_array(out)) == einval
+    assert lib.mt_upfirdn(c_array(h), 3, 1, 1, c_array(x), 8, 2, null, 2, null, 0, 0, 0, 8, c_array(out)) == einval
+    assert lib.mt_upfirdn(c_array(h), 0, 1, 1, c_array(x), 8, 2, null, 0, null, 0, 0, 0, 8, c_array(out)) == einval
+    assert lib.mt_fill_gaps(c_array(x), c_array(out), 8, 2, 2, 3, 5) == einval
+    assert lib.mt_fill_gaps(c_array(x), c_array(out), 8, 2, 1, 3, 0) == einval
+    assert lib.mt_nan_runs(c_array(x), 8, 2, 2, ffi.NULL, 0, ffi.NULL) == einval
+    assert lib.mt_nan_runs(c_array(x), 8, 2, 2, ffi.NULL, 4, count) == einval
+    # and the status becomes a ValueError naming the call when it reaches Python
+    with pytest.raises(ValueError, match="mt_sosfiltfilt: .*status -1"):
+        check(einval, "mt_sosfiltfilt")
