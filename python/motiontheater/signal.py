@@ -42,7 +42,7 @@ from mtcore import signal as sg
 from mtcore.text import format_number
 
 from ._io import Source, output
-from .filtering import EdgeMode, _wrap_into
+from .filtering import EdgeMode, TakeStats, _wrap_into, unwrap_angles
 from .motion import Motion
 from .registry import Frames, Joints, exporter, step
 from .skeleton import ROTATIONS
@@ -72,24 +72,14 @@ def _columns(motion: Motion, joints: Iterable[str] | None, translation: bool = T
 
 
 def _unwrapped(angles: np.ndarray, period: float) -> np.ndarray:
-    """Angle columns with whole turns added wherever one jumps by more than half a turn
-    from its last valid frame (NaN frames skipped, and kept): exact multiples of the period."""
-    n = len(angles)
-    valid = ~np.isnan(angles)
-    # each frame's last valid value (NaN before the first)
-    last = np.maximum.accumulate(np.where(valid, np.arange(n)[:, None], 0), axis=0)
-    held = np.take_along_axis(angles, last, axis=0)
-    steps = np.diff(held, axis=0, prepend=held[:1])
-    with np.errstate(invalid="ignore"):
-        jumps = np.where(np.abs(steps) > period / 2, -np.round(steps / period), 0.0)
-    return angles + np.cumsum(np.nan_to_num(jumps), axis=0) * period
+    """Angle columns unwrapped as the smoothing filters unwrap them (NaN stepped over and kept)."""
+    return unwrap_angles(angles, period)[0] if len(angles) else angles.copy()
 
 
 def _ranges(angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each column's lowest and highest value, NaN ignored (NaN for a column of NaN)."""
-    if not len(angles):
-        return np.full(angles.shape[1], np.nan), np.full(angles.shape[1], np.nan)
-    return np.fmin.reduce(angles, axis=0), np.fmax.reduce(angles, axis=0)
+    """Each column's range of finite values, which the wrap-back keeps it in."""
+    stats = TakeStats.of(angles)
+    return stats.low, stats.high
 
 
 def _filtered(
