@@ -62,14 +62,16 @@ def test_python_refuses_sizes_no_window_has(filt, size):
 BAD = [np.nan, np.inf, -np.inf]
 
 
+WINDOWS = [(mode, 5) for mode in MODES] + [("reflect", 3), ("nearest", 8), ("mirror", 40), ("wrap", 300)]
+
+
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
-@pytest.mark.parametrize("mode", MODES)
-@pytest.mark.parametrize("size", [3, 5, 8, 40, 300])
-@pytest.mark.parametrize("axis", [0, 1])  # the direct path and the tile path
+@pytest.mark.parametrize("mode, size", WINDOWS)
+@pytest.mark.parametrize("axis", [0, 1])  # the direct path (16 channels) and the tile path
 def test_a_non_finite_sample_reaches_only_the_windows_that_hold_it(rng, dtype, mode, size, axis):
     """A running sum keeps a NaN after it leaves (and inf - inf is NaN): it must be summed again
     there, not at the next 256-frame block.  Against the twin, which sums each window whole."""
-    x = rng.standard_normal((700, 20)).astype(dtype)
+    x = rng.standard_normal((700, 16)).astype(dtype)
     x[10, 1] = np.nan
     x[300, 2], x[302, 2] = np.inf, -np.inf  # both in some windows: NaN there
     x[500, 3] = np.inf

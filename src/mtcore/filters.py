@@ -3,7 +3,10 @@
 Each filter runs along one axis of an n-d array, in C.  float32 and float64
 are computed natively (float32 stays float32; means are accumulated in
 double); float16 is computed in float32; bool and integer input in float64,
-the result cast to the output type as scipy does (truncation toward zero).
+the result cast to the output type as scipy does (truncation toward zero),
+but for the median of 64-bit integers beyond 2**53, which float64 would
+round: it is exact (computed on the values' ranks).  A NaN or an infinity
+affects only the outputs whose windows hold it.
 The input is never modified.  ``output`` may be an array of the input's shape
 (any dtype, any layout, even the input itself) or a dtype.
 
@@ -127,8 +130,8 @@ def median_filter1d(
     Gives the same result as ``scipy.ndimage.median_filter(input, size=size,
     axes=(axis,), mode=mode, cval=cval, origin=origin)``: for an even size the
     upper of the two middle values (rank ``size // 2``), never an average, so
-    the median never invents values.  A window that contains NaN gives NaN
-    (scipy's result is undefined there).
+    the median never invents values, 64-bit integers included.  A window
+    that contains NaN gives NaN (scipy's result is undefined there).
     """
     return _filter1d(lib.MT_FILTER_MEDIAN, input, size, axis, output, mode, cval, origin, workers)
 
@@ -174,11 +177,15 @@ def binomial_filter1d(
     return _filter1d(lib.MT_FILTER_CORRELATE, input, size, axis, output, mode, cval, origin, workers)
 
 
-def _check_size(size: int, most: int = MAX_SIZE, what: str = "") -> int:
+def _integer(value, name: str) -> int:
     try:
-        size = operator.index(size)
+        return operator.index(value)
     except TypeError:
-        raise TypeError(f"size must be an integer, got {type(size).__name__}") from None
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__}") from None
+
+
+def _check_size(size: int, most: int = MAX_SIZE, what: str = "") -> int:
+    size = _integer(size, "size")
     if size < 1:
         raise ValueError(f"size must be at least 1, got {size}")
     if size > most:
@@ -218,7 +225,7 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
     work = _work_dtype(a.dtype)
     binomial = kind == lib.MT_FILTER_CORRELATE
     size = _check_size(size, MAX_BINOMIAL_SIZE if binomial else MAX_SIZE, "binomial " if binomial else "")
-    axis = operator.index(axis)
+    axis = _integer(axis, "axis")
     if not -a.ndim <= axis < a.ndim:
         raise np.exceptions.AxisError(axis, a.ndim)
     axis %= a.ndim
@@ -226,8 +233,11 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
         code = MODES[mode]
     except (KeyError, TypeError):
         raise ValueError(f"mode must be one of {', '.join(map(repr, MODES))}; got {mode!r}") from None
-    cval = float(cval)
-    origin = operator.index(origin)
+    try:
+        cval = float(cval)
+    except (TypeError, ValueError):
+        raise TypeError(f"cval must be a real number, got {cval!r}") from None
+    origin = _integer(origin, "origin")
     if not -(size // 2) <= origin <= (size - 1) // 2:
         raise ValueError(f"origin must be in [{-(size // 2)}, {(size - 1) // 2}] for size {size}, got {origin}")
     target = _target(output, a)
