@@ -1072,6 +1072,7 @@
     if (!spec) throw new Error(`unknown step ${step.kind}`);
     if (!(Number.isInteger(step.first) && Number.isInteger(step.last) && f0 <= step.first && step.first < step.last && step.last <= f1))
       throw new Error(`frames must satisfy ${f0} <= first < last <= ${f1}`);
+    for (const joint of step.joints || []) if (!t.jointIndex.has(joint)) throw new Error(`no joint '${joint}' in ${t.name}`);
     if (spec.size && !(Number.isInteger(step.size) && step.size >= 1 && step.size % 2 === 1))
       throw new Error("size must be an odd number of frames (1, 3, 5, ...)");
     S.stack.push({ kind: step.kind, first: step.first, last: step.last, joints: step.joints || null, size: spec.size ? step.size : null });
@@ -1178,7 +1179,9 @@
     setToggle("b-follow", S.follow);
     setToggle("b-speed", S.speed === 2);
     $("slider").addEventListener("input", (e) => seek(Number(e.target.value)));
-    $("frame").addEventListener("change", (e) => seek((Number(e.target.value) - t.firstFrame) / t.step));
+    $("frame").addEventListener("change", (e) => {
+      if (e.target.value.trim() !== "" && Number.isFinite(Number(e.target.value))) seek((Number(e.target.value) - t.firstFrame) / t.step);
+    });
     $("b-help").addEventListener("click", () => ($("help").hidden = !$("help").hidden));
     document.addEventListener("keydown", (e) => {
       const tag = e.target.tagName;
