@@ -72,6 +72,14 @@
       channelCount: t.channels.length,
       values: decodeValues(planes, t.frames, t.channels.length, exceptions),
       axis: Float64Array.from(t.axis),
+      segment: Float64Array.from(t.segment),
+      direction: Float64Array.from(t.direction),
+      parent: Int32Array.from(t.parent),
+      order: Int32Array.from(t.order),
+      dofStart: Int32Array.from(t.dofStart),
+      dofKind: Int32Array.from(t.dofKind),
+      dofColumn: Int32Array.from(t.dofColumn),
+      parentFrame: Uint8Array.from(t.parentFrame),
       plain: new Uint8Array(J),
       jointIndex: new Map(t.joints.map((name, i) => [name, i])),
       plantFlags: {},
@@ -264,9 +272,12 @@
 
   /* ---------- forward kinematics (port of csrc/kinematics.c) ---------- */
 
+  // scratch of fkFrame (one call at a time: the page is single-threaded)
+  const FK_M = new Float64Array(9), FK_L = new Float64Array(9), FK_CM = new Float64Array(9);
+
   function fkFrame(take, values, row, pos, po, world, local) {
     const J = take.joints.length, scale = take.angleScale;
-    const m = new Float64Array(9), l = new Float64Array(9), cm = new Float64Array(9);
+    const m = FK_M, l = FK_L, cm = FK_CM;
     for (let ii = 0; ii < J; ii++) {
       const j = take.order[ii];
       setIdentity(m, 0);
@@ -304,15 +315,13 @@
       for (let i = 0; i < 3; i++)
         for (let k = 0; k < 3; k++)
           world[w + 3 * i + k] = world[q + 3 * i] * l[k] + world[q + 3 * i + 1] * l[3 + k] + world[q + 3 * i + 2] * l[6 + k];
-      const vec = [0, 1, 2].map(
-        (e) =>
-          take.segment[seg + e] + take.direction[seg + e] * stretch +
-          C[c9 + 3 * e] * t0 + C[c9 + 3 * e + 1] * t1 + C[c9 + 3 * e + 2] * t2
-      );
+      const S3 = take.segment, D3 = take.direction;
+      const v0 = S3[seg] + D3[seg] * stretch + C[c9] * t0 + C[c9 + 1] * t1 + C[c9 + 2] * t2;
+      const v1 = S3[seg + 1] + D3[seg + 1] * stretch + C[c9 + 3] * t0 + C[c9 + 4] * t1 + C[c9 + 5] * t2;
+      const v2 = S3[seg + 2] + D3[seg + 2] * stretch + C[c9 + 6] * t0 + C[c9 + 7] * t1 + C[c9 + 8] * t2;
       const turn = take.parentFrame[j] ? q : w;
       for (let e = 0; e < 3; e++)
-        pos[po + 3 * j + e] =
-          pos[po + 3 * p + e] + world[turn + 3 * e] * vec[0] + world[turn + 3 * e + 1] * vec[1] + world[turn + 3 * e + 2] * vec[2];
+        pos[po + 3 * j + e] = pos[po + 3 * p + e] + world[turn + 3 * e] * v0 + world[turn + 3 * e + 1] * v1 + world[turn + 3 * e + 2] * v2;
     }
   }
 
@@ -704,7 +713,7 @@
     ctx.fillRect(0, 0, view.width, view.height);
     drawGrid();
     const t = take0();
-    for (const take of S.takes.slice(1)) drawSkeleton(take, take.positions, indexAt(take, S.time), take.colour, 0.45, false);
+    for (const take of S.takes.slice(1)) drawSkeleton(take, take.drawn, indexAt(take, S.time), take.colour, 0.45, false);
     if (S.edited && S.preview) drawSkeleton(t, t.positions, S.cur, "#888", 0.35, false);
     const P = shownPositions(t);
     drawSkeleton(t, P, S.cur, t.colour, 1, true);
@@ -1326,6 +1335,11 @@
     if (DATA.note) {
       $("note").textContent = DATA.note;
       $("note").hidden = false;
+    }
+    // compared takes drawn in the first take's length unit (their own positions stay as computed)
+    for (const take of S.takes) {
+      const k = take.metersPerUnit / t.metersPerUnit;
+      take.drawn = k === 1 ? take.positions : take.positions.map((v) => v * k);
     }
     setUpCamera();
     buildTree();
