@@ -97,7 +97,7 @@ def test_names_cannot_break_out_of_the_data():
 
 
 def test_long_takes_are_decimated_with_a_note():
-    """One hour at 120 Hz, 62 channels: the page keeps every 15th frame and says so."""
+    """One hour at 120 Hz, 62 channels: the page keeps 1 frame in 15 and says so."""
     frames = 432_000
     skeleton = small_take().skeleton
     t = np.arange(frames)[:, None] / 120.0
@@ -107,7 +107,7 @@ def test_long_takes_are_decimated_with_a_note():
     take = data["takes"][0]
     assert take["step"] == 15 and take["frames"] == 28_800 <= DEFAULT_MAX_FRAMES
     assert np.array_equal(decoded(take), values[::15])
-    assert "every 15th" in data["note"] and "editing is off" in data["note"]
+    assert "1 frame in 15 of its 432,000 is shown (8 Hz)" in data["note"] and "editing is off" in data["note"]
     assert data["editable"] is False
 
 
@@ -158,3 +158,28 @@ def test_write_page_writes_nothing_on_failure(tmp_path):
     assert not list(tmp_path.iterdir())
     write_page([small_take()], target)
     assert target.read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
+
+
+def test_cli_view_writes_the_page(tmp_path, data_dir, monkeypatch, capsys):
+    from motiontheater.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    take, other = data_dir / "cmu" / "01_01.amc", data_dir / "cmu" / "01_01.bvh"
+    assert main(["view", str(take), str(other), "--no-open"]) == 0
+    assert "wrote 01_01.html" in capsys.readouterr().out
+    data = page_data((tmp_path / "01_01.html").read_text(encoding="utf-8"))
+    assert [t["name"] for t in data["takes"]] == ["01_01.amc", "01_01.bvh"]
+    assert main(["view", str(take), "--no-open", "--max-frames", "1000", "-o", "small.html"]) == 0
+    data = page_data((tmp_path / "small.html").read_text(encoding="utf-8"))
+    assert data["takes"][0]["step"] == 3 and "1 frame in 3 of its 2,751" in data["note"]
+
+
+@pytest.mark.parametrize("verb", ["view", "plot", "render", "markers"])
+def test_cli_help_teaches(verb, capsys):
+    from motiontheater.cli import main
+
+    with pytest.raises(SystemExit) as exit:
+        main([verb, "--help"])
+    assert exit.value.code == 0
+    text = capsys.readouterr().out
+    assert "Example: motiontheater " + verb in " ".join(text.split())

@@ -20,8 +20,8 @@ file of up to seven significant digits) is a 32-bit word, any other its
 float64; words go in four byte planes, deflated, base64.  CMU 01_01 (2,751
 frames x 62 channels) makes a page of about 0.6 MB.
 
-Takes longer than ``max_frames`` frames are decimated (every k-th frame is
-kept, k the smallest that fits) and the page says so; editing is then off,
+Takes longer than ``max_frames`` frames are decimated (1 frame in k is kept,
+k the smallest that fits) and the page says so; editing is then off,
 since filters and interpolators work on every frame.
 """
 
@@ -182,7 +182,7 @@ def page(
             raise ValueError(f"{label} has no frames to show")
     steps = [max(1, math.ceil(m.frames / max_frames)) for m in takes]
     notes = [
-        f"{label}: every {k}th of its {m.frames:,} frames is shown ({m.frame_rate / k:g} Hz)"
+        f"{label}: 1 frame in {k} of its {m.frames:,} is shown ({m.frame_rate / k:g} Hz)"
         for m, label, k in zip(takes, labels, steps)
         if k > 1
     ]
