@@ -81,18 +81,20 @@ _POW10 = 10.0 ** np.arange(23)  # exact doubles: 10^22 is the largest power of t
 def _encode_values(values: np.ndarray) -> dict[str, str]:
     """Values (frames, channels) as the page stores them (see the module docstring)."""
     flat = np.ascontiguousarray(values.T).ravel()
-    words = np.full(flat.shape, 31, np.int64)
-    pending = np.ones(flat.shape, bool)
+    words = np.full(flat.shape, 31, np.int32)
+    pending, rest = np.arange(flat.size), flat  # the values without a word yet, and where they go
     with np.errstate(over="ignore", invalid="ignore"):
         for d, scale in enumerate(_POW10):
-            m = np.rint(flat * scale)
-            exact = pending & (np.abs(m) < _EXACT_LIMIT) & (m / scale == flat)
-            words[exact] = (m[exact].astype(np.int64) << 5) | d
-            pending &= ~exact
+            m = np.rint(rest * scale)
+            exact = (np.abs(m) < _EXACT_LIMIT) & (m / scale == rest)
+            words[pending[exact]] = (m[exact].astype(np.int32) << 5) | d
+            pending, rest = pending[~exact], rest[~exact]
+            if not len(pending):
+                break
     planes = words.astype("<i4").view(np.uint8).reshape(-1, 4).T.tobytes()
     return {
         "data": base64.b64encode(zlib.compress(planes, 6)).decode("ascii"),
-        "exceptions": base64.b64encode(flat[pending].astype("<f8").tobytes()).decode("ascii"),
+        "exceptions": base64.b64encode(rest.astype("<f8").tobytes()).decode("ascii"),
     }
 
 

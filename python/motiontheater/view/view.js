@@ -736,8 +736,20 @@
     return Number.isFinite(v) ? String(Number(v.toPrecision(8))) : String(v);
   }
 
+  /* the table is rebuilt when the joint changes; on other frames only its values are rewritten */
   function updateJointPanel() {
     const t = take0(), j = S.selected;
+    if (S.panelJoint === j && j >= 0) {
+      for (const [cell, take, column] of S.panelCells) {
+        const v = shownValues(take)[indexAt(take, S.time) * take.channelCount + column];
+        cell.textContent = formatValue(v);
+        cell.dataset.value = String(v);
+      }
+      updateGlyph();
+      return;
+    }
+    S.panelJoint = j;
+    S.panelCells = [];
     const body = $("channels").tBodies[0];
     body.textContent = "";
     $("joint-name").textContent = j >= 0 ? t.points[j] : "none";
@@ -761,14 +773,12 @@
         const k = take.jointIndex.get(name);
         const at = k === undefined ? -1 : take.dofs[k].indexOf(dof);
         if (at < 0) continue;
-        const v = shownValues(take)[indexAt(take, S.time) * take.channelCount + take.firstColumn[k] + at];
-        cell.textContent = formatValue(v);
-        cell.dataset.value = String(v);
         cell.dataset.dof = dof;
         cell.dataset.take = String(take.index);
+        S.panelCells.push([cell, take, take.firstColumn[k] + at]);
       }
     });
-    updateGlyph();
+    updateJointPanel();
   }
 
   /* the selected joint's own rotation (C M C^T) at the current frame as an axis and an angle */
@@ -871,6 +881,7 @@
 
   const curves = $("curves");
   const cctx = curves.getContext("2d");
+  const overlay = $("playhead");
   let curveBase = null;
   const M = { left: 56, right: 10, top: 8, bottom: 20 };
 
@@ -887,10 +898,7 @@
   function drawCurveBase() {
     resizeCanvas(curves);
     const G = curveGeometry(), t = take0();
-    const base = document.createElement("canvas");
-    base.width = curves.width;
-    base.height = curves.height;
-    const c = base.getContext("2d");
+    const c = cctx;
     c.fillStyle = "#fff";
     c.fillRect(0, 0, G.W, G.H);
     c.font = `${11 * G.dpr}px system-ui, sans-serif`;
@@ -982,7 +990,7 @@
     if (!t.dofs[j].length) label("no channels", "#333");
     for (const dof of t.dofs[j]) label(dof, AXIS_COLOURS[dof[1] || "l"] || "#555");
     if (S.takes.length > 1 || (S.edited && S.preview)) label(S.edited && S.preview ? "(dashed: before editing, compared takes)" : "(dashed: compared takes)", "#777");
-    curveBase = { canvas: base, G };
+    curveBase = { width: curves.width, height: curves.height, G };
     S.dirtyCurves = false;
   }
 
@@ -996,23 +1004,29 @@
     return out;
   }
 
+  /* the curves are drawn when they change; the playhead and the selection over them on every frame */
   function drawCurves() {
-    if (S.dirtyCurves || !curveBase || curveBase.canvas.width !== curves.width || curveBase.canvas.height !== curves.height) drawCurveBase();
-    const { canvas, G } = curveBase, t = take0();
-    cctx.drawImage(canvas, 0, 0);
+    resizeCanvas(curves);
+    if (S.dirtyCurves || !curveBase || curveBase.width !== curves.width || curveBase.height !== curves.height) drawCurveBase();
+    const { G } = curveBase, t = take0(), c = overlay.getContext("2d");
+    if (overlay.width !== curves.width || overlay.height !== curves.height) {
+      overlay.width = curves.width;
+      overlay.height = curves.height;
+    }
+    c.clearRect(0, 0, overlay.width, overlay.height);
     if (S.selection) {
       const [a, b] = S.selection;
       const xa = G.xOf((a * t.step) / t.frameRate), xb = G.xOf((b * t.step) / t.frameRate);
-      cctx.fillStyle = "rgba(224,112,0,0.15)";
-      cctx.fillRect(xa, G.y0, xb - xa, G.y1 - G.y0);
+      c.fillStyle = "rgba(224,112,0,0.15)";
+      c.fillRect(xa, G.y0, xb - xa, G.y1 - G.y0);
     }
     const x = G.xOf(S.time);
-    cctx.strokeStyle = "#e07000";
-    cctx.lineWidth = 1.5 * G.dpr;
-    cctx.beginPath();
-    cctx.moveTo(x, G.y0);
-    cctx.lineTo(x, G.H);
-    cctx.stroke();
+    c.strokeStyle = "#e07000";
+    c.lineWidth = 1.5 * G.dpr;
+    c.beginPath();
+    c.moveTo(x, G.y0);
+    c.lineTo(x, G.H);
+    c.stroke();
   }
 
   /* ---------- editor ---------- */
