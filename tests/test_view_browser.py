@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
+from conftest import ids, real_files
 from motiontheater.view import write_page
 
 if sys.version_info >= (3, 11):
@@ -133,6 +134,29 @@ def test_real_take_opens_and_its_skeleton_is_drawn(browser, data_dir, tmp_path, 
     # and the test could fail: the corners of the 3D view are background
     box = browser.find_element(By.ID, "view3d").rect
     assert not inked(picture, box["x"] + box["width"] - 6, box["y"] + 30)
+
+
+VARIETY = real_files("bvh/*.bvh") + real_files("edge/*.amc") + real_files("hdm05/HDM_bd_squat1Reps_003_120.amc")
+
+
+@pytest.mark.parametrize("path", VARIETY, ids=ids(VARIETY))
+def test_every_kind_of_file_opens(browser, tmp_path, path):
+    """Every producer's BVH (orders, odd names, a one-frame rest pose), a non-CMU ASF, HDM05."""
+    if path.suffix == ".bvh":
+        motion = mt.read_bvh(path)
+    else:
+        motion = mt.read_amc(path, mt.read_asf(mt.skeleton_path_for(path)))
+    open_page(browser, tmp_path, [motion], names=[path.name])
+    assert console_errors(browser) == []
+    expected = motion.positions()
+    for frame in {0, motion.frames // 2, motion.frames - 1}:
+        got = np.array(browser.execute_script("return mtView.positions(0, arguments[0])", frame))
+        np.testing.assert_allclose(got.reshape(-1, 3), expected[frame], rtol=1e-12, atol=1e-9)
+    browser.execute_script("mtView.play()")
+    time.sleep(0.3)
+    browser.execute_script("mtView.pause()")
+    assert console_errors(browser) == []
+    assert not browser.find_element(By.ID, "error").is_displayed()
 
 
 def test_play_advances_the_frame_and_the_picture(browser, data_dir, tmp_path):

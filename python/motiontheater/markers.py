@@ -33,7 +33,7 @@ def c3d_points(motion: Motion, *, workers: int | None = None) -> np.ndarray:
     millimetres, residual (0, or -1 for a missing sample, whose coordinates are 0) and the
     camera mask (0)."""
     positions = motion.positions(meters=True, workers=workers) * 1000.0
-    missing = ~np.isfinite(positions).all(axis=2)
+    missing = np.logical_not(np.isfinite(positions).all(axis=2))
     points = np.zeros(positions.shape[:2] + (5,))
     points[..., :3] = np.where(missing[..., None], 0.0, positions)
     points[..., 3] = np.where(missing, -1.0, 0.0)

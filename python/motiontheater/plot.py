@@ -60,7 +60,7 @@ def figure(
     if len(labels) != len(takes):
         raise ValueError(f"give one name per take ({len(takes)}), got {len(labels)}")
     base = takes[0]
-    panels = []
+    panels: list[tuple[str, str]] = []
     for joint in joints:
         available = base.skeleton.dofs(joint)
         chosen = available if dofs is None else tuple(d for d in (x.lower() for x in dofs) if d in available)

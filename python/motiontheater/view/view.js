@@ -937,7 +937,7 @@
     for (const time of ticks(0, G.T, 10)) {
       const x = G.xOf(time);
       c.beginPath(); c.moveTo(x, G.y0); c.lineTo(x, G.y1); c.stroke();
-      c.fillText(`${Number(time.toPrecision(6))} s`, x, G.H - (M.bottom - 4) * G.dpr);
+      c.fillText(`${Number(time.toPrecision(6))} s`, x, G.y1 + 4 * G.dpr);
     }
     // series: the shown take solid, the compared and the unedited ones dashed
     for (const s of series) {
