@@ -23,6 +23,7 @@ else:
 
 webdriver = pytest.importorskip("selenium.webdriver", reason="selenium is not installed (pip install selenium)")
 from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.ui import Select, WebDriverWait
@@ -193,6 +194,71 @@ def test_keys_step_and_jump(browser, data_dir, tmp_path):
     body.send_keys(" ")
     body.send_keys(Keys.HOME)
     wait_frame(browser, 1)
+    state = "return [mtView.state.speed, mtView.state.loop, mtView.state.follow]"
+    assert browser.execute_script(state) == [1, True, True]
+    body.send_keys("d", "l", "f")
+    assert browser.execute_script(state) == [2, False, False]
+    assert browser.find_element(By.ID, "b-speed").get_attribute("aria-pressed") == "true"
+    body.send_keys(Keys.ARROW_RIGHT * 4, "[")
+    body.send_keys(Keys.SHIFT, Keys.ARROW_RIGHT)
+    body.send_keys("]")
+    assert browser.find_element(By.ID, "e-from").get_attribute("value") == "5"
+    assert browser.find_element(By.ID, "e-to").get_attribute("value") == "15"
+    body.send_keys("?")
+    assert browser.find_element(By.ID, "help").is_displayed()
+    body.send_keys(Keys.ESCAPE)
+    assert not browser.find_element(By.ID, "help").is_displayed()
+
+
+def test_orbit_zoom_and_pan_move_the_camera(browser, data_dir, tmp_path):
+    open_page(browser, tmp_path, [cmu(data_dir)])
+    view = browser.find_element(By.ID, "view3d")
+    camera = "return document.getElementById('view3d').toDataURL()"
+    pictures = [browser.execute_script(camera)]
+    ActionChains(browser).move_to_element(view).click_and_hold().move_by_offset(80, 30).release().perform()
+    time.sleep(0.1)
+    pictures.append(browser.execute_script(camera))
+    before = joints_on_screen(browser)
+    ActionChains(browser).scroll_from_origin(ScrollOrigin.from_element(view), 0, 300).perform()  # zoom out
+    time.sleep(0.1)
+    after = joints_on_screen(browser)
+    spread = lambda points: np.ptp(np.array(points), axis=0).max()
+    assert spread(after) < spread(before)
+    ActionChains(browser).move_to_element(view).key_down(Keys.SHIFT).click_and_hold().move_by_offset(
+        50, 0
+    ).release().key_up(Keys.SHIFT).perform()
+    time.sleep(0.1)
+    moved = joints_on_screen(browser)
+    shift = np.array(moved).mean(axis=0) - np.array(after).mean(axis=0)
+    assert abs(shift[0] - 50) < 10 and abs(shift[1]) < 10  # panned with the pointer
+    pictures.append(browser.execute_script(camera))
+    assert len(set(pictures)) == 3
+
+
+def test_tree_collapses(browser, data_dir, tmp_path):
+    open_page(browser, tmp_path, [cmu(data_dir)])
+    femur = browser.find_element(By.CSS_SELECTOR, ".jname[data-name='lfemur']")
+    foot = browser.find_element(By.CSS_SELECTOR, ".jname[data-name='lfoot']")
+    assert foot.is_displayed()
+    femur.find_element(By.XPATH, "preceding-sibling::button").click()
+    assert not foot.is_displayed() and femur.is_displayed()
+    femur.find_element(By.XPATH, "preceding-sibling::button").click()
+    assert foot.is_displayed()
+
+
+def test_one_hour_take_opens_decimated(browser, data_dir, tmp_path):
+    take = cmu(data_dir)
+    hour = take.replace(values=np.tile(take.values, (432_000 // take.frames + 1, 1))[:432_000])
+    open_page(browser, tmp_path, [hour], names=["hour.amc"])
+    note = browser.find_element(By.ID, "note")
+    assert note.is_displayed() and "1 frame in 15 of its 432,000 is shown (8 Hz)" in note.text
+    assert not browser.find_element(By.ID, "editor").is_displayed()
+    assert browser.execute_script("return mtView.state.takes[0].frames") == 28_800
+    browser.execute_script("mtView.seek(28_799)")
+    wait_frame(browser, 432_000 - 14)  # the last frame kept: 1 + 28,799 x 15
+    got = np.array(browser.execute_script("return mtView.positions(0, 28799)")).reshape(-1, 3)
+    np.testing.assert_allclose(got, hour.replace(values=hour.values[-15:-14]).positions()[0], atol=1e-9)
+    assert console_errors(browser) == []
 
 
 def test_selecting_a_joint_shows_its_values_and_rotation(browser, data_dir, tmp_path):
