@@ -179,11 +179,14 @@ def test_render_without_ffmpeg_says_so(tmp_path, monkeypatch):
         (dict(size=(8, 8)), "size"),
         (dict(frames=(5, 99)), "frames 5..99"),
         (dict(format="avi"), "format"),
+        (dict(fps=100, size=(16, 16), long=True), "1801 frames is too long"),
     ],
 )
 def test_render_refuses_bad_requests(tmp_path, kwargs, message):
+    take = walk(541) if kwargs.pop("long", False) else walk()  # 18 s at 30 Hz
     with pytest.raises(ValueError, match=message):
-        render([walk()], tmp_path / "walk.gif", **kwargs)
+        render([take], tmp_path / "walk.gif", **kwargs)
+    assert not list(tmp_path.iterdir())
 
 
 def test_cli_plot_and_render(tmp_path, data_dir, capsys):

@@ -24,6 +24,7 @@ from ._optional import require
 from .motion import Motion
 
 FORMATS = ("gif", "mp4")
+MAX_GIF_FRAMES = 1500  # a minute at 25 fps; pillow holds every frame of a GIF until it writes it
 _COLOURS = ("#1f4e9c", "#c0392b", "#2e8b57", "#8e44ad", "#b8860b")
 
 
@@ -129,6 +130,11 @@ def render(
         if motion.frames == 0:
             raise ValueError(f"{label} has no frames to render")
     shown = _frame_times(takes[0], fps, frames)
+    if format == "gif" and len(shown) > MAX_GIF_FRAMES:
+        raise ValueError(
+            f"a GIF of {len(shown)} frames is too long (at most {MAX_GIF_FRAMES}, held in memory until written): "
+            "choose fewer frames, a lower fps, or write .mp4"
+        )
     pictures = _pictures(takes, labels, shown, (width, height), follow)
     total = len(shown)
 
@@ -153,7 +159,10 @@ def _pictures(takes, labels, shown, size, follow):
 
     width, height = size
     base = takes[0]
-    positions = [m.positions() for m in takes]
+    # only the frames shown: each take's nearest frame to each instant of the first take's
+    seconds = np.asarray(shown) / base.frame_rate
+    rows = [np.minimum(m.frames - 1, np.rint(seconds * m.frame_rate).astype(int)) for m in takes]
+    positions = [m.replace(values=m.values[r]).positions() for m, r in zip(takes, rows)]
     points = positions[0]
     finite = points[np.isfinite(points).all(axis=2)]
     floor = float(finite[:, 1].min()) if len(finite) else 0.0
@@ -183,9 +192,8 @@ def _pictures(takes, labels, shown, size, follow):
     parents = [
         np.array([m.skeleton.joint_names.index(m.skeleton.parent(b)) for b in m.skeleton.bone_names]) for m in takes
     ]
-    for i in shown:
-        seconds = i / base.frame_rate
-        root = points[i, 0]
+    for n, i in enumerate(shown):
+        root = points[n, 0]
         target = np.array([root[0], height_of_view, root[2]]) if follow and np.isfinite(root).all() else centre
         camera.look_at(target)
         gx = (
@@ -207,13 +215,12 @@ def _pictures(takes, labels, shown, size, follow):
             ]
         )
         grid.set_segments(camera.segments(a, b))
-        for k, motion in enumerate(takes):
-            j = min(motion.frames - 1, round(seconds * motion.frame_rate))
-            p = positions[k][j]
+        for k in range(len(takes)):
+            p = positions[k][n]
             bones[k].set_segments(camera.segments(p[parents[k]], p[1:]))
             xy = camera.points(p)
             joints[k].set_data(xy[:, 0], xy[:, 1])
-        caption.set_text(f"{labels[0]}   frame {base.first_frame + i}   {seconds:.2f} s")
+        caption.set_text(f"{labels[0]}   frame {base.first_frame + i}   {seconds[n]:.2f} s")
         canvas.draw()
         yield np.asarray(canvas.buffer_rgba())[:, :, :3].copy()
 
