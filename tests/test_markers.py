@@ -152,7 +152,7 @@ def read_trc_as_opensim(path) -> tuple[dict, list[str], np.ndarray, np.ndarray]:
 def test_trc_opens_by_opensims_rules(tmp_path, path, capsys):
     motion = read(path)
     target = tmp_path / "take.trc"
-    assert main(["markers", str(path), "-o", str(target), "--meters"]) == 0
+    assert main(["positions", str(path), "-o", str(target), "--meters"]) == 0
     assert "to " + str(target) in capsys.readouterr().out
     header, labels, times, data = read_trc_as_opensim(target)
     assert header["Units"] == "m"
@@ -167,8 +167,8 @@ def test_cli_markers_to_c3d(tmp_path, capsys):
     if not TAKES:
         pytest.skip("no corpus")
     target = tmp_path / "take.c3d"
-    assert main(["markers", str(TAKES[-1]), "-o", str(target)]) == 0
-    assert "(millimetres, c3d)" in capsys.readouterr().out
+    assert main(["c3d", str(TAKES[-1]), "-o", str(target)]) == 0
+    assert "c3d: wrote" in capsys.readouterr().out
     _, labels, _ = read_with_c3d(target)
     assert len(labels) == len(read(TAKES[-1]).skeleton.point_names)
 
@@ -177,7 +177,7 @@ def test_missing_c3d_library_is_one_line(tmp_path, capsys, monkeypatch):
     if not TAKES:
         pytest.skip("no corpus")
     monkeypatch.setitem(sys.modules, "c3d", None)
-    assert main(["markers", str(TAKES[-1]), "-o", str(tmp_path / "take.c3d")]) == 2
+    assert main(["c3d", str(TAKES[-1]), "-o", str(tmp_path / "take.c3d")]) == 2
     err = capsys.readouterr().err.strip()
-    assert err == "motiontheater markers: writing C3D files needs c3d: pip install 'motiontheater[c3d]'"
+    assert err == "motiontheater c3d: writing C3D files needs c3d: pip install 'motiontheater[c3d]'"
     assert not list(tmp_path.iterdir())

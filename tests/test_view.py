@@ -122,11 +122,15 @@ def test_compared_takes_and_footplants():
     assert data["editable"] is True
 
 
-def test_editor_steps_cover_the_pipeline():
-    from motiontheater.interpolate import STEPS
+def test_editor_steps_are_registered_steps():
+    from motiontheater.registry import lookup
 
-    assert [s["kind"] for s in EDIT_STEPS] == list(STEPS)
-    assert {s["kind"] for s in EDIT_STEPS if s["size"]} == {"median", "mean", "binomial"}
+    kinds = [s["kind"] for s in EDIT_STEPS]
+    assert kinds == ["slerp", "euler", "expmap", "aligned_expmap", "median3", "median", "mean", "binomial"]
+    for spec in EDIT_STEPS:
+        options = {o.name for o in lookup(spec["run"]).all_options}
+        assert {"frames", "joints"} <= options
+        assert ("size" in options) == spec["size"]
 
 
 @pytest.mark.parametrize(
@@ -174,7 +178,7 @@ def test_cli_view_writes_the_page(tmp_path, data_dir, monkeypatch, capsys):
     assert data["takes"][0]["step"] == 3 and "1 frame in 3 of its 2,751" in data["note"]
 
 
-@pytest.mark.parametrize("verb", ["view", "plot", "render", "markers"])
+@pytest.mark.parametrize("verb", ["view", "plot", "render", "c3d"])
 def test_cli_help_teaches(verb, capsys):
     from motiontheater.cli import main
 

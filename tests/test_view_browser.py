@@ -368,13 +368,21 @@ def test_footplants_are_marked_on_the_feet_and_the_timeline(browser, data_dir, t
     assert not green[int(y) - 3 : int(y) + 4, int(x) - 3 : int(x) + 4].any()
 
 
-def apply_recipe(text: str, motion: mt.Motion) -> mt.Motion:
-    """The recipe's steps through motiontheater's Pipeline."""
-    pipeline = mt.Pipeline()
-    for step in tomllib.loads(text)["step"]:
-        first, last = step["frames"]
-        pipeline = pipeline.then(step["run"], first, last, step.get("joints"), step.get("size", 3))
-    return pipeline.apply(motion)
+def apply_recipe(text: str, motion: mt.Motion, tmp_path) -> mt.Motion:
+    """The recipe applied by the command line (motiontheater apply) to the take, read back."""
+    from motiontheater.cli import main
+
+    recipe, take = (
+        tmp_path / "steps.toml",
+        tmp_path / ("take.bvh" if motion.skeleton.convention == "bvh" else "take.amc"),
+    )
+    recipe.write_text(text, encoding="utf-8")
+    mt.write_take(motion, take)
+    if take.suffix == ".amc":
+        mt.write_asf(motion.skeleton, take.with_suffix(".asf"))
+    out = take.with_name("out" + take.suffix)
+    assert main(["apply", str(take), "--recipe", str(recipe), "-o", str(out)]) == 0
+    return mt.read_take(out, take.with_suffix(".asf") if take.suffix == ".amc" else None)
 
 
 def previewed(browser, shape):
@@ -415,7 +423,7 @@ def test_recipe_from_the_page_gives_the_previewed_motion(browser, data_dir, tmp_
         browser.execute_script("mtView.addStep(arguments[0])", step)
     recipe = browser.execute_script("return mtView.recipe()")
     assert recipe.count("[[step]]") == len(steps)
-    expected = apply_recipe(recipe, motion).values
+    expected = apply_recipe(recipe, motion, tmp_path).values
     got = previewed(browser, motion.values.shape)
     assert np.abs(got - expected).max() <= 1e-6
     assert not np.array_equal(expected, motion.values)  # the steps did something
@@ -447,7 +455,7 @@ def test_editing_through_the_controls(browser, data_dir, tmp_path):
         "frames": [first, last],
         "joints": ["rfemur", "rtibia", "rfoot", "rtoes"],
     }
-    expected = apply_recipe(recipe, motion).values
+    expected = apply_recipe(recipe, motion, tmp_path).values
     assert np.abs(previewed(browser, motion.values.shape) - expected).max() <= 1e-6
     # a bad step is refused with a message and changes nothing
     size.clear()
@@ -464,4 +472,4 @@ def test_editing_through_the_controls(browser, data_dir, tmp_path):
     browser.find_element(By.CSS_SELECTOR, "#stack li:last-child button").click()
     recipe = browser.find_element(By.ID, "recipe").get_attribute("value")
     assert recipe.count("[[step]]") == 1
-    assert np.abs(previewed(browser, motion.values.shape) - apply_recipe(recipe, motion).values).max() <= 1e-6
+    assert np.abs(previewed(browser, motion.values.shape) - apply_recipe(recipe, motion, tmp_path).values).max() <= 1e-6

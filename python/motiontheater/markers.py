@@ -18,12 +18,14 @@ origin, 1.2e-4 mm below 2.048 m, 2.4e-4 mm below 4.096 m.
 from __future__ import annotations
 
 import warnings
+from typing import Annotated
 
 import numpy as np
 
 from ._io import Source, output
 from ._optional import require
 from .motion import Motion
+from .registry import exporter
 
 MAX_MARKERS = 255  # one POINT:LABELS parameter; more needs LABELS2, which readers handle unevenly
 
@@ -40,7 +42,13 @@ def c3d_points(motion: Motion, *, workers: int | None = None) -> np.ndarray:
     return points
 
 
-def write_c3d(motion: Motion, target: Source, *, workers: int | None = None) -> None:
+@exporter("c3d", (".c3d",), "write every joint and end site as a C3D marker (millimetres; the c3d extra)")
+def write_c3d(
+    motion: Motion,
+    target: Source,
+    *,
+    workers: Annotated[int | None, "threads (default: every core for large takes)"] = None,
+) -> None:
     """Write every joint and end site of the motion as a C3D marker (see the module docstring).
     A path is written atomically; ValueError for a motion without frames or with more than
     255 points."""

@@ -36,44 +36,33 @@ from importlib.resources import files
 
 import numpy as np
 
-from .. import __version__
 from .._io import Source, output
+from .._version import __version__
 from ..filtering import FILTERS
-from ..interpolate import INTERPOLATORS
-from ..kinematics import joint_tree
+from ..interpolators import INTERPOLATORS
 from ..motion import Motion
+from ..registry import lookup
 
 __all__ = ["DEFAULT_MAX_FRAMES", "EDIT_STEPS", "page", "write_page"]
 
 DEFAULT_MAX_FRAMES = 30_000
 """Frames per take a page holds before it decimates (250 s at 120 Hz; a one-hour take keeps every 15th)."""
 
-_LABELS = {
-    "euler": "euler: linear on the angles",
-    "slerp": "slerp: quaternions, short arc",
-    "expmap": "expmap: linear exponential maps",
-    "aligned_expmap": "aligned expmap",
-    "median3": "median3: 3-frame median",
-    "median": "median filter",
-    "mean": "mean filter",
-    "binomial": "binomial filter",
-}
-
 EDIT_STEPS: tuple[dict, ...] = tuple(
     {
         "kind": kind,
-        "label": _LABELS[kind],
-        "run": kind,  # the step's name in recipes
+        "label": f"{kind}: {lookup(kind).summary}",
+        "run": kind,  # the registered step's name, as recipes give it
         "options": {},  # fixed options written with it
         "size": kind in FILTERS,  # takes a window size
     }
     for kind in (*INTERPOLATORS, "median3", *FILTERS)
 )
-"""The editor's steps and how each is written in a recipe: a ``[[step]]`` table with ``run``, the
-fixed ``options``, ``size`` where it takes one, ``frames = [first, last]`` (frame numbers) and
-``joints`` (absent: all)."""
+"""The editor's steps (registered steps whose preview the page computes) and how each is written in
+a recipe: a ``[[step]]`` table with ``run``, the fixed ``options``, ``size`` where it takes one,
+``frames = [first, last]`` (frame numbers) and ``joints`` (absent: all)."""
 
-_APPLY_HINT = "motiontheater apply --recipe RECIPE.toml TAKE -o OUT"
+_APPLY_HINT = "motiontheater apply TAKE --recipe RECIPE.toml -o OUT"
 _EXACT_LIMIT = 2**26  # |m| below this fits the word's 27 bits beside the 5 of d
 _POW10 = 10.0 ** np.arange(23)  # exact doubles: 10^22 is the largest power of ten that is one
 
@@ -107,7 +96,7 @@ def _spans(flags: np.ndarray) -> list[list[int]]:
 
 def _take_data(motion: Motion, label: str, step: int, plants: Mapping[str, np.ndarray] | None) -> dict:
     skeleton = motion.skeleton
-    tree = joint_tree(skeleton)
+    tree = skeleton.tree
     names = skeleton.joint_names
     index = {name: i for i, name in enumerate(names)}
     values = motion.values[::step]
@@ -146,7 +135,7 @@ def _take_data(motion: Motion, label: str, step: int, plants: Mapping[str, np.nd
         "dofStart": tree.dof_start.tolist(),
         "dofKind": tree.dof_kind.tolist(),
         "dofColumn": tree.dof_column.tolist(),
-        "parentFrame": tree.parent_frame.tolist(),
+        "parentFrame": np.asarray(tree.parent_frame, dtype=np.uint8).tolist(),
         "angleScale": tree.angle_scale,
         "plants": shown_plants,
         "values": _encode_values(values),
