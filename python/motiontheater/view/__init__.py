@@ -51,7 +51,7 @@ DEFAULT_MAX_FRAMES = 30_000
 EDIT_STEPS: tuple[dict, ...] = tuple(
     {
         "kind": kind,
-        "label": f"{kind}: {lookup(kind).summary}",
+        "label": lookup(kind).summary,
         "run": kind,  # the registered step's name, as recipes give it
         "options": {},  # fixed options written with it
         "size": kind in FILTERS,  # takes a window size

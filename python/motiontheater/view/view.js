@@ -1107,10 +1107,14 @@
     for (const s of DATA.steps) {
       const o = document.createElement("option");
       o.value = s.kind;
-      o.textContent = s.label;
+      o.textContent = s.kind;
+      o.title = s.label;
       kind.append(o);
     }
-    const sizeShown = () => ($("e-size-label").hidden = !stepSpec(kind.value).size);
+    const sizeShown = () => {
+      $("e-size-label").hidden = !stepSpec(kind.value).size;
+      $("e-what").textContent = stepSpec(kind.value).label;
+    };
     kind.addEventListener("change", sizeShown);
     sizeShown();
     if (!DATA.editable) {
