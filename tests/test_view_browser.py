@@ -84,6 +84,13 @@ def frame_shown(browser) -> int:
     return int(browser.execute_script("return document.body.dataset.frame"))
 
 
+def settle(browser) -> None:
+    """Return after two animation frames: the page has drawn what the last input changed."""
+    browser.execute_async_script(
+        "const done = arguments[arguments.length - 1]; requestAnimationFrame(() => requestAnimationFrame(() => done()));"
+    )
+
+
 def wait_frame(browser, frame: int) -> None:
     """Wait until the page shows this frame number (it draws on the next animation frame)."""
     WebDriverWait(browser, 5).until(lambda d: frame_shown(d) == frame)
@@ -216,18 +223,18 @@ def test_orbit_zoom_and_pan_move_the_camera(browser, data_dir, tmp_path):
     camera = "return document.getElementById('view3d').toDataURL()"
     pictures = [browser.execute_script(camera)]
     ActionChains(browser).move_to_element(view).click_and_hold().move_by_offset(80, 30).release().perform()
-    time.sleep(0.1)
+    settle(browser)
     pictures.append(browser.execute_script(camera))
     before = joints_on_screen(browser)
     ActionChains(browser).scroll_from_origin(ScrollOrigin.from_element(view), 0, 300).perform()  # zoom out
-    time.sleep(0.1)
+    settle(browser)
     after = joints_on_screen(browser)
     spread = lambda points: np.ptp(np.array(points), axis=0).max()
     assert spread(after) < spread(before)
     ActionChains(browser).move_to_element(view).key_down(Keys.SHIFT).click_and_hold().move_by_offset(
         50, 0
     ).release().key_up(Keys.SHIFT).perform()
-    time.sleep(0.1)
+    settle(browser)
     moved = joints_on_screen(browser)
     shift = np.array(moved).mean(axis=0) - np.array(after).mean(axis=0)
     assert abs(shift[0] - 50) < 10 and abs(shift[1]) < 10  # panned with the pointer
@@ -349,7 +356,8 @@ def test_footplants_are_marked_on_the_feet_and_the_timeline(browser, data_dir, t
     flags[:200] = True
     open_page(browser, tmp_path, [motion], plants=[{"ltoes": flags}])
     browser.execute_script("mtView.seek(100)")
-    time.sleep(0.2)
+    wait_frame(browser, 101)
+    settle(browser)
     picture = screenshot(browser)
     j = motion.skeleton.joint_names.index("ltoes")
     x, y = joints_on_screen(browser)[j]
@@ -361,7 +369,8 @@ def test_footplants_are_marked_on_the_feet_and_the_timeline(browser, data_dir, t
     xa, xb = curve_x(browser, 100), curve_x(browser, 1500)
     assert inked(picture, xa, strip_y, 1) and not inked(picture, xb, strip_y, 1)
     browser.execute_script("mtView.seek(1000)")
-    time.sleep(0.2)
+    wait_frame(browser, 1001)
+    settle(browser)
     picture = screenshot(browser)
     x, y = joints_on_screen(browser)[j]
     green = (picture[..., 1] > 120) & (picture[..., 0] < 80) & (picture[..., 2] < 110)
