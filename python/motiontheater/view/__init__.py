@@ -7,18 +7,22 @@ camera that follows the root), the joint tree with the selected joint's
 channel values and an axis-angle glyph of its rotation, the selected joint's
 channel curves with a playhead, several takes compared (overlaid curves and
 ghosted skeletons, aligned in time), optional footplants, and an editor that
-stacks the interpolators and filters of :mod:`motiontheater.interpolate` over
-frame ranges, previews them and exports the stack as a recipe.
+stacks the registered interpolators (:mod:`motiontheater.interpolators`) and
+filters (:mod:`motiontheater.filtering`) over frame ranges, previews them
+(JavaScript ports of those steps, equal to about 1e-12) and exports the
+stack as a recipe for ``motiontheater apply``.
 
 What the page holds, and why: each take's channel values and its joint tree,
 not positions.  The channels are what the joint table, the curves and the
 editing preview need, and the page computes forward kinematics from them
 (the port of mtcore's kernel, to about 1e-12), so positions would only add
 three numbers per point per frame.  Values are stored exactly: a value equal
-to m / 10^d (integers |m| < 2^26, d <= 22; every value read from a decimal
-file of up to seven significant digits) is a 32-bit word, any other its
-float64; words go in four byte planes, deflated, base64.  CMU 01_01 (2,751
-frames x 62 channels) makes a page of about 0.6 MB.
+to m / 10^d (integers |m| < 2^26, d <= 22: every value read from a decimal
+of up to seven significant digits and 22 decimals) is a 32-bit word, which
+the page divides back to the same double; any other value is kept as its
+float64.  Words go in four byte planes, deflated, base64 (the page inflates
+them with the browser's DecompressionStream).  CMU 01_01 (2,751 frames x 62
+channels) makes a page of 0.65 MB.
 
 Takes longer than ``max_frames`` frames are decimated (1 frame in k is kept,
 k the smallest that fits) and the page says so; editing is then off,
@@ -112,7 +116,6 @@ def _take_data(motion: Motion, label: str, step: int, plants: Mapping[str, np.nd
         shown_plants[point] = _spans(flags[::step])
     return {
         "name": label,
-        "label": label,
         "frameRate": motion.frame_rate,
         "firstFrame": motion.first_frame,
         "step": step,

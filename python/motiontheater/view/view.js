@@ -500,7 +500,7 @@
     editedPositions: null,
     dirtyCurves: true,
     dirty: true,
-    stats: { ticks: 0, playTicks: 0, drawMs: 0, maxDrawMs: 0, startedAt: 0 },
+    stats: { ticks: 0, playTicks: 0, drawMs: 0, maxDrawMs: 0 },
   };
 
   function take0() {
@@ -759,7 +759,7 @@
     head.insertCell().textContent = "";
     for (const take of S.takes) {
       const cell = head.insertCell();
-      cell.textContent = take.label;
+      cell.textContent = take.name;
       cell.style.color = take.colour;
     }
     const dofs = t.dofs[j];
@@ -1347,7 +1347,7 @@
     for (const take of S.takes) {
       const span = document.createElement("span");
       span.innerHTML = `<i style="background:${take.colour}"></i>`;
-      span.append(take.label);
+      span.append(take.name);
       legend.append(span);
     }
     if (DATA.note) {
