@@ -439,6 +439,40 @@ def test_recipe_from_the_page_gives_the_previewed_motion(browser, data_dir, tmp_
     assert console_errors(browser) == []
 
 
+def test_preview_over_missing_and_infinite_samples(browser, data_dir, tmp_path):
+    """NaN and inf in the frames edited: the page's steps treat them as the package's do."""
+    motion = cmu(data_dir)
+    values = motion.values.copy()
+    femur, humerus = motion.columns("lfemur"), motion.columns("rhumerus")
+    values[300:304, femur[0]] = np.nan  # a gap inside a filtered range
+    values[310, femur[1]] = np.inf
+    values[500, humerus] = np.nan  # a key of an interpolation
+    values[200:220, humerus[2]] = np.nan  # a gap at the start of a range
+    motion = motion.replace(values=values)
+    open_page(browser, tmp_path, [motion])
+    steps = [
+        dict(kind="median", first=290, last=330, joints=["lfemur"], size=5),
+        dict(kind="mean", first=200, last=260, joints=["rhumerus"], size=7),
+        dict(kind="binomial", first=280, last=320, joints=None, size=5),
+        dict(kind="median3", first=290, last=320, joints=None),
+        dict(kind="slerp", first=480, last=500, joints=["rhumerus"]),
+    ]
+    for step in steps:
+        browser.execute_script("mtView.addStep(arguments[0])", step)
+    expected = mt.Pipeline.from_toml(browser.execute_script("return mtView.recipe()")).apply(motion).values
+    got = np.array(
+        browser.execute_script(
+            "return mtView.values(0).map(v => Number.isNaN(v) ? 'nan' : v === Infinity ? 'inf' : v === -Infinity ? '-inf' : v)"
+        )
+    )
+    got = got.astype(float).reshape(motion.values.shape)
+    assert np.array_equal(np.isnan(got), np.isnan(expected)) and np.array_equal(np.isinf(got), np.isinf(expected))
+    finite = np.isfinite(expected)
+    assert np.array_equal(got[~finite & ~np.isnan(expected)], expected[~finite & ~np.isnan(expected)])
+    assert np.abs(got[finite] - expected[finite]).max() <= 1e-6
+    assert console_errors(browser) == []
+
+
 def test_editing_through_the_controls(browser, data_dir, tmp_path):
     motion = cmu(data_dir)
     open_page(browser, tmp_path, [motion], names=["01_01.amc"])

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import io
 import mmap
 import os
@@ -48,6 +49,7 @@ def decode(data: bytes) -> str:
 
 
 def encode(text: str) -> bytes:
+    """The bytes of :func:`decode`'s text, undecodable bytes restored."""
     return text.encode("utf-8", "surrogateescape")
 
 
@@ -55,16 +57,85 @@ def encode(text: str) -> bytes:
 def output(target: Source) -> Iterator[IO[bytes]]:
     """A binary stream to write to.  For a path, the text goes to a temporary file
     beside it that replaces the path only when complete, so that a failure
-    leaves no partial file."""
+    leaves no partial file; the file gets the permissions any new file gets
+    (the umask's).  An OSError names the target, never the temporary file."""
     if not isinstance(target, (str, os.PathLike)):
         yield typing.cast(IO[bytes], target.buffer if isinstance(target, io.TextIOWrapper) else target)
         return
-    directory = os.path.dirname(os.path.abspath(target))
-    fd, tmp = tempfile.mkstemp(prefix=PARTIAL_PREFIX, suffix="-" + os.path.basename(target), dir=directory)
+    path = os.fspath(target)
+    directory = os.path.dirname(os.path.abspath(path))
+    remove_stale_partials(directory)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f"{PARTIAL_PREFIX}{os.getpid()}-", suffix=".tmp", dir=directory)
+    except OSError as e:
+        raise OutputError(e.errno, f"cannot write {path}: {e.strerror}") from None
     try:
         with os.fdopen(fd, "wb") as f:
             yield f
-        os.replace(tmp, target)
-    except BaseException:
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, path)
+    except BaseException as e:
         os.unlink(tmp)
+        if isinstance(e, OSError) and e.filename in (None, tmp) and e.errno in WRITE_ERRORS:
+            raise OutputError(e.errno, f"cannot write {path}: {e.strerror}") from None
         raise
+
+
+WRITE_ERRORS = (errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+
+
+class OutputError(OSError):
+    """A file could not be written (no permission, read-only, disk full): the message names the
+    file the user asked for, never the temporary file."""
+
+    def __str__(self) -> str:
+        return str(self.strerror)
+
+
+def _umask() -> int:
+    """The process's umask (read without changing it where /proc tells it)."""
+    try:
+        with open("/proc/self/status") as f:
+            return int(next(line for line in f if line.startswith("Umask:")).split()[1], 8)
+    except (OSError, StopIteration, ValueError):
+        mask = os.umask(0o022)
+        os.umask(mask)
+        return mask
+
+
+_CLEANED: set[str] = set()
+
+
+def remove_stale_partials(directory: str | os.PathLike, *, recursive: bool = False) -> int:
+    """Remove the temporary files that killed processes left in ``directory`` (and below it,
+    ``recursive``); a file being written by a live process is left alone.  A folder is looked
+    at once per process unless ``recursive``.  Returns how many were removed."""
+    folder = os.fspath(directory)
+    if not recursive:
+        if folder in _CLEANED:
+            return 0
+        _CLEANED.add(folder)
+    removed = 0
+    with contextlib.suppress(OSError), os.scandir(folder) as entries:
+        for entry in entries:
+            if recursive and entry.is_dir(follow_symlinks=False):
+                removed += remove_stale_partials(entry.path, recursive=True)
+            elif entry.name.startswith(PARTIAL_PREFIX) and not _alive(entry.name[len(PARTIAL_PREFIX) :]):
+                with contextlib.suppress(OSError):
+                    os.unlink(entry.path)
+                    removed += 1
+    return removed
+
+
+def _alive(rest: str) -> bool:
+    """Whether the process whose id starts ``rest`` ("<pid>-...") still runs."""
+    pid = rest.split("-", 1)[0]
+    if not pid.isdigit():
+        return False
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True

@@ -39,7 +39,10 @@ def skeleton_path_for(amc_path: str | os.PathLike) -> Path:
         if matches and (best is None or len(stem) > len(best.stem.split("-")[0])):
             best = asf
     if best is None:
-        raise FileNotFoundError(f"no skeleton (.asf) for {amc} in {amc.parent}")
+        raise FileNotFoundError(
+            f"no skeleton for {amc}: no .asf in {amc.parent} matches its name (CMU 01_02.amc -> 01.asf, "
+            "HDM05 HDM_bd_squat_003_120.amc -> HDM_bd.asf, take.amc -> take.asf); give it with --asf"
+        )
     return best
 
 
@@ -65,7 +68,7 @@ def _split_header(data: Text) -> tuple[list[tuple[int, str]], int, int]:
         lines += 1
         if line:
             header.append((lines, decode(line)))
-        pos = end + (2 if data[end : end + 2] == b"\r\n" else 1)
+        pos = min(len(data), end + (2 if data[end : end + 2] == b"\r\n" else 1))
     return header, pos, lines
 
 

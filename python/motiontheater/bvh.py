@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mtcore.errors import CountError, FormatError, MissingError, TruncatedError
-from mtcore.text import format_table, scan_table
+from mtcore.text import format_table, parse_number, scan_table
 
 from ._io import LINE_BREAK, Source, decode, encode, output, read_source
 from .motion import Motion
@@ -64,8 +64,10 @@ def _read(data) -> Motion:
     if frames_match is None or time_match is None:
         raise MissingError("the MOTION section needs 'Frames: N' and 'Frame Time: T'", motion_line)
     try:
+        if not frames_match.group(1).isdigit():  # int() would take '_', signs and other scripts' digits
+            raise ValueError
         frames = int(frames_match.group(1))
-        frame_time = float(time_match.group(1))
+        frame_time = parse_number(time_match.group(1))
     except ValueError:
         raise FormatError("expected a whole number of frames and a frame time in seconds", motion_line + 1) from None
     if frames < 0 or not frame_time > 0:
@@ -206,7 +208,7 @@ def _numbers(words: list[str], count: int, number: int, what: str) -> tuple[floa
     if len(words) != count:
         raise CountError(f"{what} takes {count} numbers, found {len(words)}", number)
     try:
-        return tuple(float(w) for w in words)
+        return tuple(parse_number(w) for w in words)
     except ValueError:
         raise FormatError(f"expected numbers after {what}, found '{' '.join(words)}'", number) from None
 
@@ -246,7 +248,7 @@ def write_bvh(motion: Motion, target: Source) -> None:
 
     joint("root", 0)
     frame_time = next((h.split(":", 1)[1].strip() for h in motion.header if h.lower().startswith("frame time")), None)
-    if frame_time is None or 1.0 / float(frame_time) != motion.frame_rate:
+    if frame_time is None or 1.0 / parse_number(frame_time) != motion.frame_rate:
         frame_time = format_number(1.0 / motion.frame_rate)
     lines += ["MOTION", f"Frames: {motion.frames}", f"Frame Time: {frame_time}"]
     columns = [c for name in written for c in motion.columns(name)] if motion.values.shape[1] else []

@@ -211,6 +211,20 @@ class Skeleton:
         except KeyError:
             raise UnknownNameError(f"no bone '{joint}' in skeleton '{self.name}'") from None
 
+    def columns_of(self, joints: Iterable[str] | None = None) -> list[int]:
+        """The columns of the joints' channels (every joint's when None), in the order given.
+        UnknownNameError for a name the skeleton lacks, ValueError for a joint without channels
+        (an end site, a bone without dofs): asking to change it is a mistake worth saying."""
+        if joints is None:
+            return list(range(len(self.channels)))
+        columns: list[int] = []
+        for joint in joints:
+            start, count = self.first_column(joint), len(self.dofs(joint))
+            if not count:
+                raise ValueError(f"joint '{joint}' has no channels (it only follows its parent)")
+            columns.extend(range(start, start + count))
+        return columns
+
     def euler_groups(self, joints: Iterable[str] | None = None) -> list[tuple[str, bool, np.ndarray]]:
         """The joints (all by default) with three rotation channels, grouped by Euler convention
         so that each group converts in one call: (order, extrinsic, columns (joints, 3)), columns

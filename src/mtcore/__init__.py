@@ -11,12 +11,14 @@ angles, matrices, quaternions, rotation vectors) in :mod:`mtcore.rotations`.
 """
 
 from . import errors
+from ._parallel import cpu_count
 from .filters import MODES, binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
 from .text import format_frames, format_number, scan_frames
 
 __all__ = [
     "MODES",
     "binomial_filter1d",
+    "cpu_count",
     "errors",
     "format_frames",
     "format_number",

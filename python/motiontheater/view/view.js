@@ -388,21 +388,36 @@
     return window[(window.length - 1) >> 1];
   }
 
-  /* one column's rows a..b filtered with edges held ("nearest"), into out */
+  /* one column's rows a..b filtered with edges held ("nearest"), into out.  The mean is mtcore's
+   * running sum, restarted every max(size, 256) frames as its kernel does: a NaN or inf entering
+   * the sum spoils the rest of its stretch there too. */
   function filterColumn(src, out, C, c, a, b, kind, size, base) {
     const half = size >> 1, n = b - a + 1;
-    const at = (i) => src[(a + Math.min(Math.max(i, 0), n - 1)) * C + c];
+    const at = (i) => src[(a + Math.min(Math.max(i, 0), n - 1)) * C + c] - base;
+    if (kind === "mean") {
+      const chunk = Math.max(size, 256);
+      for (let t0 = 0; t0 < n; t0 += chunk) {
+        let acc = 0;
+        for (let j = 0; j + 1 < size; j++) acc += at(t0 - half + j);
+        for (let t = t0; t < Math.min(n, t0 + chunk); t++) {
+          const sum = acc + at(t - half + size - 1);
+          out[(a + t) * C + c] = sum / size + base;
+          acc = sum - at(t - half);
+        }
+      }
+      return;
+    }
     const weights = kind === "binomial" ? pascal(size) : null;
     for (let i = 0; i < n; i++) {
       let v;
       if (kind === "median") {
         const w = [];
         for (let k = -half; k <= half; k++) w.push(at(i + k));
-        v = median(w);
+        v = median(w) + base;
       } else {
         let sum = 0;
-        for (let k = -half; k <= half; k++) sum += (weights ? weights[k + half] : 1) * (at(i + k) - base);
-        v = (weights ? sum : sum / size) + base;
+        for (let k = -half; k <= half; k++) sum += weights[k + half] * at(i + k);
+        v = sum + base;
       }
       out[(a + i) * C + c] = v;
     }
@@ -425,8 +440,9 @@
     return out;
   }
 
-  /* filter_motion over rows a..b as a motion of its own: rotations unwrapped, smoothed relative to
-   * the first row (means), wrapped back into the range the rows used */
+  /* filter_motion over rows a..b as a motion of its own: rotations unwrapped (a sample that is not
+   * finite is stepped over), smoothed relative to the first finite value (means), wrapped back into
+   * the range the finite samples used (inf and NaN kept as they are) */
   function smooth(take, values, a, b, kind, size, joints) {
     const C = take.channelCount, out = values.slice();
     const period = take.angleUnit === "deg" ? 360 : 2 * Math.PI;
@@ -436,34 +452,38 @@
       columnsOf(take, joint).forEach((c, i) => (ROTATIONS.includes(dofs[i]) ? rotations : others).push(c));
     }
     const unwrapped = values.slice(); // only rows a..b of the chosen columns are read
-    const low = {}, high = {};
+    const low = {}, high = {}, base = {};
     for (const c of rotations.concat(others)) {
-      let lo = Infinity, hi = -Infinity;
+      let lo = Infinity, hi = -Infinity, first = null;
       for (let f = a; f <= b; f++) {
-        lo = Math.min(lo, values[f * C + c]);
-        hi = Math.max(hi, values[f * C + c]);
+        const v = values[f * C + c];
+        if (!Number.isFinite(v)) continue;
+        lo = Math.min(lo, v);
+        hi = Math.max(hi, v);
+        if (first === null) first = v;
       }
       low[c] = lo;
       high[c] = hi;
+      base[c] = first === null ? 0 : first;
     }
     for (const c of rotations) {
-      let turns = 0;
-      for (let f = a + 1; f <= b; f++) {
-        const step = values[f * C + c] - values[(f - 1) * C + c];
+      let turns = 0, last = values[a * C + c]; // the last finite sample (the first sample to begin)
+      for (let f = a; f <= b; f++) {
+        const raw = values[f * C + c], filled = Number.isFinite(raw) ? raw : last;
+        const step = filled - last;
         if (Math.abs(step) > period / 2) turns += -roundEven(step / period);
-        unwrapped[f * C + c] = values[f * C + c] + turns * period;
+        unwrapped[f * C + c] = raw + turns * period;
+        last = filled;
       }
     }
-    for (const c of rotations.concat(others)) {
-      const base = kind === "median" ? 0 : values[a * C + c];
-      filterColumn(unwrapped, out, C, c, a, b, kind, size, base);
-    }
+    for (const c of rotations.concat(others)) filterColumn(unwrapped, out, C, c, a, b, kind, size, kind === "median" ? 0 : base[c]);
     const half = period / 2;
     for (const c of rotations) {
       const centred = low[c] >= -half && high[c] <= half;
       const positive = !centred && low[c] >= 0 && high[c] <= period;
       for (let f = a; f <= b; f++) {
         const v = out[f * C + c];
+        if (!Number.isFinite(v)) continue;
         if (centred && !(Math.abs(v) <= half)) out[f * C + c] = v - period * Math.floor((v + half) / period);
         if (positive && !(v >= 0 && v <= period)) out[f * C + c] = v - period * Math.floor(v / period);
       }
