@@ -49,47 +49,52 @@ static char *digits_before(uint64_t v, char *end)
 }
 
 /* A style checked and unpacked; NULL is the default style. */
+struct line_end {
+    size_t len;
+    char bytes[2];
+};
+
 struct style {
     int digits, exponent_digits;
-    size_t newline_len;
-    char newline[2];
+    struct line_end newline, frame_newline;
 };
+
+/* The bytes of a line ending code; 0 for a code that is none. */
+static int unpack_line_end(int code, struct line_end *end)
+{
+    switch (code) {
+    case MT_NEWLINE_LF:
+        *end = (struct line_end){1, {'\n', 0}};
+        return 1;
+    case MT_NEWLINE_CRLF:
+        *end = (struct line_end){2, {'\r', '\n'}};
+        return 1;
+    case MT_NEWLINE_CR:
+        *end = (struct line_end){1, {'\r', 0}};
+        return 1;
+    default:
+        return 0;
+    }
+}
 
 static int unpack_style(const struct mt_format_style *in, struct style *s)
 {
-    static const struct mt_format_style fallback = {0, 2, MT_NEWLINE_LF};
+    static const struct mt_format_style fallback = {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF};
     if (in == NULL)
         in = &fallback;
     if (in->digits < 0 || in->digits > 17 || in->exponent_digits < 1 || in->exponent_digits > 3)
         return 0;
     s->digits = in->digits;
     s->exponent_digits = in->exponent_digits;
-    switch (in->newline) {
-    case MT_NEWLINE_LF:
-        s->newline_len = 1;
-        s->newline[0] = '\n';
-        break;
-    case MT_NEWLINE_CRLF:
-        s->newline_len = 2;
-        s->newline[0] = '\r';
-        s->newline[1] = '\n';
-        break;
-    case MT_NEWLINE_CR:
-        s->newline_len = 1;
-        s->newline[0] = '\r';
-        break;
-    default:
-        return 0;
-    }
-    return 1;
+    return unpack_line_end(in->newline, &s->newline) && unpack_line_end(in->frame_newline, &s->frame_newline);
 }
 
-static inline char *put_newline(const struct style *s, char *out)
+static inline char *put_newline(const struct line_end *end, char *out)
 {
-    out[0] = s->newline[0];
-    if (s->newline_len == 2)
-        out[1] = s->newline[1];
-    return out + s->newline_len;
+    out[0] = end->bytes[0];
+    if (end->len == 2)
+        out[1] = end->bytes[1];
+    return out + end->len;
 }
 
 /*
@@ -200,9 +205,9 @@ size_t mt_format_bound(size_t frames, const size_t *key_lens, const size_t *coun
     struct style s;
     if (!unpack_style(style, &s) || (nkeys > 0 && (key_lens == NULL || counts == NULL)))
         return SIZE_MAX;
-    size_t per_frame = 18 + s.newline_len; /* a frame number <= MT_FRAME_MAX has 18 digits */
+    size_t per_frame = 18 + s.frame_newline.len; /* a frame number <= MT_FRAME_MAX has 18 digits */
     for (size_t k = 0; k < nkeys; k++)
-        per_frame = add_sat(per_frame, add_sat(add_sat(key_lens[k], s.newline_len),
+        per_frame = add_sat(per_frame, add_sat(add_sat(key_lens[k], s.newline.len),
                                                mul_sat(counts[k], MT_NUMBER_MAX + 1)));
     return mul_sat(frames, per_frame);
 }
@@ -212,7 +217,7 @@ size_t mt_format_table_bound(size_t rows, size_t columns, const struct mt_format
     struct style s;
     if (!unpack_style(style, &s))
         return SIZE_MAX;
-    return mul_sat(rows, add_sat(mul_sat(columns, MT_NUMBER_MAX + 1), s.newline_len));
+    return mul_sat(rows, add_sat(mul_sat(columns, MT_NUMBER_MAX + 1), s.newline.len));
 }
 
 int mt_format_frames(const double *values, size_t frames, size_t channels, long long first_frame,
@@ -239,7 +244,7 @@ int mt_format_frames(const double *values, size_t frames, size_t channels, long 
         char number[20];
         const char *start = digits_before((uint64_t)first_frame + f, number + sizeof number);
         memcpy(out, start, (size_t)(number + sizeof number - start));
-        out = put_newline(&s, out + (number + sizeof number - start));
+        out = put_newline(&s.frame_newline, out + (number + sizeof number - start));
         const double *row = values + f * channels;
         for (size_t k = 0; k < nkeys; k++) {
             memcpy(out, keys[k], key_lens[k]);
@@ -248,7 +253,7 @@ int mt_format_frames(const double *values, size_t frames, size_t channels, long 
                 *out++ = ' ';
                 out = put_number(row[offsets[k] + i], &s, out);
             }
-            out = put_newline(&s, out);
+            out = put_newline(&s.newline, out);
         }
     }
     *written = (size_t)(out - buf);
@@ -272,7 +277,7 @@ int mt_format_table(const double *values, size_t rows, size_t columns, const str
                 *out++ = ' ';
             out = put_number(values[r * columns + c], &s, out);
         }
-        out = put_newline(&s, out);
+        out = put_newline(&s.newline, out);
     }
     *written = (size_t)(out - buf);
     return MT_OK;

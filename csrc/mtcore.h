@@ -162,7 +162,7 @@ enum mt_newline {
 };
 
 /*
- * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF}.
+ * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF}.
  *
  *   digits           0: the shortest text that reads back as exactly the value, of
  *                    those the nearest to it (the digits of Python's repr); exponent
@@ -174,11 +174,14 @@ enum mt_newline {
  *   exponent_digits  the fewest digits of an exponent, 1 .. 3: 2 gives 1e-05 (Python,
  *                    C on Linux), 3 gives 1e-005 (HDM05 files, C on Windows).
  *   newline          the line ending of mt_format_frames and mt_format_table.
+ *   frame_newline    the ending of the lines that hold only a frame number
+ *                    (mt_format_frames): HDM05 ends those in LF, every other in CRLF.
  */
 struct mt_format_style {
     int digits;
     int exponent_digits;
     int newline;
+    int frame_newline;
 };
 
 /* Bytes a number can take: -1.2345678901234567e-308. */
@@ -338,6 +341,93 @@ int mt_combine(const double *old_values, size_t old_frames, const double *new_va
                const double *weight, const unsigned char *selected, const long long *offset_row,
                const double *offsets, size_t offset_rows, const size_t *offset_channel,
                size_t noffsets, size_t begin, size_t end, double *out);
+/*
+ * Signal kernels (bands.c, iir.c, resample.c, gaps.c), float64.  Unless said
+ * otherwise an array is n rows (frames) of `channels` values, consecutive
+ * rows `stride` values apart (stride >= channels): a call may process a slab
+ * of the columns of a wider (n, stride) array, so that threads can share the
+ * channels of one array.  Outputs have the input's layout and never alias it.
+ */
+
+/*
+ * The band equaliser of Bruderlin and Williams (1995).  Level G_0 is the
+ * input; G_{k+1} is G_k correlated with (1 4 6 4 1) / 16, its taps 2^k frames
+ * apart (no decimation: every level has all n frames), the level extended
+ * past its ends by `mode` (fill value cval); band k is G_k - G_{k+1}.  Writes
+ *
+ *     out = in + sum_{k < levels} (gains[k] - 1) (G_k - G_{k+1}),
+ *
+ * which is G_levels + sum gains[k] band_k, summed so that gains of 1 give the
+ * input exactly.  Requires 2^levels <= n (for n >= 1).
+ */
+int mt_equalize(const double *in, double *out, size_t n, size_t channels, size_t stride, size_t levels,
+                const double *gains, int mode, double cval);
+
+/*
+ * How mt_sosfiltfilt extends a line a b c d by padlen samples (scipy's padtype):
+ *
+ *   odd       2a-d 2a-c 2a-b | a b c d | 2d-c 2d-b 2d-a
+ *   even         d    c    b | a b c d | c b a
+ *   constant     a    a    a | a b c d | d d d
+ *   none         (no extension)
+ */
+enum mt_pad {
+    MT_PAD_NONE = 0,
+    MT_PAD_ODD = 1,
+    MT_PAD_EVEN = 2,
+    MT_PAD_CONSTANT = 3
+};
+
+/*
+ * Forward-backward filtering by `sections` second-order sections (sos,
+ * sections x 6: b0 b1 b2 a0 a1 a2, a0 = 1), as scipy.signal.sosfiltfilt: the
+ * line extended by padlen samples (padtype), filtered forward from the state
+ * zi[s] * (first sample), then backward from zi[s] * (last forward output),
+ * the extension cut off.  zi (sections x 2) is the steady state of a unit
+ * step (scipy.signal.sosfilt_zi).  Requires padlen < n (padlen is ignored
+ * for MT_PAD_NONE, then n >= 1).
+ *
+ * Computed as scipy computes it, bit for bit, with the input read twice and
+ * the output written once (see iir.c).
+ */
+int mt_sosfiltfilt(const double *sos, size_t sections, const double *zi, const double *in, double *out, size_t n,
+                   size_t channels, size_t stride, size_t padlen, int padtype);
+
+/*
+ * Upsample by up, filter by the FIR h (taps), downsample by down, as
+ * scipy.signal.upfirdn, on (n, channels) rows (stride = channels): output row
+ * j (begin <= j < end, at out + j * channels) is
+ *
+ *     sum over i of v[i] h[(skip + j) down - i up],  0 <= (skip + j) down - i up < taps,
+ *
+ * v[i] = in row i for 0 <= i < n, before row nbefore + i for -nbefore <= i < 0,
+ * after row i - n for n <= i < n + nafter (both (rows, channels)), 0 elsewhere.
+ */
+int mt_upfirdn(const double *h, size_t taps, size_t up, size_t down, const double *in, size_t n, size_t channels,
+               const double *before, size_t nbefore, const double *after, size_t nafter, size_t skip, size_t begin,
+               size_t end, double *out);
+
+enum mt_fill {
+    MT_FILL_LINEAR = 0, /* the line between the samples around the gap (numpy.interp) */
+    MT_FILL_CUBIC = 1   /* the not-a-knot cubic spline of scipy.interpolate.CubicSpline */
+};
+
+/*
+ * Copies in to out and fills each run of NaN in a channel that is at most
+ * max_gap frames long and has a sample on both sides.  MT_FILL_CUBIC takes
+ * the spline through every sample of the stretch between the runs left
+ * unfilled (or the ends of the line).  Other runs stay NaN.
+ */
+int mt_fill_gaps(const double *in, double *out, size_t n, size_t channels, size_t stride, size_t max_gap,
+                 int method);
+
+/*
+ * The runs of NaN: (channel, first frame, frame after the last) triples, in
+ * the order they end, the first `capacity` of them into runs (capacity x 3);
+ * *count receives how many there are (runs may be NULL when capacity is 0).
+ */
+int mt_nan_runs(const double *in, size_t n, size_t channels, size_t stride, size_t *runs, size_t capacity,
+                size_t *count);
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from mtcore.errors import CountError, FormatError, MissingError, TruncatedError
-from mtcore.text import format_table, parse_number, scan_table
+from mtcore.text import format_number, format_table, parse_number, scan_table
 
-from ._io import LINE_BREAK, Source, decode, encode, output, read_source
+from ._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
 from .motion import Motion
 from .skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem
 
@@ -46,7 +46,7 @@ def read_bvh(source: Source) -> Motion:
     """
     data, name = read_source(source)
     try:
-        return _read(data)
+        return _read(data).read_from(source)
     except FormatError as e:
         raise e.at(name) from None
 
@@ -77,8 +77,15 @@ def _read(data) -> Motion:
     start = max(frames_match.end(), time_match.end())
     start = data.find(b"\n", start) + 1 if data.find(b"\n", start) != -1 else len(data)
     lines_before = data.count(b"\n", 0, start)
+    columns = len(skeleton.channels)
+    room = (len(data) - start + 1) // max(1, 2 * columns)  # a frame takes a digit and a blank per channel
+    if frames > room and frames * columns * 8 > 1 << 24:  # a header's claim is no reason to allocate much
+        raise TruncatedError(
+            f"the header says {frames} frames but the {len(data) - start} bytes after it hold at most {room}",
+            motion_line + 1,
+        )
     try:
-        values = scan_table(data, frames, len(skeleton.channels), start=start)
+        values = scan_table(data, frames, columns, start=start)
     except FormatError as e:
         raise e.at(None, lines_before) from None
     values.flags.writeable = False
@@ -89,6 +96,7 @@ def _read(data) -> Motion:
         first_frame=1,
         header=(f"Frame Time: {decode(time_match.group(1))}",),
         line_order=None,
+        style=TextStyle.of(data),
     )
 
 
@@ -215,11 +223,14 @@ def _numbers(words: list[str], count: int, number: int, what: str) -> tuple[floa
 
 def write_bvh(motion: Motion, target: Source) -> None:
     """Write a motion of a BVH skeleton as BVH, to a path (atomically) or a binary file object;
-    every number the shortest text that reads back exactly, the frame time as it was read."""
+    every number the shortest text that reads back exactly, the frame time as it was read, lines
+    and exponents laid out as the file read was (``motion.style``).  A motion written back
+    unchanged is its file's very bytes."""
     skeleton = motion.skeleton
     if skeleton.convention != "bvh":
         raise ValueError("write_bvh needs a motion of a BVH skeleton (read_bvh, or convert an ASF/AMC first)")
-    from mtcore import format_number
+    if motion.unchanged() and motion.origin is not None and motion.origin.file.copy_to(target):
+        return
 
     lines = ["HIERARCHY"]
     written: list[str] = []  # joints in the order the file declares them: its columns' order
@@ -252,6 +263,9 @@ def write_bvh(motion: Motion, target: Source) -> None:
         frame_time = format_number(1.0 / motion.frame_rate)
     lines += ["MOTION", f"Frames: {motion.frames}", f"Frame Time: {frame_time}"]
     columns = [c for name in written for c in motion.columns(name)] if motion.values.shape[1] else []
+    style = motion.style
     with output(target) as f:
-        f.write(encode("\n".join(lines) + "\n"))
-        format_table(motion.values[:, columns], f.write)
+        f.write(style.lines(lines))
+        format_table(motion.values[:, columns], f.write, **style.numbers())
+        if not style.final_newline and f.seekable():  # the file read ended without a line break
+            f.truncate(f.tell() - len(style.newline))

@@ -53,7 +53,7 @@ _NEWLINES = {b"\n": lib.MT_NEWLINE_LF, b"\r\n": lib.MT_NEWLINE_CRLF, b"\r": lib.
 _GRAMMAR = "a number (optional sign, digits with an optional '.' and exponent, as 17.8693 or -1.2e-05; or inf, nan)"
 
 
-def _style(digits: int | None, exponent_digits: int, newline: bytes = b"\n"):
+def _style(digits: int | None, exponent_digits: int, newline: bytes = b"\n", frame_newline: bytes | None = None):
     """The C style of numbers and lines, checked: see format_frames."""
     if digits is not None:
         try:
@@ -68,9 +68,13 @@ def _style(digits: int | None, exponent_digits: int, newline: bytes = b"\n"):
         raise TypeError(f"exponent_digits must be an integer, got {type(exponent_digits).__name__}") from None
     if not 1 <= exponent_digits <= 3:
         raise ValueError(f"exponent_digits must be 1, 2 or 3, got {exponent_digits}")
-    if newline not in _NEWLINES:
-        raise ValueError(f"newline must be one of {sorted(_NEWLINES)}, got {newline!r}")
-    return ffi.new("struct mt_format_style *", [digits or 0, exponent_digits, _NEWLINES[newline]])
+    frame_newline = newline if frame_newline is None else frame_newline
+    for name, ending in (("newline", newline), ("frame_newline", frame_newline)):
+        if ending not in _NEWLINES:
+            raise ValueError(f"{name} must be one of {sorted(_NEWLINES)}, got {ending!r}")
+    return ffi.new(
+        "struct mt_format_style *", [digits or 0, exponent_digits, _NEWLINES[newline], _NEWLINES[frame_newline]]
+    )
 
 
 class _KeyTable:
@@ -275,6 +279,7 @@ def format_frames(
     digits: int | None = None,
     exponent_digits: int = 2,
     newline: bytes = b"\n",
+    frame_newline: bytes | None = None,
 ) -> None:
     """Write (frames, channels) values as frame text through ``write``, in chunks.
 
@@ -287,7 +292,7 @@ def format_frames(
     ``1e-05``; 3: ``1e-005`` as HDM05 writes), ``newline`` the line ending
     (``b"\\n"``, ``b"\\r\\n"`` or ``b"\\r"``); :func:`text_style` finds both in a file.
     """
-    style = _style(digits, exponent_digits, newline)
+    style = _style(digits, exponent_digits, newline, frame_newline)
     values = np.ascontiguousarray(values, dtype=np.float64)
     if values.ndim != 2:
         raise ValueError(f"values must be (frames, channels), got shape {values.shape}")
@@ -456,7 +461,7 @@ _STYLE_SAMPLE = 1 << 22  # bytes of a file that text_style looks at
 _EXPONENTS = (b"e-", b"e+", b"E-", b"E+")
 
 
-def text_style(data: bytes) -> tuple[bytes, int]:
+def text_style(data: Text) -> tuple[bytes, int]:
     """The line ending and the fewest exponent digits of the numbers of a file's text, for
     writing it back alike: ``(newline, exponent_digits)`` for :func:`format_frames`.
 
