@@ -16,8 +16,8 @@ def test_csv(motion, tmp_path):
     mt.write_positions(motion, tmp_path / "p.csv")
     lines = (tmp_path / "p.csv").read_text().splitlines()
     header = lines[0].split(",")
-    assert header[:5] == ["frame", "time", "root.x", "root.y", "root.z"]
-    assert header[-1] == f"{motion.skeleton.bone_names[-1]}.z"
+    assert header[:5] == ["frame", "time [s]", "root.x [in/0.45]", "root.y [in/0.45]", "root.z [in/0.45]"]
+    assert header[-1] == f"{motion.skeleton.bone_names[-1]}.z [in/0.45]"
     table = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
     assert table.shape == (motion.frames, 2 + 3 * 31)
     np.testing.assert_array_equal(table[:, 0], np.arange(1, motion.frames + 1))

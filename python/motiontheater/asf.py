@@ -9,7 +9,16 @@ from mtcore.errors import CountError, DuplicateError, FormatError, MissingError,
 
 from ._io import LINE_BREAK, Source, decode, encode, output, read_source
 from ._version import __version__
-from .skeleton import BONE_DOFS, ROOT_DOFS, Bone, Root, Skeleton, canonical_hierarchy, name_problem
+from .skeleton import (
+    BONE_DOFS,
+    ROOT_DOFS,
+    Bone,
+    Root,
+    Skeleton,
+    canonical_hierarchy,
+    name_problem,
+    settle_length_unit,
+)
 
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|infinity|nan)", re.IGNORECASE)
 _LIMIT = re.compile(r"\(\s*(\S+)\s+(\S+)\s*\)")
@@ -64,9 +73,10 @@ def read_asf(source: Source) -> Skeleton:
     """
     data, name = read_source(source)
     try:
-        return _parse(_Lines(decode(data)))
+        skeleton = _parse(_Lines(decode(data)))
     except FormatError as e:
         raise e.at(name) from None
+    return settle_length_unit(skeleton)  # a stated unit that makes the character absurdly sized is corrected
 
 
 def _parse(lines: _Lines) -> Skeleton:

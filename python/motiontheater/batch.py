@@ -33,6 +33,7 @@ from .errors import FormatError
 from .formats import TAKE_SUFFIXES, skeleton_for, write_take
 from .motion import Motion
 from .pipeline import Pipeline
+from .skeleton import settle_length_unit
 from .streaming import CHUNK_FRAMES, stream, streamable
 
 STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed (when its pipeline allows)
@@ -50,6 +51,7 @@ class Job:
     frame_rate: float | None = None
     stream_above: int = STREAM_ABOVE
     chunk_frames: int = CHUNK_FRAMES
+    unit: str | None = None  # the takes' length unit (--unit), when given
 
 
 @dataclass
@@ -100,6 +102,7 @@ def plan_jobs(
     resume: bool = False,
     stream_above: int = STREAM_ABOVE,
     chunk_frames: int = CHUNK_FRAMES,
+    unit: str | None = None,
 ) -> tuple[list[Job], list[Result]]:
     """The jobs to run, and the takes skipped or failed before running (no skeleton, already done)."""
     jobs, settled = [], []
@@ -114,7 +117,9 @@ def plan_jobs(
         if resume and target.exists() and target.stat().st_mtime >= inputs_time:
             settled.append(Result(str(take), str(target), skipped=True, bytes=take.stat().st_size))
             continue
-        job = Job(str(take), str(target), str(asf) if asf else "", pipeline, frame_rate, stream_above, chunk_frames)
+        job = Job(
+            str(take), str(target), str(asf) if asf else "", pipeline, frame_rate, stream_above, chunk_frames, unit
+        )
         jobs.append(job)
     return jobs, settled
 
@@ -144,8 +149,9 @@ def run_job(job: Job) -> Result:
 
 def _read(job: Job) -> Motion:
     if not job.skeleton:
-        return read_bvh(job.input)
-    return read_amc(job.input, _skeleton(job.skeleton, *_stamp(job.skeleton)), job.frame_rate, workers=1)
+        return read_bvh(job.input, unit=job.unit)
+    skeleton = settle_length_unit(_skeleton(job.skeleton, *_stamp(job.skeleton)), job.unit)
+    return read_amc(job.input, skeleton, job.frame_rate, workers=1)
 
 
 def _write(job: Job, result: Motion, motion: Motion) -> str:
