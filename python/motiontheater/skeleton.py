@@ -302,7 +302,8 @@ class Skeleton:
         self, *, length_factor: float = 1.0, length: str | None = None, angle: str | None = None
     ) -> Skeleton:
         """The same skeleton with lengths multiplied by ``length_factor`` (unit text
-        ``length``) and angles converted to ``angle`` ("deg" or "rad")."""
+        ``length``, which then is the unit in effect) and angles converted to ``angle``
+        ("deg" or "rad").  A BVH joint's OFFSET (its ``direction``) is a length too."""
         factor = angle_factor(self.angle_unit, angle)
         units = dict(self.units)
         choice = self.length_choice
@@ -315,6 +316,7 @@ class Skeleton:
             replace(
                 b,
                 length=b.length * length_factor,
+                direction=_scaled(b.direction, length_factor) if self.convention == "bvh" else b.direction,
                 axis=_scaled(b.axis, factor),
                 limits=tuple(
                     (lo * f, hi * f)
