@@ -152,7 +152,7 @@ def to_asf(motion: Motion) -> Motion:
         turner = () if parent == "root" else tuple(d for d in skeleton.bone(parent).dofs if d in ROTATIONS)[::-1]
         shift = tuple(d for d in bone.dofs if d in TRANSLATIONS)
         name = bone.name.replace(" ", "_")
-        length = float(np.linalg.norm(bone.direction))
+        length = math.hypot(*bone.direction)  # as the kinematic tables measure it: the vector is kept exactly
         bones.append(Bone(name=name, direction=bone.direction, length=length, dofs=turner + shift))
         pairs.append(("root" if parent == "root" else parent.replace(" ", "_"), (name,)))
         if turner:

@@ -426,7 +426,7 @@ def _joint_tree(skeleton: Skeleton) -> JointTree:
             segment.append(_replaced(d, bone.dofs))
             continue
         axis.append(_axis_frame(bone.axis_order, bone.axis, degrees))
-        norm = float(np.linalg.norm(d))
+        norm = math.hypot(*d)  # no overflow for huge components, unlike the sum of squares
         unit = d / norm if norm > 0 else np.zeros(3)
         direction.append(unit)
         # a direction that is already the bone's vector (converted BVH offsets) is kept exactly
