@@ -146,3 +146,22 @@ Frame Time: 0.5
 1 2 3 4 5 6 7 8 9
 1 2 3 4 5 7 7 8 9
 """
+
+
+def test_every_verb_that_reads_takes_takes_a_unit():
+    from motiontheater.cli import build_parser
+
+    verbs = build_parser()._subparsers._group_actions[0].choices
+    readers = {name for name, p in verbs.items() if any(a.dest == "asf" for a in p._actions)}
+    assert {"info", "filter", "apply", "batch", "convert", "positions", "median"} <= readers
+    for name in readers - {"bench"}:  # bench reads a take for its timings only
+        assert any(a.dest == "unit" for a in verbs[name]._actions), name
+
+
+def test_batch_reads_with_the_unit_given(data_dir, tmp_path):
+    (tmp_path / "in").mkdir()
+    (tmp_path / "in" / "walk01.bvh").write_bytes((data_dir / "bvh" / "walk01.bvh").read_bytes())
+    (tmp_path / "r.toml").write_text('[[step]]\nrun = "positions"\n')
+    args = ["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--recipe", str(tmp_path / "r.toml")]
+    assert main([*args, "--jobs", "1", "--quiet", "--unit", "mm"]) == 0
+    assert (tmp_path / "out" / "walk01.csv").read_text().split(",")[2] == "root.x [mm]"

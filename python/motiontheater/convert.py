@@ -194,9 +194,14 @@ def convert(
 ) -> Motion:
     """The motion in the other file convention: see :func:`to_bvh` and :func:`to_asf`.
 
-    ASF/AMC to BVH: a joint at each bone's start carries the bone's rotation.
-    BVH to ASF/AMC: a bone per segment, named after the joint it ends at; the
-    skeleton is written beside an AMC output as OUT.asf.
+    ASF/AMC to BVH: a joint at each bone's start carries the bone's rotation
+    (and position channels where the bone before translates or stretches).
+    BVH to ASF/AMC: a bone per segment, named after the joint it ends at, with
+    translation dofs where the joint has position channels; the skeleton is
+    written beside an AMC output as OUT.asf.  Lengths keep their numbers and
+    their unit: the ASF's :units length goes with the BVH motion, and a BVH's
+    (detected, given with --unit, or assumed) becomes the ASF's.  A BVH file
+    states no unit: one whose size does not tell it is read back with --unit.
     """
     if to is None:
         to = "asf" if motion.skeleton.convention == "bvh" else "bvh"

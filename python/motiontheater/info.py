@@ -21,6 +21,7 @@ from .bvh import NAMES as BVH_CHANNEL_NAMES
 from .motion import Motion
 
 SET_UNIT = f"set another with --unit UNIT (Python: unit=UNIT), UNIT: {units.UNIT_HELP}"
+_WORDS = {"m": "metres", "cm": "centimetres", "mm": "millimetres", "in": "inches"}
 SET_RATE = "set it with --frame-rate HZ (Python: read_amc(..., frame_rate=HZ))"
 
 
@@ -113,7 +114,7 @@ def as_text(facts: dict[str, Any]) -> str:
     skeleton_file = f" of skeleton {facts['skeleton_file']}" if facts["skeleton_file"] else ""
     lines = [f"{facts['file'] or 'take'}: {facts['format']} take{skeleton_file}"]
     if frames:
-        span = f"{frames} frames, numbered {facts['first_frame']} to {facts['last_frame']}"
+        span = f"{frames} frame{'s' if frames > 1 else ''}, numbered {facts['first_frame']} to {facts['last_frame']}"
     else:
         span = f"no frames (the first would be number {facts['first_frame']})"
     rate_note = {"stated": "", "given": " (given)", "assumed": f" (assumed: the AMC states no rate; {SET_RATE})"}
@@ -206,7 +207,7 @@ def _why(skeleton, sizing: units.Sizing) -> str:
                 f"{_g(max(sizing.extents) * stated)} m in size; "
             )
         return (
-            f"{said}its rest pose {what}, {_g(meters)} m in {unit}, the one unit of "
+            f"{said}its rest pose {what}, {_g(meters)} m in {_WORDS.get(unit, unit)}, the one unit of "
             f"{', '.join(units.DETECTABLE)} that gives a human size ({low:g} to {high:g} m)"
         )
     cmu = ""
