@@ -296,7 +296,10 @@ class Skeleton:
     def with_length_unit(self, unit: str, source: str = "given") -> Skeleton:
         """The same skeleton (lengths unchanged) read as being in ``unit`` (m, cm, mm, in, or a
         number L for inch / L), chosen as ``source`` says; the stated ``units`` stay as they were."""
-        return replace(self, length_choice=(unit.strip(), source))
+        relabelled = replace(self, length_choice=(unit.strip(), source))
+        if "tree" in self.__dict__:  # the same geometry: the kinematic tables worked out for the rest pose serve
+            relabelled.__dict__["tree"] = self.tree
+        return relabelled
 
     def with_units(
         self, *, length_factor: float = 1.0, length: str | None = None, angle: str | None = None
