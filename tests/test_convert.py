@@ -227,6 +227,8 @@ def test_convert_command_says_when_a_unit_was_assumed(data_dir, tmp_path, capsys
     assert "the length unit of the input was assumed (cm)" in err and "--unit UNIT" in err
     assert main(["convert", str(data_dir / "bvh" / "walk01.bvh"), "-o", str(tmp_path / "w.amc")]) == 0
     assert capsys.readouterr().err == ""  # detected, and nothing to say
+    assert main(["median", str(data_dir / "bvh" / "sinusoidal.bvh"), "--size", "3", "-o", str(tmp_path / "s.bvh")]) == 0
+    assert capsys.readouterr().err == ""  # a BVH in, a BVH out: its unit, assumed again, matters to neither
 
 
 def test_bad_order():

@@ -22,7 +22,7 @@ def info_json(capsys, *args):
 @pytest.mark.parametrize("take", TAKES, ids=ids(TAKES))
 def test_info_on_every_real_take(take, capsys):
     assert main(["info", str(take)]) == 0
-    text = capsys.readouterr().out
+    text = " ".join(capsys.readouterr().out.split())  # unwrapped
     facts = info_json(capsys, take)
     motion = mt.read_take(take)
     assert facts["frames"] == motion.frames and facts["first_frame"] == motion.first_frame
@@ -38,7 +38,8 @@ def test_info_on_every_real_take(take, capsys):
     assert rest["height_m"] == pytest.approx(rest["height"] * motion.skeleton.meters_per_unit)
     for words in ("frames", "length unit", "up axis", "height", "Joint tree", "--unit UNIT"):
         assert words in text
-    assert f"{motion.frames} frames, numbered {motion.first_frame} to {motion.last_frame}" in text
+    frames = f"{motion.frames} frame{'s' if motion.frames > 1 else ''}"
+    assert f"{frames}, numbered {motion.first_frame} to {motion.last_frame}" in text
     assert facts["length_unit"]["source"] in text
     for joint in facts["joints"]:
         assert joint["name"] in text

@@ -162,24 +162,24 @@ def field(lines: list[str], name: str, text: str) -> None:
 
 def unit_notes(motion: Motion, result: Motion, target: str | os.PathLike) -> list[str]:
     """What a command says about length units after writing ``result`` (made from ``motion``)
-    to ``target``: that the input's unit was assumed, and that a BVH written in a unit its
-    size does not tell must be read back with ``--unit`` (a BVH file states no unit)."""
-    notes = []
-    skeleton = motion.skeleton
-    if skeleton.length_source == "assumed":
-        notes.append(
-            f"note: the length unit of the input was assumed ({units.label(skeleton.length_unit)}): "
-            f"its size tells none; {SET_UNIT}"
-        )
+    to ``target``.  A BVH file states no unit: one written in a unit its size does not tell
+    must be read back with ``--unit``.  Into other files (an ASF's ``:units length``, positions)
+    the unit goes as a fact: if the input's was only assumed, that is said."""
     if os.fspath(target).lower().endswith(".bvh"):
         unit = result.skeleton.length_unit or "1"
-        sizing = result.skeleton.sizing()
-        if units.meters_per(unit) != units.meters_per(sizing.unit or units.ASSUMED_UNIT):
-            notes.append(
-                f"note: BVH files state no length unit and the size of this one does not tell its unit, "
-                f"{units.label(unit)} ({_g(units.meters_per(unit))} m): read {os.fspath(target)} with --unit {unit}"
-            )
-    return notes
+        told = result.skeleton.sizing().unit or units.ASSUMED_UNIT
+        if units.meters_per(unit) == units.meters_per(told):
+            return []
+        return [
+            f"note: BVH files state no length unit and the size of this one does not tell its unit, "
+            f"{units.label(unit)} ({_g(units.meters_per(unit))} m): read {os.fspath(target)} with --unit {unit}"
+        ]
+    if motion.skeleton.length_source == "assumed":
+        return [
+            f"note: the length unit of the input was assumed ({units.label(motion.skeleton.length_unit)}): "
+            f"its size tells none; {SET_UNIT}"
+        ]
+    return []
 
 
 def _why(skeleton, sizing: units.Sizing) -> str:
