@@ -430,7 +430,8 @@ def _joint_tree(skeleton: Skeleton) -> JointTree:
             continue
         axis.append(_axis_frame(bone.axis_order, bone.axis, degrees))
         norm = math.hypot(*d)  # no overflow for huge components, unlike the sum of squares
-        unit = d / norm if norm > 0 else np.zeros(3)
+        # no direction: zero; an infinite one (bad input) has none either, and says so with NaN
+        unit = d / norm if 0 < norm < math.inf else np.full(3, math.nan if norm else 0.0)
         direction.append(unit)
         # a direction that is already the bone's vector (converted BVH offsets) is kept exactly
         segment.append(d if bone.length == norm else unit * bone.length)
