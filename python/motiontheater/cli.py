@@ -28,11 +28,13 @@ from .asf import write_asf
 from .examples import noisy_rotations
 from .filtering import FILTERS
 from .formats import read_take, take_suffix, write_take
+from .info import as_text, describe, unit_notes
 from .motion import Motion
 from .pipeline import Pipeline
 from .registry import Option, Step, lookup, steps
 from .scene import RECIPE_HELP as SCENE_HELP
 from .scene import read_recipe
+from .units import UNIT_HELP
 
 RECIPE_HELP = """\
 A recipe is a TOML file of [[step]] tables, applied in order; each names a step
@@ -80,9 +82,15 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _take_options(parser: argparse.ArgumentParser) -> None:
-    """How a take is read: the flags every verb that reads AMC takes shares."""
+    """How a take is read: the flags every verb that reads takes shares."""
     parser.add_argument("--asf", help="the AMC's skeleton (default: the ASF beside it, by the CMU/HDM05 naming)")
     parser.add_argument("--frame-rate", type=float, metavar="HZ", help="frames per second when the AMC does not say")
+    parser.add_argument(
+        "--unit",
+        metavar="UNIT",
+        help=f"the takes' length unit: {UNIT_HELP} "
+        "(default: a BVH's is told from its size, an ASF's is its :units length)",
+    )
 
 
 def _output_options(parser: argparse.ArgumentParser, what: str) -> None:
@@ -116,6 +124,8 @@ def _write(motion: Motion, result: Motion, source: str, target: str) -> str:
     """Write a step's result as its suffix says; an AMC of a new skeleton gets its ASF beside it.
     Returns what was written, in words."""
     write_take(result, target)
+    for note in unit_notes(motion, result, target):
+        print(note, file=sys.stderr)
     if result.skeleton.convention == "asf" and result.skeleton is not motion.skeleton:
         skeleton = os.path.splitext(target)[0] + ".asf"
         write_asf(result.skeleton, skeleton)
@@ -130,10 +140,12 @@ def _run_step(args: argparse.Namespace) -> int:
     target = _output(args, source)
     if not step.is_exporter:
         take_suffix(target)
-    motion = read_take(source, asf, args.frame_rate)
+    motion = read_take(source, asf, args.frame_rate, args.unit)
     if step.is_exporter:
         step(motion, target, **options)
         print(f"{step.name}: wrote {motion.frames} frames of {source} to {target}")
+        for note in unit_notes(motion, motion, target):
+            print(note, file=sys.stderr)
         return 0
     result = step(motion, **options)
     written = _write(motion, result, source, target)
@@ -147,7 +159,7 @@ def _apply(args: argparse.Namespace) -> int:
     target = _output(args, source)
     if pipeline.exporter is None:
         take_suffix(target)
-    motion = read_take(source, asf, args.frame_rate)
+    motion = read_take(source, asf, args.frame_rate, args.unit)
     result = pipeline.apply(motion)
     if pipeline.exporter is not None:
         pipeline.write(result, target)
@@ -164,7 +176,7 @@ def _filter(args: argparse.Namespace) -> int:
     source, asf = _inputs(args)
     target = _output(args, source)
     take_suffix(target)
-    motion = read_take(source, asf, args.frame_rate)
+    motion = read_take(source, asf, args.frame_rate, args.unit)
     written = _write(motion, pipeline.apply(motion), source, target)
     entry = pipeline.entries[0]
     which = ", ".join(args.joints) if args.joints else "all joints"
@@ -197,6 +209,18 @@ def _filter_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def _info(args: argparse.Namespace) -> int:
+    import json
+
+    from .formats import skeleton_for
+
+    motion = read_take(args.input, args.asf, args.frame_rate, args.unit)
+    skeleton_file = None if args.input.lower().endswith(".bvh") else skeleton_for(args.input, args.asf)
+    facts = describe(motion, args.input, skeleton_file, frame_rate_given=args.frame_rate is not None)
+    print(json.dumps(facts, indent=2) if args.json else as_text(facts))
+    return 0
+
+
 def _steps(args: argparse.Namespace) -> int:
     for name, step in steps().items():
         kind = f"exporter ({', '.join(step.suffixes)})" if step.is_exporter else "step"
@@ -221,6 +245,7 @@ def _batch(args: argparse.Namespace) -> int:
         pipeline,
         skeleton=args.asf,
         frame_rate=args.frame_rate,
+        unit=args.unit,
         resume=args.resume,
         in_place=args.in_place,
         stream_above=int(args.stream_above * 1e6),
@@ -505,6 +530,23 @@ def build_parser() -> argparse.ArgumentParser:
 
     listing = verbs.add_parser("steps", help="list every step and exporter with its options")
     listing.set_defaults(run=_steps)
+
+    about = verbs.add_parser(
+        "info",
+        help="describe a take: frames, rate, units, height, up axis, joint tree and channel ranges",
+        description=(
+            "Describe a take (AMC or BVH): its frames, frame rate, duration and first frame; its length "
+            "unit, how that was chosen (stated by the ASF, detected from the character's size, given with "
+            "--unit, or assumed) and how to set another; the character's height in metres and in file "
+            "units and its up axis; and the joint tree with each channel's range over the take. --json "
+            "prints the same as JSON for programs."
+        ),
+        epilog="Example: motiontheater info walk01.bvh ; motiontheater info 01_01.amc --json",
+    )
+    about.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    about.add_argument("--json", action="store_true", help="print JSON (NaN as null)")
+    _take_options(about)
+    about.set_defaults(run=_info)
 
     smooth = verbs.add_parser(
         "filter",
