@@ -130,3 +130,29 @@ print(mt.read_amc(take, skeleton).frames)
         *["table mt_scan_table"] * 3,
         "2751",
     ], done.stdout
+
+
+def test_the_error_in_a_bad_take_does_not_depend_on_the_worker_count():
+    """A take scanned in pieces reports the first thing wrong in it, as one piece does: here a frame
+    number out of sequence where a piece begins, and a later one inside that piece."""
+    from mtcore.errors import FormatError
+    from mtcore.text import _piece_count, _pieces, scan_frames
+
+    keys, offsets, counts = [b"root", b"lfemur"], [0, 6], [6, 3]
+    frame = ["{}", "root 1.5 2.5 3.5 0.1 0.2 0.3", "lfemur 10.25 -3.5 7"]
+    lines = [line.format(f) for f in range(1, 60_001) for line in frame]
+    whole = ("\n".join(lines) + "\n").encode()
+    boundaries = [begin for begin, _ in _pieces(whole, 0, _piece_count(4, len(whole)))[1:]]
+    assert boundaries, "the take must be long enough to be cut"
+    for boundary in boundaries:
+        at = whole[:boundary].count(b"\n")
+        lines_bad = list(lines)
+        lines_bad[at] = "5"
+        lines_bad[at + 30] = "root 1 2 x 4 5 6"
+        text = ("\n".join(lines_bad) + "\n").encode()
+        errors = set()
+        for workers in (1, 2, 3, 4):
+            with pytest.raises(FormatError) as caught:
+                scan_frames(text, keys, offsets, counts, 9, workers=workers)
+            errors.add((type(caught.value), str(caught.value)))
+        assert errors == {(mt.SequenceError, f"line {at + 1}: frame number 5 out of sequence: expected {at // 3 + 1}")}

@@ -183,12 +183,13 @@ def scan_frames(
         statuses = run_all([piece(i) for i in range(len(pieces))])
     frames, first = 0, 0
     for (begin, _), base, report, status in zip(pieces, bases, reports, statuses):
-        check(status, "mt_scan_frames", _describer(text, start, begin, table, report, noun))
+        # the piece's first frame number comes before anything else wrong in it, as in one piece
         if frames and report.frames and report.first_frame != first + frames:
             raise SequenceError(
                 f"frame number {report.first_frame} out of sequence: expected {first + frames}",
                 line_breaks(text, start, begin) + 1,
             )
+        check(status, "mt_scan_frames", _describer(text, start, begin, table, report, noun))
         if not frames:
             first = report.first_frame
         values[frames : frames + report.frames] = values[base : base + report.frames]
