@@ -8,10 +8,14 @@ import io
 import mmap
 import os
 import re
+import shutil
 import tempfile
 import typing
 from collections.abc import Iterator
-from typing import IO
+from dataclasses import dataclass
+from typing import IO, Any
+
+from mtcore.text import frame_line, text_style
 
 Source = str | os.PathLike | IO[bytes] | IO[str]
 Text = bytes | mmap.mmap  # a file's bytes, read or mapped
@@ -40,6 +44,78 @@ def mapped_source(source: Source) -> Iterator[tuple[bytes | mmap.mmap, str | Non
         return
     with open(source, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
         yield mapped, os.fspath(source)
+
+
+@dataclass(frozen=True)
+class TextStyle:
+    """How a file's text is laid out, so that what is written from it looks the same: its line
+    endings (``frame_newline`` for the lines that hold only a frame number, which HDM05 ends in LF
+    while every other line ends in CRLF), the fewest digits of an exponent (HDM05: 3, ``e-013``),
+    and whether the last line ends in a line break."""
+
+    newline: bytes = b"\n"
+    frame_newline: bytes = b"\n"
+    exponent_digits: int = 2
+    final_newline: bool = True
+
+    @classmethod
+    def of(cls, data: bytes | mmap.mmap) -> TextStyle:
+        """The style of a file's text."""
+        newline, exponent_digits = text_style(data)
+        frame = frame_line(data, 0, min(len(data), 1 << 20))
+        frame_newline = newline
+        if frame != -1:
+            match = _LINE_END.search(data, frame)
+            frame_newline = match.group() if match else newline
+        return cls(newline, frame_newline, exponent_digits, not data or data[-1:] in (b"\n", b"\r"))
+
+    def lines(self, lines: list[str]) -> bytes:
+        """Header lines as bytes, each ended as the file ends its lines."""
+        return encode("".join(line + self.newline.decode() for line in lines))
+
+    def numbers(self) -> dict[str, Any]:
+        """The options of mtcore.text's writers for this style (format_frames also takes frame_newline)."""
+        return {"exponent_digits": self.exponent_digits, "newline": self.newline}
+
+
+PLAIN = TextStyle()  # what this package writes when no file says otherwise
+_LINE_END = re.compile(rb"\r\n|\r|\n")
+
+
+@dataclass(frozen=True)
+class Origin:
+    """The file an object was read from, and the file's size and time then: while they hold, the
+    file still says exactly what was read, and writing the unchanged object back can copy it."""
+
+    path: str
+    stamp: tuple[int, int]
+
+    @classmethod
+    def of(cls, source: Source) -> Origin | None:
+        """The origin of a source named by path; None for a file object (it cannot be read again)."""
+        if not isinstance(source, (str, os.PathLike)):
+            return None
+        status = os.stat(source)
+        return cls(os.path.abspath(source), (status.st_size, status.st_mtime_ns))
+
+    def intact(self) -> bool:
+        """Whether the file is still as it was read."""
+        try:
+            status = os.stat(self.path)
+        except OSError:
+            return False
+        return (status.st_size, status.st_mtime_ns) == self.stamp
+
+    def copy_to(self, target: Source) -> bool:
+        """Write the file's bytes to ``target`` (atomically, as :func:`output`) if it is intact and
+        is not the target itself; returns whether it did."""
+        if not self.intact():
+            return False
+        if isinstance(target, (str, os.PathLike)) and os.path.abspath(target) == self.path:
+            return True  # writing the file over itself, unchanged: nothing to do
+        with open(self.path, "rb") as src, output(target) as dst:
+            shutil.copyfileobj(src, dst)
+        return True
 
 
 def decode(data: bytes) -> str:

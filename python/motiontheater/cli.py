@@ -8,6 +8,7 @@ apply, batch, combine, bench) are written out below.
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import shutil
 import signal
@@ -467,6 +468,14 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _notes() -> logging.Handler:
+    """A handler that prints what steps note on the package's logger (a cut-off chosen, gaps left) to stderr."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    handler.setLevel(logging.INFO)
+    return handler
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status: 0 done, 1 some takes failed (batch), 2 a
     one-line reason on failure, 130 interrupted (Ctrl-C or SIGTERM: nothing partial is left)."""
@@ -475,6 +484,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.verb is None:
         parser.print_help()
         return 0
+    logger, notes = logging.getLogger("motiontheater"), _notes()
+    logger.addHandler(notes)
+    level = logger.level
+    logger.setLevel(logging.INFO)
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminated) if main_thread else None
     try:
@@ -495,6 +508,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"motiontheater {args.verb}: {exc}", file=sys.stderr)
         return 2
     finally:
+        logger.removeHandler(notes)
+        logger.setLevel(level)
         if main_thread:
             signal.signal(signal.SIGTERM, previous)
 

@@ -116,32 +116,13 @@ class Smoother:
         return mtcore.filters.lib.mt_filter1d_block(self.size)
 
     def unwrap(self, values: np.ndarray, state: Unwrapping | None) -> tuple[np.ndarray, Unwrapping | None]:
-        """(values with rotation channels unwrapped, the state after the last frame).
-
-        A jump of more than half a period between frames counts whole turns,
-        and the angle gets turns times the period added: exact multiples, so
-        that every chunking of a take unwraps to the same values.  A sample
-        that is not finite (inf, NaN) stays as it is and is stepped over: the
-        next finite one is compared with the last finite one before it, so a
-        bad sample spoils only the windows that hold it.  ``state`` is what
-        the frames before these left (None at the take's start).
-        """
+        """(values with rotation channels unwrapped by :func:`unwrap_angles`, the state after the last
+        frame).  ``state`` is what the frames before these left (None at the take's start)."""
         out = values.copy()
         if not self.rotations or not len(values):
             return out, state
-        raw = values[:, self.rotations]
-        finite = np.isfinite(raw)
-        # each sample's last finite value so far, its own where it is finite (a forward fill)
-        last = np.where(finite, np.arange(len(raw))[:, None], -1)
-        np.maximum.accumulate(last, axis=0, out=last)
-        before = raw[:1] if state is None else state.last[None]
-        filled = np.where(last >= 0, np.take_along_axis(raw, np.maximum(last, 0), axis=0), before)
-        steps = np.diff(filled, axis=0, prepend=before)
-        with np.errstate(invalid="ignore"):  # NaN steps (nothing finite yet) count no turn
-            jumps = np.where(np.abs(steps) > self.period / 2, -np.round(steps / self.period), 0.0)
-        counted = np.cumsum(jumps, axis=0) + (0.0 if state is None else state.turns)
-        out[:, self.rotations] = raw + counted * self.period
-        return out, Unwrapping(filled[-1].copy(), counted[-1].copy())
+        out[:, self.rotations], state = unwrap_angles(values[:, self.rotations], self.period, state)
+        return out, state
 
     def smooth(self, unwrapped: np.ndarray, stats: TakeStats) -> np.ndarray:
         """Smoothed frames (all channels; the chosen ones changed), rotations wrapped back."""
@@ -163,6 +144,30 @@ class Smoother:
                 values[:, self.rotations], stats.low[self.rotations], stats.high[self.rotations], self.period
             )
         return values
+
+
+def unwrap_angles(raw: np.ndarray, period: float, state: Unwrapping | None = None) -> tuple[np.ndarray, Unwrapping]:
+    """Angle columns (frames, columns, at least one frame) unwrapped, and the state after the last frame.
+
+    A jump of more than half a period between frames counts whole turns,
+    and the angle gets turns times the period added: exact multiples, so
+    that every chunking of a take unwraps to the same values.  A sample
+    that is not finite (inf, NaN) stays as it is and is stepped over: the
+    next finite one is compared with the last finite one before it, so a
+    bad sample spoils only the windows that hold it.  ``state`` is what
+    the frames before these left (None at the take's start).
+    """
+    finite = np.isfinite(raw)
+    # each sample's last finite value so far, its own where it is finite (a forward fill)
+    last = np.where(finite, np.arange(len(raw))[:, None], -1)
+    np.maximum.accumulate(last, axis=0, out=last)
+    before = raw[:1] if state is None else state.last[None]
+    filled = np.where(last >= 0, np.take_along_axis(raw, np.maximum(last, 0), axis=0), before)
+    steps = np.diff(filled, axis=0, prepend=before)
+    with np.errstate(invalid="ignore"):  # NaN steps (nothing finite yet) count no turn
+        jumps = np.where(np.abs(steps) > period / 2, -np.round(steps / period), 0.0)
+    counted = np.cumsum(jumps, axis=0) + (0.0 if state is None else state.turns)
+    return raw + counted * period, Unwrapping(filled[-1].copy(), counted[-1].copy())
 
 
 def filter_motion(

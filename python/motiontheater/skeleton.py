@@ -23,6 +23,7 @@ import numpy as np
 from mtcore import rotations
 from mtcore.kinematics import DOFS, JointTree, forward_kinematics
 
+from ._io import PLAIN, Origin, TextStyle
 from .errors import DuplicateError, HierarchyError, UnknownNameError
 
 Vec3 = tuple[float, float, float]
@@ -122,6 +123,8 @@ class Skeleton:
     documentation: tuple[str, ...] = ()
     sections: tuple[tuple[str, tuple[str, ...]], ...] = ()
     convention: str = "asf"  # "asf", or "bvh": a joint's offset turns with its parent, see kinematics
+    style: TextStyle = field(default=PLAIN, compare=False, repr=False)  # how its ASF file was laid out
+    origin: Origin | None = field(default=None, compare=False, repr=False)  # the ASF file it was read from
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
     _parents: dict[str, str] = field(init=False, repr=False, compare=False)
     _children: dict[str, tuple[str, ...]] = field(init=False, repr=False, compare=False)
