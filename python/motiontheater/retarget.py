@@ -51,6 +51,7 @@ above its feet) cannot give a hip height and is refused.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import itertools
 import math
@@ -146,7 +147,10 @@ class RetargetPlan:
 
 def _unit_text(skeleton: Skeleton) -> str:
     stated = skeleton.unit("length")
-    how = f"':units length {stated}'" if stated is not None else "not stated: inch, the Acclaim default"
+    if stated is not None:
+        how = f"':units length {stated}'"
+    else:
+        how = f"{'a BVH file' if skeleton.convention == 'bvh' else 'the ASF'} states none: inch, the Acclaim default"
     return f"{skeleton.meters_per_unit:.6g} m per unit ({how})"
 
 
@@ -663,16 +667,52 @@ def _cleanup_options(plan: RetargetPlan) -> dict:
 
 def read_target(path: str | os.PathLike) -> Skeleton:
     """The skeleton of a target file: an ASF, or a BVH's hierarchy (its rest pose: OFFSETs, every
-    rotation channel zero)."""
+    rotation channel zero), named after its file when it has no name (BVH files give none)."""
     suffix = Path(path).suffix.lower()
     if suffix not in (".asf", ".bvh"):
         raise ValueError(f"{os.fspath(path)}: the target must be an .asf or a .bvh file")
     if not os.path.exists(path):
         raise FileNotFoundError(f"{os.fspath(path)}: no such target skeleton file")
-    return read_asf(path) if suffix == ".asf" else read_bvh(path).skeleton
+    skeleton = read_asf(path) if suffix == ".asf" else read_bvh(path).skeleton
+    return skeleton if skeleton.name else dataclasses.replace(skeleton, name=Path(path).stem)
 
 
-@step("retarget", "put a take on another skeleton (.asf or .bvh): other proportions, another rig", frames="none")
+def describe_retarget(
+    motion: Motion,
+    *,
+    to: Path,
+    map: Path | None = None,
+    cleanup: bool = True,
+    mode: str = "auto",
+) -> str:
+    """What the step ``retarget`` would do to ``motion`` (``motiontheater retarget --dry-run``):
+    the plan's description (:meth:`RetargetPlan.describe`), the footskate cleanup, and the result."""
+    target = read_target(to)
+    plan = plan_retarget(motion.skeleton, target, map, mode=mode)
+    if not cleanup:
+        feet = "off: the feet are not re-planted"
+    elif is_step("cleanup"):
+        options = _cleanup_options(plan)
+        legs = ",".join(options["legs"]) if "legs" in options else "found by name"
+        feet = f"the footskate cleanup re-plants the feet (legs {legs}; up axis {options['up']})"
+    else:
+        feet = "not available in this version (no 'cleanup' step): the feet are not re-planted"
+    return "\n".join(
+        [
+            f"retarget {motion.frames} frames ({motion.first_frame}..{motion.last_frame}, {motion.frame_rate:g} Hz) "
+            f"of skeleton '{motion.skeleton.name or '(unnamed)'}' onto {os.fspath(to)}",
+            plan.describe(),
+            f"cleanup: {feet}",
+        ]
+    )
+
+
+@step(
+    "retarget",
+    "put a take on another skeleton (.asf or .bvh): other proportions, another rig",
+    frames="none",
+    dry_run=describe_retarget,
+)
 def retarget_step(
     motion: Motion,
     *,
@@ -682,17 +722,20 @@ def retarget_step(
     ] = None,
     cleanup: Annotated[bool, "re-plant the feet with the footskate cleanup after retargeting"] = True,
     mode: Annotated[
-        Literal["auto", "rotations", "directions"], "carry rotations (same rig) or bone directions"
+        Literal["auto", "rotations", "directions"],
+        "carry rotations over (the same rig) or make bones point the source's way (auto: rotations for the same rig)",
     ] = "auto",
 ) -> Motion:
-    """Put the take on the skeleton of --to, a character with other proportions or another rig.
+    """Put the take on the skeleton of --to: a character with other proportions or another rig.
 
-    Joints are paired by the built-in alias tables (CMU/HDM05 ASF, the CMU BVH conversion,
-    HumanIK/Mixamo, Biovision names) or a --map file. The same rig (another CMU subject, another
+    Joints are paired by the built-in alias tables (CMU/HDM05 ASF names, the CMU BVH conversion,
+    HumanIK and Mixamo, Biovision) or by a --map file (TOML: a [joints] table of source = "target"
+    names; the tables fill in what it does not name). The same rig (another CMU subject, another
     HDM05 actor) gets the joint rotations as they are; another rig gets each bone pointing where
-    the source's points, the rest poses (T-pose, A-pose) corrected bone by bone; unmapped target
+    the source's points, rest poses (T-pose, A-pose) corrected bone by bone; unmapped target
     joints keep their rest rotation. The root's position is scaled by the ratio of the legs (hip
-    heights at rest); up axes are matched. A BVH target's rest pose is the one its OFFSETs draw.
-    --dry-run prints the joint map, what is unmapped, the scale factors and the units assumed.
+    heights at rest) and turned to the target's up axis. A BVH target's rest pose is the one its
+    OFFSETs draw (rotations zero). --dry-run prints the joint map, what is unmapped on each side,
+    the scale factors and the units assumed, and writes nothing.
     """
     return retarget(motion, read_target(to), map, mode=mode, cleanup=cleanup)
