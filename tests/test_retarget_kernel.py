@@ -9,6 +9,7 @@ import pytest
 
 import motiontheater as mt
 from motiontheater.skeleton import Skeleton
+from mtcore.kinematics import forward_kinematics
 from mtcore.retarget import RetargetPlan, retarget_rotations
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -48,8 +49,8 @@ def test_kernel_matches_the_numpy_twin(data_dir, rng, pair, frames):
     plan = mt.plan_retarget(source, target)
     assert plan.mode == "directions"
     values = random_values(source, frames, rng)
-    got = retarget_rotations(values, source.tree, target.tree, len(target.channels), plan.kernel, workers=1)
-    want = twin.retarget_rotations(values, source.tree, target.tree, len(target.channels), plan.kernel)
+    got = retarget_rotations(values, plan.source_tree, target.tree, len(target.channels), plan.kernel, workers=1)
+    want = twin.retarget_rotations(values, plan.source_tree, target.tree, len(target.channels), plan.kernel)
     assert got.shape == (frames, len(target.channels))
     angles_equal(got, want, 1e-8)
 
@@ -85,20 +86,35 @@ def test_kernel_matches_the_twin_on_other_channel_layouts(data_dir, rng, dofs):
     target = variant(mt.read_bvh(data_dir / "bvh" / "walk01.bvh").skeleton, dofs)
     plan = mt.plan_retarget(source, target)
     values = random_values(source, 97, rng)
-    got = retarget_rotations(values, source.tree, target.tree, len(target.channels), plan.kernel, workers=1)
-    want = twin.retarget_rotations(values, source.tree, target.tree, len(target.channels), plan.kernel)
+    got = retarget_rotations(values, plan.source_tree, target.tree, len(target.channels), plan.kernel, workers=1)
+    want = twin.retarget_rotations(values, plan.source_tree, target.tree, len(target.channels), plan.kernel)
     angles_equal(got, want, 1e-8)
     translations = [c for c, (_, d) in enumerate(target.channels) if not d.startswith("r")]
     assert not got[:, translations].any()  # the kernel writes rotation channels only
+
+
+def test_the_source_tree_is_cut_to_what_the_target_reads(data_dir, rng):
+    source = mt.read_asf(data_dir / "cmu" / "01.asf")
+    plan = mt.plan_retarget(source, mt.read_bvh(data_dir / "bvh" / "walk01.bvh").skeleton)
+    kept = [source.joint_names[j] for j in plan.source_joints]
+    assert {"lfingers", "lthumb", "rtoes"}.isdisjoint(kept) and {"root", "lhipjoint", "upperback", "lwrist"} <= set(
+        kept
+    )
+    values = random_values(source, 50, rng)
+    whole, _, _ = forward_kinematics(values, source.tree)
+    cut, _, _ = forward_kinematics(values, plan.source_tree)
+    np.testing.assert_array_equal(cut, whole[:, plan.source_joints])
 
 
 def test_splitting_frames_over_threads_changes_no_bit(data_dir, rng):
     source, target = mt.read_asf(data_dir / "cmu" / "01.asf"), mt.read_asf(data_dir / "cmu" / "02.asf")
     plan = mt.plan_retarget(source, target, mode="directions")
     values = random_values(source, 1001, rng)
-    one = retarget_rotations(values, source.tree, target.tree, len(target.channels), plan.kernel, workers=1)
+    one = retarget_rotations(values, plan.source_tree, target.tree, len(target.channels), plan.kernel, workers=1)
     for workers in (2, 3, 7):
-        many = retarget_rotations(values, source.tree, target.tree, len(target.channels), plan.kernel, workers=workers)
+        many = retarget_rotations(
+            values, plan.source_tree, target.tree, len(target.channels), plan.kernel, workers=workers
+        )
         np.testing.assert_array_equal(one, many)
 
 
@@ -109,7 +125,7 @@ def test_inputs_are_not_modified_and_out_keeps_other_channels(data_dir, rng):
     values = random_values(source, 33, rng)
     before = values.copy()
     out = np.full((33, len(target.channels)), 7.0)
-    retarget_rotations(values, source.tree, target.tree, len(target.channels), plan.kernel, out=out)
+    retarget_rotations(values, plan.source_tree, target.tree, len(target.channels), plan.kernel, out=out)
     np.testing.assert_array_equal(values, before)
     np.testing.assert_array_equal(out[:, :3], 7.0)  # the root's position channels are the caller's
 
@@ -120,7 +136,7 @@ def test_nan_in_a_channel_gives_nan_where_it_reaches_and_nothing_breaks(data_dir
     plan = mt.plan_retarget(source, target)
     values = random_values(source, 20, rng)
     values[5, source.columns_of(["lhumerus"])[0]] = np.nan
-    out = retarget_rotations(values, source.tree, target.tree, len(target.channels), plan.kernel)
+    out = retarget_rotations(values, plan.source_tree, target.tree, len(target.channels), plan.kernel)
     arm = target.columns_of(["LeftArm"])
     assert np.isnan(out[5, arm]).all()
     assert np.isfinite(np.delete(out, 5, axis=0)).all()
@@ -130,20 +146,21 @@ def test_nan_in_a_channel_gives_nan_where_it_reaches_and_nothing_breaks(data_dir
 def test_bad_tables_are_refused_before_the_kernel_runs(data_dir):
     source = mt.read_asf(data_dir / "cmu" / "01.asf")
     target = mt.read_bvh(data_dir / "bvh" / "walk01.bvh").skeleton
-    plan = mt.plan_retarget(source, target).kernel
+    whole = mt.plan_retarget(source, target)
+    plan, tree = whole.kernel, whole.source_tree
     n = len(target.channels)
     values = np.zeros((4, len(source.channels)))
     with pytest.raises(ValueError, match="values have"):
-        retarget_rotations(values[:, :10], source.tree, target.tree, n, plan)
+        retarget_rotations(values[:, :10], tree, target.tree, n, plan)
     with pytest.raises(ValueError, match="target tree reads column"):
-        retarget_rotations(values, source.tree, target.tree, n - 3, plan)
+        retarget_rotations(values, tree, target.tree, n - 3, plan)
     with pytest.raises(ValueError, match="names a source joint beyond"):
-        retarget_rotations(values, source.tree, target.tree, n, dataclasses.replace(plan, follow=plan.follow + 100))
+        retarget_rotations(values, tree, target.tree, n, dataclasses.replace(plan, follow=plan.follow + 100))
     with pytest.raises(ValueError, match="correction must have shape"):
         RetargetPlan(**{**{f.name: getattr(plan, f.name) for f in dataclasses.fields(plan)}, "correction": np.eye(3)})
     with pytest.raises(ValueError, match="out must be"):
-        retarget_rotations(values, source.tree, target.tree, n, plan, out=np.zeros((4, n), np.float32))
+        retarget_rotations(values, tree, target.tree, n, plan, out=np.zeros((4, n), np.float32))
     # a joint with four rotation channels passes the Python checks; the kernel refuses it
     four = variant(target, {"Spine1": ("rx", "ry", "rz", "rx")})
     with pytest.raises(ValueError, match="mt_retarget"):
-        retarget_rotations(values, source.tree, four.tree, len(four.channels), plan)
+        retarget_rotations(values, tree, four.tree, len(four.channels), plan)

@@ -62,6 +62,7 @@ from typing import Annotated, Literal
 
 import numpy as np
 
+from mtcore.kinematics import JointTree
 from mtcore.retarget import RetargetPlan as KernelPlan
 from mtcore.retarget import retarget_rotations
 from mtcore.rotations import unroll_euler
@@ -89,7 +90,11 @@ class RetargetPlan:
     ``align`` (3, 3) turns source world axes into target world axes;
     ``source_up`` and ``target_up`` are the up axes ("+y", "+z", ...);
     ``source_leg`` and ``target_leg`` the hip heights at rest in file units;
-    ``kernel`` the C kernel's tables (None for "rotations"); ``copies``
+    ``kernel`` the C kernel's tables (None for "rotations"), whose source
+    joints are those of ``source_tree``: the source's tree cut to the joints
+    the target needs, ``source_joints`` (their indices in the source's
+    ``joint_names``), so that no forward kinematics is done for fingers that
+    nothing follows; ``copies``
     (source column, target column) pairs of copied channels; ``aims`` what
     each mapped target joint aims at, and its rest correction in degrees;
     ``notes`` what the user should know.
@@ -105,6 +110,8 @@ class RetargetPlan:
     source_leg: float
     target_leg: float
     kernel: KernelPlan | None
+    source_tree: JointTree | None
+    source_joints: np.ndarray | None
     copies: tuple[tuple[int, int], ...]
     aims: dict[str, tuple[str, float]]
     notes: tuple[str, ...]
@@ -309,12 +316,15 @@ def _plan(source: Skeleton, target: Skeleton, pairs: JointMap, mode: str) -> Ret
     if mode == "rotations" and differs:
         raise ValueError(f"mode 'rotations' needs the same rig on both sides, but {differs}; use mode 'directions'")
     kernel: KernelPlan | None = None
+    source_tree: JointTree | None = None
+    source_joints: np.ndarray | None = None
     copies: tuple[tuple[int, int], ...] = ()
     aims: dict[str, tuple[str, float]] = {}
     if mode == "rotations" or (mode == "auto" and not differs):
         chosen, copies = "rotations", _copies(source, target, pairs)
     else:
         chosen, (kernel, aims) = "directions", _kernel_plan(s_pose, t_pose, follow, align, pairs)
+        kernel, source_tree, source_joints = _pruned(source.tree, kernel)
     root = target.dofs(target.root.name)
     missing = [d for d in TRANSLATIONS if d not in root]
     if missing:
@@ -333,6 +343,8 @@ def _plan(source: Skeleton, target: Skeleton, pairs: JointMap, mode: str) -> Ret
         source_leg=source_leg,
         target_leg=target_leg,
         kernel=kernel,
+        source_tree=source_tree,
+        source_joints=source_joints,
         copies=copies,
         aims=aims,
         notes=tuple(notes),
@@ -489,6 +501,37 @@ def _kernel_plan(
     return plan, aims
 
 
+def _pruned(tree: JointTree, plan: KernelPlan) -> tuple[KernelPlan, JointTree, np.ndarray]:
+    """The plan and the source tree cut to the joints it reads (those it follows, the points it aims
+    at, and the joints above them), the plan's source indices renumbered to match, and the joints
+    kept (indices in the whole tree)."""
+    parent = tree.parent
+    keep = np.zeros(tree.joints, bool)
+    for j in np.concatenate([plan.follow, plan.key_points.ravel()]):
+        while j >= 0 and not keep[j]:
+            keep[j] = True
+            j = parent[j]
+    kept = np.nonzero(keep)[0]
+    index = np.full(tree.joints + 1, -1, np.int64)  # index[-1] stays -1: "none" maps to itself
+    index[kept] = np.arange(len(kept))
+    starts = [range(tree.dof_start[j], tree.dof_start[j + 1]) for j in kept]
+    dofs = np.array([c for r in starts for c in r], np.intp)
+    pruned = JointTree(
+        parent=index[parent[kept]],
+        order=index[[j for j in tree.order if keep[j]]],
+        axis=tree.axis[kept],
+        direction=tree.direction[kept],
+        segment=tree.segment[kept],
+        dof_start=np.concatenate([[0], np.cumsum([len(r) for r in starts])]),
+        dof_kind=tree.dof_kind[dofs],
+        dof_column=tree.dof_column[dofs],
+        angle_scale=tree.angle_scale,
+        parent_frame=None if tree.parent_frame is None else tree.parent_frame[kept],
+    )
+    renumbered = dataclasses.replace(plan, follow=index[plan.follow], key_points=index[plan.key_points])
+    return renumbered, pruned, kept
+
+
 _Key = tuple[tuple[int, int], tuple[int, int], str, bool, "int | None"]
 
 
@@ -578,12 +621,12 @@ def retarget(
         raise ValueError("the plan given is for other skeletons than the motion's and the target")
     values = np.zeros((motion.frames, len(target.channels)))
     _rest_channels(target, values)
-    if plan.kernel is None:
+    if plan.kernel is None or plan.source_tree is None:
         for a, b in plan.copies:
             values[:, b] = motion.values[:, a]
     else:
         retarget_rotations(
-            motion.values, source.tree, target.tree, len(target.channels), plan.kernel, out=values, workers=workers
+            motion.values, plan.source_tree, target.tree, len(target.channels), plan.kernel, out=values, workers=workers
         )
         _unroll(target, values, plan.kernel.follow)
     _root_positions(motion, plan, values)
