@@ -21,7 +21,7 @@ import motiontheater as mt
 from motiontheater.retarget import _cached_plan, _rest_channels, _root_positions, _unroll
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-import retarget_twin
+from twins import retarget as retarget_twin
 
 DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 FAST = dict(rounds=30, iterations=1, warmup_rounds=2)

@@ -1,7 +1,6 @@
 """The retargeting kernel (mt_retarget) against its numpy twin, over real rigs and made-up channel layouts."""
 
 import dataclasses
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -11,9 +10,7 @@ import motiontheater as mt
 from motiontheater.skeleton import Skeleton
 from mtcore.kinematics import forward_kinematics
 from mtcore.retarget import RetargetPlan, retarget_rotations
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import retarget_twin as twin
+from twins import retarget as twin
 
 PAIRS = [
     ("cmu/01.asf", "bvh/walk01.bvh"),  # ASF onto BVH: every target joint three channels

@@ -1,13 +1,17 @@
-"""Retargeting in vectorised numpy: the twin of ``mt_retarget`` (and of the whole of
-``motiontheater.retarget.retarget`` for the benchmark).
+"""Retargeting in vectorised numpy: the twin of ``mt_retarget`` (and, in the benchmark, of the
+whole of ``motiontheater.retarget.retarget``).
 
-One numpy call per joint over all frames: forward kinematics of the source
-from the tree tables (ASF and BVH alike), then each target joint, parents
-first, as mtcore.h describes the kernel; Euler angles by scipy.
+One numpy call per joint over all frames: the source's forward kinematics
+(the twin of mt_forward_kinematics), then each target joint, parents first,
+as mtcore.h describes the kernel; Euler angles by scipy.
 """
+
+from __future__ import annotations
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from .kinematics import forward_kinematics
 
 EYE = np.eye(3)
 
@@ -22,43 +26,16 @@ def axis_rotation(axis: int, angles: np.ndarray) -> np.ndarray:
     return m
 
 
-def forward_kinematics(values: np.ndarray, tree) -> tuple[np.ndarray, np.ndarray]:
-    """(points (frames, joints, 3), world rotations (frames, joints, 3, 3)) of a JointTree."""
-    frames = len(values)
-    points = np.zeros((frames, tree.joints, 3))
-    world = np.zeros((frames, tree.joints, 3, 3))
-    for j in tree.order:
-        m = np.broadcast_to(EYE, (frames, 3, 3))
-        t, stretch = np.zeros((frames, 3)), np.zeros(frames)
-        for c in range(tree.dof_start[j], tree.dof_start[j + 1]):
-            kind, v = int(tree.dof_kind[c]), values[:, tree.dof_column[c]]
-            if kind <= 2:
-                m = axis_rotation(kind, v * tree.angle_scale) @ m
-            elif kind <= 5:
-                t[:, kind - 3] += v
-            else:
-                stretch += v
-        c9 = tree.axis[j]
-        local = c9 @ m @ c9.T
-        p = tree.parent[j]
-        if p < 0:
-            world[:, j] = local
-            points[:, j] = tree.segment[j] + t
-            continue
-        world[:, j] = world[:, p] @ local
-        vector = tree.segment[j] + tree.direction[j] * stretch[:, None] + t @ c9.T
-        turn = world[:, p] if tree.parent_frame[j] else world[:, j]
-        points[:, j] = points[:, p] + np.einsum("fij,fj->fi", turn, vector)
-    return points, world
-
-
 def unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
 def smallest_rotation(u: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """(n, 3, 3): the smallest rotations taking the directions u onto w (n, 3)."""
-    u, w = unit(u), unit(w)
+    """(n, 3, 3): the smallest rotations taking the directions u onto w (n, 3); the identity
+    where either is zero or not finite."""
+    lengths = np.linalg.norm(u, axis=-1) * np.linalg.norm(w, axis=-1)
+    ok = (lengths > 0) & np.isfinite(lengths)
+    u, w = unit(np.where(ok[:, None], u, 1.0)), unit(np.where(ok[:, None], w, 1.0))
     v, c = np.cross(u, w), np.sum(u * w, -1)
     vx = np.zeros((len(u), 3, 3))
     vx[:, 0, 1], vx[:, 0, 2], vx[:, 1, 2] = -v[:, 2], v[:, 1], -v[:, 0]
@@ -70,6 +47,7 @@ def smallest_rotation(u: np.ndarray, w: np.ndarray) -> np.ndarray:
         e[int(np.argmin(np.abs(u[f])))] = 1.0
         n = unit(np.cross(u[f], e))
         r[f] = 2 * np.outer(n, n) - EYE
+    r[~ok] = EYE
     return r
 
 
@@ -132,11 +110,11 @@ def reduce(m: np.ndarray, axes: list[int], aim: np.ndarray) -> tuple[np.ndarray,
 
 
 def swivel(want, bone, child_bone, hinge, goal):
-    """want (n, 3, 3) turned about its bone so that a hinged child can aim at goal (see retarget.c)."""
-    lengths = [np.linalg.norm(v, axis=-1) for v in (want @ bone, want @ hinge, want @ child_bone, goal)]
-    if not all((length > 0).all() for length in lengths):
-        return want
-    d, n, a, g = unit(want @ bone), unit(want @ hinge), unit(want @ child_bone), unit(goal)
+    """want (n, 3, 3) turned about its bone so that a hinged child can aim at goal (see retarget.c);
+    unturned in frames where a direction vanishes."""
+    vectors = (want @ bone, want @ hinge, want @ child_bone, goal)
+    ok = np.all([np.linalg.norm(v, axis=-1) > 0 for v in vectors], axis=0)
+    d, n, a, g = (unit(np.where(ok[:, None], v, 1.0)) for v in vectors)
     bend = np.linalg.norm(np.cross(d, g), axis=-1)
     full = np.sin(np.radians(10))
     weight = np.clip((bend / full - 0.2) / 0.8, 0, 1)
@@ -151,7 +129,7 @@ def swivel(want, bone, child_bone, hinge, goal):
     first = np.remainder(phi - spread + np.pi, 2 * np.pi) - np.pi
     second = np.remainder(phi + spread + np.pi, 2 * np.pi) - np.pi
     psi = np.where(np.abs(second) < np.abs(first), second, first)
-    psi = np.where(rho > 0, psi * weight, 0.0)
+    psi = np.where(ok & (rho > 0), psi * weight, 0.0)
     turn = Rotation.from_rotvec(d * psi[:, None]).as_matrix()
     return turn @ want
 
@@ -164,7 +142,7 @@ def rotation_channels(tree, j):
 
 def retarget_rotations(values, source, target, target_channels, plan):
     """The twin of ``mtcore.retarget.retarget_rotations`` (zeros in the other channels)."""
-    points, world = forward_kinematics(values, source)
+    points, world, _ = forward_kinematics(values, source)
     frames = len(values)
     out = np.zeros((frames, target_channels))
     glob = np.zeros((frames, target.joints, 3, 3))
