@@ -14,9 +14,11 @@ from motiontheater.retarget import RetargetPlan, _cleanup_options
 from motiontheater.rigs import CHAINS, match_chain, recognise
 from motiontheater.skeleton import Skeleton
 
+UNITS = {"cmu/01_01.bvh": "0.45"}  # the CMU BVH conversion is in the ASF's unit, which its size does not tell
+
 
 def read(data_dir: Path, name: str) -> mt.Motion:
-    return mt.read_take(data_dir / name)
+    return mt.read_take(data_dir / name, unit=UNITS.get(name))
 
 
 def skeleton(data_dir: Path, name: str) -> Skeleton:
@@ -330,6 +332,19 @@ def test_a_rest_pose_that_does_not_stand_is_an_error(data_dir, cmu):
     lying = mt.read_bvh(data_dir / "bvh" / "jesse_dance.bvh").skeleton  # every bone along x at rest
     with pytest.raises(ValueError, match="does not stand in its rest pose.*OFFSETs"):
         mt.plan_retarget(cmu.skeleton, lying)
+
+
+def test_a_length_unit_that_is_only_assumed_is_refused(data_dir, cmu):
+    conversion = mt.read_take(data_dir / "cmu" / "01_01.bvh")  # 26 units tall: no unit makes that human
+    assert conversion.skeleton.length_source == "assumed"
+    with pytest.raises(ValueError, match="the source skeleton has no known length unit.*--unit UNIT.*taken for cm"):
+        mt.plan_retarget(conversion.skeleton, cmu.skeleton)
+    with pytest.raises(ValueError, match="the target skeleton has no known length unit.*--to-unit UNIT"):
+        mt.plan_retarget(cmu.skeleton, conversion.skeleton)
+    given = conversion.skeleton.with_length_unit("0.45")
+    plan = mt.plan_retarget(given, cmu.skeleton)
+    assert plan.leg_ratio == pytest.approx(1.0, abs=1e-6)  # the conversion is subject 01 itself
+    assert "in/0.45 = 0.0564444 m (given)" in plan.describe()
 
 
 def test_rotations_mode_needs_the_same_rig(data_dir, cmu):

@@ -80,7 +80,7 @@ def test_dry_run_prints_the_plan_and_writes_nothing(data_dir, tmp_path, capsys):
         "unmapped source joints (10): ltoes, rtoes, upperback",
         "unmapped target joints: none",
         "mode: directions",
-        "units: source 0.0564444 m per unit (':units length 0.45')",
+        "units: source in/0.45 = 0.0564444 m (stated by its ASF); target cm = 0.01 m (detected from its size)",
         "scale factors: legs x",
         "up axes: source +y, target +y",
         "cleanup: ",
@@ -98,6 +98,7 @@ def test_dry_run_prints_the_plan_and_writes_nothing(data_dir, tmp_path, capsys):
         ("furlong.asf", None, "unknown length unit 'furlong'"),
         ("missing.bvh", None, "missing.bvh: no such target skeleton file"),
         ("cmu/01_01.amc", None, "the target must be an .asf or a .bvh file"),
+        ("cmu/01_01.bvh", None, "the target skeleton '01_01' has no known length unit"),
     ],
 )
 def test_bad_input_is_one_line_and_writes_nothing(data_dir, tmp_path, capsys, target, map_text, message):
@@ -115,6 +116,14 @@ def test_bad_input_is_one_line_and_writes_nothing(data_dir, tmp_path, capsys, ta
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1, err
     assert not (tmp_path / "o.bvh").exists()
+
+
+def test_the_targets_unit_can_be_given(data_dir, capsys):
+    args = ["retarget", str(data_dir / "cmu" / "01_01.amc"), "--to", str(data_dir / "cmu" / "01_01.bvh"), "--dry-run"]
+    assert main([*args, "--to-unit", "0.45"]) == 0
+    assert "target in/0.45 = 0.0564444 m (given)" in capsys.readouterr().out
+    assert main([*args, "--to-unit", "furlong"]) == 2
+    assert "unknown length unit 'furlong'" in capsys.readouterr().err
 
 
 def test_an_output_of_the_other_format_is_refused(data_dir, tmp_path, capsys):

@@ -40,8 +40,9 @@ so that a y-up capture lands y-up on a z-up rig.  *Scale*: the root's
 position is multiplied by the ratio of the legs, each the hip height of its
 rest pose (the root above the lowest point, along the up axis: y, or z when
 the pose is taller along z), in metres; lengths in file units then need no
-conversion, so a skeleton's length unit only has to be known (stated,
-detected or given) for the report and the footskate cleanup.
+conversion; yet both skeletons' length units must be known (an ASF's
+stated, a BVH's detected from its size or given), for the report and the
+footskate cleanup's thresholds in metres: an assumed unit is refused.
 
 *Rest poses*: an ASF's is its calibration pose; a BVH target's is the pose
 its OFFSETs draw with every rotation channel zero (not its first frame), as
@@ -67,13 +68,13 @@ from mtcore.retarget import RetargetPlan as KernelPlan
 from mtcore.retarget import retarget_rotations
 from mtcore.rotations import unroll_euler
 
-from . import rigs
+from . import rigs, units
 from .asf import read_asf
 from .bvh import read_bvh
 from .motion import Motion
 from .registry import is_step, step
 from .rigs import JointMap
-from .skeleton import ROTATIONS, TRANSLATIONS, Skeleton
+from .skeleton import ROTATIONS, TRANSLATIONS, Skeleton, settle_length_unit
 
 MODES = ("auto", "rotations", "directions")
 DEGENERATE = 1e-3
@@ -152,13 +153,20 @@ class RetargetPlan:
         return "\n".join(lines)
 
 
+_HOW = {
+    "stated": "stated by its ASF",
+    "default": "the Acclaim default: its ASF states none",
+    "detected": "detected from its size",
+    "given": "given",
+    "assumed": "assumed",
+}
+
+
 def _unit_text(skeleton: Skeleton) -> str:
-    stated = skeleton.unit("length")
-    if stated is not None:
-        how = f"':units length {stated}'"
-    else:
-        how = f"{'a BVH file' if skeleton.convention == 'bvh' else 'the ASF'} states none: inch, the Acclaim default"
-    return f"{skeleton.meters_per_unit:.6g} m per unit ({how})"
+    return (
+        f"{units.label(skeleton.length_unit)} = {skeleton.meters_per_unit:.6g} m "
+        f"({_HOW.get(skeleton.length_source, skeleton.length_source)})"
+    )
 
 
 def _axes_text(align: np.ndarray) -> str:
@@ -287,16 +295,25 @@ def _cached_plan(source: Skeleton, target: Skeleton, map_file: tuple[str, int, i
     return _plan(source, target, pairs, mode)
 
 
-def _meters(skeleton: Skeleton, side: str) -> float:
+def _known_unit(skeleton: Skeleton, side: str, flag: str) -> None:
+    """ValueError unless the skeleton's length unit is known: stated, detected or given."""
+    name = f"the {side} skeleton" + (f" '{skeleton.name}'" if skeleton.name else "")
     try:
-        return skeleton.meters_per_unit
+        meters = skeleton.meters_per_unit
     except ValueError as e:
-        raise ValueError(f"the {side} skeleton '{skeleton.name or '(unnamed)'}': {e}") from None
+        raise ValueError(f"{name}: {e}") from None
+    if skeleton.length_source == "assumed":
+        raise ValueError(
+            f"{name} has no known length unit: a BVH file states none and the size of this one "
+            f"({max(skeleton.sizing().extents):.4g} units across) tells none; give it with {flag} UNIT "
+            f"(Python: read it with unit=UNIT), UNIT: {units.UNIT_HELP}; it was taken for "
+            f"{units.label(skeleton.length_unit)} ({meters:g} m)"
+        )
 
 
 def _plan(source: Skeleton, target: Skeleton, pairs: JointMap, mode: str) -> RetargetPlan:
-    _meters(source, "source")
-    _meters(target, "target")
+    _known_unit(source, "source", "--unit")
+    _known_unit(target, "target", "--to-unit")
     s_pose, t_pose = _Pose.of(source), _Pose.of(target)
     s_index = {n: i for i, n in enumerate(source.point_names)}
     t_index = {n: i for i, n in enumerate(target.point_names)}
@@ -708,15 +725,20 @@ def _cleanup_options(plan: RetargetPlan) -> dict:
     return options
 
 
-def read_target(path: str | os.PathLike) -> Skeleton:
+def read_target(path: str | os.PathLike, unit: str | None = None) -> Skeleton:
     """The skeleton of a target file: an ASF, or a BVH's hierarchy (its rest pose: OFFSETs, every
-    rotation channel zero), named after its file when it has no name (BVH files give none)."""
+    rotation channel zero), named after its file when it has no name (BVH files give none), in
+    length ``unit`` when given (else as the readers settle it: an ASF's stated unit, a BVH's
+    told from its size)."""
     suffix = Path(path).suffix.lower()
     if suffix not in (".asf", ".bvh"):
         raise ValueError(f"{os.fspath(path)}: the target must be an .asf or a .bvh file")
     if not os.path.exists(path):
         raise FileNotFoundError(f"{os.fspath(path)}: no such target skeleton file")
-    skeleton = read_asf(path) if suffix == ".asf" else read_bvh(path).skeleton
+    if suffix == ".asf":
+        skeleton = settle_length_unit(read_asf(path), unit)
+    else:
+        skeleton = read_bvh(path, unit=unit).skeleton
     return skeleton if skeleton.name else dataclasses.replace(skeleton, name=Path(path).stem)
 
 
@@ -727,10 +749,11 @@ def describe_retarget(
     map: Path | None = None,
     cleanup: bool = True,
     mode: str = "auto",
+    to_unit: str | None = None,
 ) -> str:
     """What the step ``retarget`` would do to ``motion`` (``motiontheater retarget --dry-run``):
     the plan's description (:meth:`RetargetPlan.describe`), the footskate cleanup, and the result."""
-    target = read_target(to)
+    target = read_target(to, to_unit)
     plan = plan_retarget(motion.skeleton, target, map, mode=mode)
     if not cleanup:
         feet = "off: the feet are not re-planted"
@@ -768,6 +791,10 @@ def retarget_step(
         Literal["auto", "rotations", "directions"],
         "carry rotations over (the same rig) or make bones point the source's way (auto: rotations for the same rig)",
     ] = "auto",
+    to_unit: Annotated[
+        str | None,
+        f"the target's length unit: {units.UNIT_HELP} (default: an ASF's stated, a BVH's told from its size)",
+    ] = None,
 ) -> Motion:
     """Put the take on the skeleton of --to: a character with other proportions or another rig.
 
@@ -778,7 +805,9 @@ def retarget_step(
     the source's points, rest poses (T-pose, A-pose) corrected bone by bone; unmapped target
     joints keep their rest rotation. The root's position is scaled by the ratio of the legs (hip
     heights at rest) and turned to the target's up axis. A BVH target's rest pose is the one its
-    OFFSETs draw (rotations zero). --dry-run prints the joint map, what is unmapped on each side,
-    the scale factors and the units assumed, and writes nothing.
+    OFFSETs draw (rotations zero). Both length units must be known: an ASF states its own, a BVH's
+    is told from its size, or given (--unit for the take, --to-unit for the target). --dry-run
+    prints the joint map, what is unmapped on each side, the scale factors and the units, and
+    writes nothing.
     """
-    return retarget(motion, read_target(to), map, mode=mode, cleanup=cleanup)
+    return retarget(motion, read_target(to, to_unit), map, mode=mode, cleanup=cleanup)
