@@ -397,7 +397,7 @@ def knee_axis_and_side(chain, locals_):
         axis = chain.axis[1] @ basis(chain.axes[1, 0])
     else:
         total = np.cross(s1, mv(locals_[1], s2)).sum(0)
-        if np.linalg.norm(total) <= TINY * max(1.0, np.linalg.norm(s1) * np.linalg.norm(s2)) * len(s2):
+        if not np.linalg.norm(total) > TINY * max(1.0, np.linalg.norm(s1) * np.linalg.norm(s2)) * len(locals_[1]):
             total = np.cross(s1, s2 + chain.segments[2])
         axis = unit(total)
     _, _, phi = hinge(chain, locals_, axis)

@@ -578,11 +578,12 @@ def fit_ground(
     band = _FIT_BAND * scale / meters_per_unit
     prior = np.sqrt(len(z)) * _SLOPE_PRIOR * scale / meters_per_unit
     keep = np.ones(len(z), bool)
-    for _ in range(3):
-        rows = np.concatenate([design[keep], np.c_[prior * np.eye(2), np.zeros((2, len(ids)))]])
-        coef = np.linalg.lstsq(rows, np.r_[z[keep], 0.0, 0.0], rcond=None)[0]
-        residual = z - design @ coef
-        keep = residual < band
+    penalty = np.zeros((design.shape[1], design.shape[1]))
+    penalty[0, 0] = penalty[1, 1] = prior**2
+    for _ in range(3):  # least squares by its normal equations, without the samples above the floor found
+        kept = design[keep]
+        coef = np.linalg.solve(kept.T @ kept + penalty, kept.T @ z[keep])
+        keep = z - design @ coef < band
     gradient = coef[:2]
     norm = np.linalg.norm(gradient)
     if norm > _MAX_TILT:
