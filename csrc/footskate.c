@@ -70,23 +70,34 @@ static void mat_tvec(const double *m, const double *v, double *out)
     memcpy(out, r, sizeof r);
 }
 
-/* out = op(a) op(b), op the transpose where ta / tb */
-static void mat_mul_t(const double *a, int ta, const double *b, int tb, double *out)
+/* out = a b (out may be a or b) */
+static void mat_mul(const double *a, const double *b, double *out)
 {
     double r[9];
     for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++) {
-            double s = 0;
-            for (int j = 0; j < 3; j++)
-                s += (ta ? a[3 * j + i] : a[3 * i + j]) * (tb ? b[3 * k + j] : b[3 * j + k]);
-            r[3 * i + k] = s;
-        }
+        for (int k = 0; k < 3; k++)
+            r[3 * i + k] = a[3 * i] * b[k] + a[3 * i + 1] * b[3 + k] + a[3 * i + 2] * b[6 + k];
     memcpy(out, r, sizeof r);
 }
 
-static void mat_mul(const double *a, const double *b, double *out)
+/* out = a^T b */
+static void mat_tmul(const double *a, const double *b, double *out)
 {
-    mat_mul_t(a, 0, b, 0, out);
+    double r[9];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            r[3 * i + k] = a[i] * b[k] + a[3 + i] * b[3 + k] + a[6 + i] * b[6 + k];
+    memcpy(out, r, sizeof r);
+}
+
+/* out = a b^T */
+static void mat_mult(const double *a, const double *b, double *out)
+{
+    double r[9];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            r[3 * i + k] = a[3 * i] * b[3 * k] + a[3 * i + 1] * b[3 * k + 1] + a[3 * i + 2] * b[3 * k + 2];
+    memcpy(out, r, sizeof r);
 }
 
 /* The rotation by angle about the unit axis (Rodrigues). */
@@ -98,12 +109,6 @@ static void about(const double *axis, double angle, double *out)
     out[6] = t * x * z - s * y, out[7] = t * y * z + s * x, out[8] = c + t * z * z;
 }
 
-static void about_basis(int k, double angle, double *out)
-{
-    const double e[3] = {k == 0, k == 1, k == 2};
-    about(e, angle, out);
-}
-
 /* The smallest rotation taking the direction of u onto that of v (a half turn for opposite ones). */
 static void between(const double *u0, const double *v0, double *out)
 {
@@ -112,6 +117,13 @@ static void between(const double *u0, const double *v0, double *out)
     unit3(v0, v);
     cross3(u, v, axis);
     const double s = norm3(axis), c = dot3(u, v);
+    if (c > -0.5) { /* R = c I + [k]x + k k^T / (1 + c), k = u x v: no trigonometry */
+        const double f = 1 / (1 + c), *k = axis;
+        out[0] = c + f * k[0] * k[0], out[1] = -k[2] + f * k[0] * k[1], out[2] = k[1] + f * k[0] * k[2];
+        out[3] = k[2] + f * k[1] * k[0], out[4] = c + f * k[1] * k[1], out[5] = -k[0] + f * k[1] * k[2];
+        out[6] = -k[1] + f * k[2] * k[0], out[7] = k[0] + f * k[2] * k[1], out[8] = c + f * k[2] * k[2];
+        return;
+    }
     if (s > tiny) {
         unit3(axis, axis);
         about(axis, atan2(s, c), out);
@@ -194,16 +206,60 @@ static int channels(const struct mt_leg *leg, int j)
     return n;
 }
 
-/* L = C M C^T of joint j, M its channels' rotations, each about a fixed axis after the ones before. */
+/* m = R(axis) m, R the rotation about a coordinate axis of the given sine and cosine: it mixes two rows */
+static void rotate_left(double *m, int axis, double s, double c)
+{
+    double *ra = m + 3 * (axis == 0 ? 1 : axis == 1 ? 2 : 0), *rb = m + 3 * (axis == 0 ? 2 : axis == 1 ? 0 : 1);
+    for (int k = 0; k < 3; k++) {
+        const double a = ra[k], b = rb[k];
+        ra[k] = c * a - s * b;
+        rb[k] = s * a + c * b;
+    }
+}
+
+/* v = R(axis) v, R as for rotate_left */
+static void rotate_vector(double *v, int axis, double s, double c)
+{
+    const int p = axis == 0 ? 1 : axis == 1 ? 2 : 0, q = axis == 0 ? 2 : axis == 1 ? 0 : 1;
+    const double a = v[p], b = v[q];
+    v[p] = c * a - s * b;
+    v[q] = s * a + c * b;
+}
+
+static int is_identity(const double *m)
+{
+    return m[0] == 1 && m[1] == 0 && m[2] == 0 && m[3] == 0 && m[4] == 1 && m[5] == 0 && m[6] == 0 && m[7] == 0 &&
+           m[8] == 1;
+}
+
+/* m = m R(axis), R as for rotate_left: it mixes two columns */
+static void rotate_right(double *m, int axis, double s, double c)
+{
+    const int p = axis == 0 ? 1 : axis == 1 ? 2 : 0, q = axis == 0 ? 2 : axis == 1 ? 0 : 1;
+    for (int k = 0; k < 9; k += 3) {
+        const double a = m[k + p], b = m[k + q];
+        m[k + p] = c * a + s * b;
+        m[k + q] = -s * a + c * b;
+    }
+}
+
+/* L = C M C^T of joint j, M its channels' rotations, each about a fixed axis after the ones before:
+ * C M built by turning C's columns, the last channel's rotation first. */
 static void local_rotation(const struct mt_leg *leg, int j, const double *angles, double *out)
 {
-    double m[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, r[9];
-    for (int n = 0; n < channels(leg, j); n++) {
-        about_basis(leg->axes[j][n], angles[n], r);
-        mat_mul(r, m, m);
+    const int count = channels(leg, j);
+    if (is_identity(leg->axis[j])) {
+        double m[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        for (int n = 0; n < count; n++)
+            rotate_left(m, leg->axes[j][n], sin(angles[n]), cos(angles[n]));
+        memcpy(out, m, sizeof m);
+        return;
     }
-    mat_mul(leg->axis[j], m, m);
-    mat_mul_t(m, 0, leg->axis[j], 1, out);
+    double m[9];
+    memcpy(m, leg->axis[j], sizeof m);
+    for (int n = count - 1; n >= 0; n--)
+        rotate_right(m, leg->axes[j][n], sin(angles[n]), cos(angles[n]));
+    mat_mult(m, leg->axis[j], out);
 }
 
 /*
@@ -233,10 +289,14 @@ static void euler_nearest(const double *m, const int *axes, const double *ref, d
     }
 #undef M
     const int lock = h < 1e-9;
-    double r[9], x[9];
-    about_basis(last, -c, r);
-    mat_mul(r, m, x);
-    a = atan2(-eps * x[3 * j + k], x[3 * j + j]);
+    /* row j of R_last(-c) m: R_last turns rows (p, q) of what it multiplies, as rotate_left does */
+    const double cc = lock ? cos(c) : (proper ? -eps * m[3 * k + i] : m[3 * i + i]) / h;
+    const double sc = lock ? sin(c) : (proper ? m[3 * j + i] : eps * m[3 * j + i]) / h;
+    const int p = last == 0 ? 1 : last == 1 ? 2 : 0, q = last == 0 ? 2 : last == 1 ? 0 : 1;
+    double row[3];
+    for (int e = 0; e < 3; e++) /* R(-c): rows p' = c p + s q, q' = -s p + c q */
+        row[e] = j == p ? cc * m[3 * p + e] + sc * m[3 * q + e] : -sc * m[3 * p + e] + cc * m[3 * q + e];
+    a = atan2(-eps * row[k], row[j]);
     const double first[3] = {wrap_near(a, ref[0]), wrap_near(b, ref[1]), wrap_near(c, ref[2])};
     const double second[3] = {wrap_near(a + pi, ref[0]), wrap_near((proper ? 0.0 : pi) - b, ref[1]),
                               wrap_near(c + pi, ref[2])};
@@ -260,7 +320,7 @@ static void realize(const struct mt_leg *leg, int j, const double *wanted, const
     memcpy(out, ref, 3 * sizeof *out);
     if (count == 3) {
         double m[9];
-        mat_mul_t(c, 1, wanted, 0, m);
+        mat_tmul(c, wanted, m);
         mat_mul(m, c, m);
         euler_nearest(m, leg->axes[j], ref, out);
         return;
@@ -293,10 +353,10 @@ static void realize(const struct mt_leg *leg, int j, const double *wanted, const
     const double kappa = clip(q[aj] / rho, -1.0, 1.0), base = atan2(big_b, big_a), spread = acos(kappa);
     double best[2] = {0, 0}, best_cost = 0;
     for (int s = 0; s < 2; s++) {
-        double r[9], v[3], rp[3], qp[3], n[3];
+        double v[3], rp[3], qp[3], n[3];
         const double a = wrap_near(base + (s == 0 ? spread : -spread), ref[0]);
-        about(ei, a, r);
-        mat_vec(r, p, v);
+        memcpy(v, p, sizeof v);
+        rotate_vector(v, ai, sin(a), cos(a));
         perpendicular(v, ej, rp);
         perpendicular(q, ej, qp);
         cross3(rp, qp, n);
@@ -583,15 +643,15 @@ static double reach(struct hinge h, double soft, double keep)
 
 /* ---------------------------------------------------------------- phases 1 and 2 */
 
-int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *hips, const double *parents,
-                      const double *angles, const unsigned char *planted, const double *targets,
-                      const double *clearance, const struct mt_footskate *opt, double *enforced, double *goal,
-                      double *turn, double *weight, double *reaches, double *knee)
+int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *angles, const double *points,
+                      const unsigned char *planted, const double *targets, const double *clearance,
+                      const struct mt_footskate *opt, double *enforced, double *goal, double *turn, double *weight,
+                      double *reaches, double *knee)
 {
     if (check_leg(leg) != MT_OK || check_options(opt) != MT_OK || !clearance || !knee)
         return MT_EINVAL;
-    if (frames > 0 && (!hips || !parents || !angles || !planted || !targets || !enforced || !goal || !turn ||
-                       !weight || !reaches))
+    if (frames > 0 && (!angles || !points || !planted || !targets || !enforced || !goal || !turn || !weight ||
+                       !reaches))
         return MT_EINVAL;
     const double *s = leg->segment[0];
     double axis[3];
@@ -619,46 +679,49 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *hip
         }
         unit3(total, axis);
     }
-    double sides = 0;
-    for (size_t t = 0; t < frames; t++) {
-        double l[9];
-        local_rotation(leg, 1, angles + 12 * t + 3, l);
-        const double w = wrap(-hinge_of(leg, l, axis).phi);
-        sides += (w > 0) - (w < 0);
-    }
     memcpy(knee, axis, sizeof axis);
-    knee[3] = sides >= 0 ? 1.0 : -1.0;
+    knee[3] = 1.0;
     if (frames == 0)
         return MT_OK;
-
     double *partner = malloc(3 * frames * sizeof *partner), *pinlog = malloc(3 * frames * sizeof *pinlog);
-    unsigned char *masks = malloc(2 * frames);
+    unsigned char *masks = malloc(2 * frames + 1);
     if (!partner || !pinlog || !masks) {
         free(partner), free(pinlog), free(masks);
         return MT_ENOMEM;
     }
+    /* the knee's reach and the side it bends to */
+    double sides = 0;
+    for (size_t t = 0; t < frames; t++) {
+        double knee_local[9];
+        local_rotation(leg, 1, angles + 12 * t + 3, knee_local);
+        const struct hinge h = hinge_of(leg, knee_local, axis);
+        const double w = wrap(-h.phi);
+        sides += (w > 0) - (w < 0);
+        reaches[t] = reach(h, opt->knee_soft, opt->knee_keep);
+    }
+    memcpy(knee, axis, sizeof axis);
+    knee[3] = sides >= 0 ? 1.0 : -1.0;
     unsigned char *pins = masks, *some = masks + frames;
-    const double foot_length = sqrt((leg->segment[2][0] - leg->segment[3][0]) * (leg->segment[2][0] - leg->segment[3][0]) +
-                                    (leg->segment[2][1] - leg->segment[3][1]) * (leg->segment[2][1] - leg->segment[3][1]) +
-                                    (leg->segment[2][2] - leg->segment[3][2]) * (leg->segment[2][2] - leg->segment[3][2]));
-    enforce_targets(planted, targets, clearance, foot_length, opt, frames, enforced, partner);
+    double foot[3];
+    for (int e = 0; e < 3; e++)
+        foot[e] = leg->segment[2][e] - leg->segment[3][e];
+    enforce_targets(planted, targets, clearance, norm3(foot), opt, frames, enforced, partner);
 
     /* the pinned turns: both points planted, or a roll from one to the other */
     for (size_t t = 0; t < frames; t++) {
         const unsigned char *now = planted + 2 * t;
+        const double *ball = points + 15 * t + 6, *heel = points + 15 * t + 9;
         const int rolled = !isnan(partner[3 * t]);
         some[t] = now[HEEL] || now[BALL];
         pins[t] = (now[HEEL] && now[BALL]) || rolled;
         memset(pinlog + 3 * t, 0, 3 * sizeof *pinlog);
         if (!pins[t])
             continue;
-        struct leg_pose pose;
-        leg_fk(leg, hips + 3 * t, parents + 9 * t, angles + 12 * t, &pose);
         const double *heel_goal = rolled && now[BALL] ? partner + 3 * t : enforced + 6 * t;
         const double *ball_goal = rolled && now[HEEL] ? partner + 3 * t : enforced + 6 * t + 3;
         double from[3], to[3], r[9];
         for (int e = 0; e < 3; e++)
-            from[e] = pose.point[2][e] - pose.point[3][e], to[e] = ball_goal[e] - heel_goal[e];
+            from[e] = ball[e] - heel[e], to[e] = ball_goal[e] - heel_goal[e];
         between(from, to, r);
         rotvec_of(r, pinlog + 3 * t);
     }
@@ -673,6 +736,7 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *hip
         if (!some[t])
             continue;
         const unsigned char *now = planted + 2 * t;
+        const double *ankle = points + 15 * t + 3;
         double log[3], q[9];
         if (pins[t])
             memcpy(log, pinlog + 3 * t, sizeof log);
@@ -681,27 +745,23 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *hip
                 log[e] = (around.prev >= 0 ? wp * pinlog[3 * around.prev + e] : 0.0) +
                          (around.next >= 0 ? wn * pinlog[3 * around.next + e] : 0.0);
         rotvec_exp(log, q);
-        struct leg_pose pose;
-        leg_fk(leg, hips + 3 * t, parents + 9 * t, angles + 12 * t, &pose);
         const int on_ball = now[BALL] && !now[HEEL];
-        const double *pivot = pose.point[on_ball ? 2 : 3], *other = pose.point[on_ball ? 3 : 2];
+        const double *pivot = points + 15 * t + (on_ball ? 6 : 9), *other = points + 15 * t + (on_ball ? 9 : 6);
         const double *target = enforced + 6 * t + 3 * on_ball;
-        if (!now[HEEL] || !now[BALL]) {
-            if (isnan(partner[3 * t])) {
-                double arm[3], lever[3], r[9];
-                for (int e = 0; e < 3; e++)
-                    arm[e] = other[e] - pivot[e];
-                mat_vec(q, arm, lever);
-                raise_lever(lever, target, clearance[on_ball ? HEEL : BALL], opt, r);
-                mat_mul(r, q, q);
-            }
+        if ((!now[HEEL] || !now[BALL]) && isnan(partner[3 * t])) {
+            double arm[3], lever[3], r[9];
+            for (int e = 0; e < 3; e++)
+                arm[e] = other[e] - pivot[e];
+            mat_vec(q, arm, lever);
+            raise_lever(lever, target, clearance[on_ball ? HEEL : BALL], opt, r);
+            mat_mul(r, q, q);
         }
         double arm[3], moved[3];
         for (int e = 0; e < 3; e++)
-            arm[e] = pose.point[1][e] - pivot[e];
+            arm[e] = ankle[e] - pivot[e];
         mat_vec(q, arm, moved);
         for (int e = 0; e < 3; e++)
-            goal[3 * t + e] = target[e] + moved[e] - pose.point[1][e];
+            goal[3 * t + e] = target[e] + moved[e] - ankle[e];
         rotvec_of(q, turn + 3 * t);
     }
     /* free frames: shift and turn blended from the constrained frames (which this pass does not change) */
@@ -721,14 +781,9 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *hip
         }
         weight[t] = wp > wn ? wp : wn;
     }
-    /* goals from shifts; the knee's reach */
-    for (size_t t = 0; t < frames; t++) {
-        struct leg_pose pose;
-        leg_fk(leg, hips + 3 * t, parents + 9 * t, angles + 12 * t, &pose);
+    for (size_t t = 0; t < frames; t++) /* goals from shifts */
         for (int e = 0; e < 3; e++)
-            goal[3 * t + e] += pose.point[1][e];
-        reaches[t] = reach(hinge_of(leg, pose.local[1], axis), opt->knee_soft, opt->knee_keep);
-    }
+            goal[3 * t + e] += points[15 * t + 3 + e];
     free(partner), free(pinlog), free(masks);
     return MT_OK;
 }
@@ -804,23 +859,36 @@ static void project_root(const double *o, const double (*centre)[3], const doubl
         out[e] = middle[e] + q[e] * radius_c;
 }
 
-/* out = mean of in over frames t - half .. t + half (edges held), summed in window order */
+/* out = mean of in over frames t - half .. t + half (edges held), summed in window order; a window
+ * of zeros (most of a take: the root moves where legs fall short) gives 0 without the sum */
 static void moving_mean(const double *in, size_t frames, size_t half, double *out)
 {
     if (half == 0) {
         memcpy(out, in, 3 * frames * sizeof *out);
         return;
     }
-    for (size_t t = 0; t < frames; t++)
+    size_t nonzero = 0; /* rows of in[t + half] back to in[t - half], edges held, that are not zero */
+#define ROW_NONZERO(u) (in[3 * (u)] != 0 || in[3 * (u) + 1] != 0 || in[3 * (u) + 2] != 0)
+    for (long long k = -(long long)half; k <= (long long)half; k++)
+        nonzero += ROW_NONZERO(k < 0 ? 0 : (size_t)k < frames ? (size_t)k : frames - 1);
+    for (size_t t = 0; t < frames; t++) {
+        if (t > 0) { /* slide the window by one frame */
+            const long long leaving = (long long)t - 1 - (long long)half, entering = (long long)(t + half);
+            nonzero -= ROW_NONZERO(leaving < 0 ? 0 : (size_t)leaving);
+            nonzero += ROW_NONZERO((size_t)entering < frames ? (size_t)entering : frames - 1);
+        }
         for (int e = 0; e < 3; e++) {
             double total = 0;
-            for (long long k = -(long long)half; k <= (long long)half; k++) {
-                long long u = (long long)t + k;
-                u = u < 0 ? 0 : u >= (long long)frames ? (long long)frames - 1 : u;
-                total += in[3 * u + e];
-            }
+            if (nonzero)
+                for (long long k = -(long long)half; k <= (long long)half; k++) {
+                    long long u = (long long)t + k;
+                    u = u < 0 ? 0 : u >= (long long)frames ? (long long)frames - 1 : u;
+                    total += in[3 * u + e];
+                }
             out[3 * t + e] = total / (double)(2 * half + 1);
         }
+    }
+#undef ROW_NONZERO
 }
 
 /* x = two moving means of x: a triangular window of half-width 2 half */
@@ -899,25 +967,29 @@ struct solved {
  * takes foot_goal (its aim exactly, with fewer than three channels).
  */
 static void two_bone(const struct mt_leg *leg, const double *hip, const double *parent, const double *angles,
-                     const struct leg_pose *pose, const double *knee, double soft, const double *ankle_goal,
-                     const double *foot_goal, const double *aim, struct solved *out)
+                     const struct leg_pose *pose, const struct hinge *h, const double *knee, double soft,
+                     const double *ankle_goal, const double *foot_goal, const double *aim, struct solved *out)
 {
     const double *s1 = leg->segment[0], *s2 = leg->segment[1];
     memcpy(out->angles, angles, sizeof out->angles);
-    const struct hinge h = hinge_of(leg, pose->local[1], knee);
     double goal[3];
     for (int e = 0; e < 3; e++)
         goal[e] = ankle_goal[e] - hip[e];
-    const double longest = reach(h, soft, 0.0), low2 = h.base - 2 * h.rho;
+    const double longest = reach(*h, soft, 0.0), low2 = h->base - 2 * h->rho;
     const double shortest = sqrt(low2 > 0 ? low2 : 0.0);
     const double d = clip(norm3(goal), shortest, longest);
-    const double cosine = clip((d * d - h.base) / (2 * (h.rho > tiny ? h.rho : 1.0)), -1.0, 1.0);
-    const double bend = h.rho > tiny ? acos(cosine) : 0.0;
+    const double cosine = clip((d * d - h->base) / (2 * (h->rho > tiny ? h->rho : 1.0)), -1.0, 1.0);
+    const double bend = h->rho > tiny ? acos(cosine) : 0.0;
     double r[9], wanted[9], knee_local[9], thigh[9], shin[9], v[3], leg_vector[3], world[3], hip_local[9];
-    about(knee, h.phi + knee[3] * bend, r);
+    about(knee, h->phi + knee[3] * bend, r);
     mat_mul(r, pose->local[1], wanted);
     realize(leg, 1, wanted, s2, angles + 3, out->angles + 3);
-    local_rotation(leg, 1, out->angles + 3, knee_local);
+    /* a joint with three channels takes the wanted rotation itself (to rounding), and so does a
+     * one-channel knee, whose hinge is its channel's axis */
+    if (channels(leg, 1) != 2)
+        memcpy(knee_local, wanted, sizeof wanted);
+    else
+        local_rotation(leg, 1, out->angles + 3, knee_local);
     mat_mul(parent, pose->local[0], thigh);
     mat_vec(knee_local, s2, v);
     for (int e = 0; e < 3; e++)
@@ -925,15 +997,22 @@ static void two_bone(const struct mt_leg *leg, const double *hip, const double *
     mat_vec(thigh, leg_vector, world);
     between(world, goal, r);
     mat_mul(r, thigh, wanted);
-    mat_mul_t(parent, 1, wanted, 0, wanted);
+    mat_tmul(parent, wanted, wanted);
     realize(leg, 0, wanted, leg_vector, angles, out->angles);
-    local_rotation(leg, 0, out->angles, hip_local);
+    if (channels(leg, 0) == 3)
+        memcpy(hip_local, wanted, sizeof wanted);
+    else
+        local_rotation(leg, 0, out->angles, hip_local);
     mat_mul(parent, hip_local, thigh);
     mat_mul(thigh, knee_local, shin);
-    mat_mul_t(shin, 1, foot_goal, 0, wanted);
+    mat_tmul(shin, foot_goal, wanted);
     realize(leg, 2, wanted, aim, angles + 6, out->angles + 6);
-    local_rotation(leg, 2, out->angles + 6, r);
-    mat_mul(shin, r, out->foot);
+    if (channels(leg, 2) == 3)
+        mat_mul(shin, wanted, out->foot);
+    else {
+        local_rotation(leg, 2, out->angles + 6, r);
+        mat_mul(shin, r, out->foot);
+    }
     double a[3], b[3];
     mat_vec(thigh, s1, a);
     mat_vec(shin, s2, b);
@@ -976,7 +1055,7 @@ static void bend_toes(const struct mt_leg *leg, const double *foot, const double
     realize(leg, 3, wanted, t, ref, angles);
 }
 
-/* how far the lower of heel and ball, of a foot at ankle turned to foot, is above where it rests */
+/* how far the lower of heel and ball, of a foot at ankle turned to foot, is above where they rest */
 static double foot_low(const struct mt_leg *leg, const double *ankle, const double *foot, const double *clearance,
                        const struct mt_footskate *opt)
 {
@@ -993,15 +1072,15 @@ static double foot_low(const struct mt_leg *leg, const double *ankle, const doub
 }
 
 int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hips, const double *parents,
-                       const double *angles, const unsigned char *planted, const double *goal, const double *turn,
-                       const double *weight, const double *knee, const double *root, const double *clearance,
-                       const struct mt_footskate *opt, double *out)
+                       const double *angles, const double *points, const unsigned char *planted, const double *goal,
+                       const double *turn, const double *weight, const double *knee, const double *root,
+                       const double *clearance, const struct mt_footskate *opt, double *out)
 {
     if (check_leg(leg) != MT_OK || check_options(opt) != MT_OK || !clearance || !knee)
         return MT_EINVAL;
     if (frames == 0)
         return MT_OK;
-    if (!hips || !parents || !angles || !planted || !goal || !turn || !weight || !root || !out)
+    if (!hips || !parents || !angles || !points || !planted || !goal || !turn || !weight || !root || !out)
         return MT_EINVAL;
     double *lift_by = malloc(2 * frames * sizeof *lift_by);
     if (!lift_by)
@@ -1013,26 +1092,42 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
         depth[t] = 0;
         if (planted[2 * t] || planted[2 * t + 1])
             continue;
-        struct leg_pose pose;
-        double q[9], foot_goal[9];
-        leg_fk(leg, hips + 3 * t, parents + 9 * t, angles + 12 * t, &pose);
+        const double *p = points + 15 * t, *ankle = p + 3;
+        double q[9], low = 0;
         rotvec_exp(turn + 3 * t, q);
-        mat_mul(q, pose.foot, foot_goal);
-        const double low = foot_low(leg, goal + 3 * t, foot_goal, clearance, opt);
+        for (int k = HEEL; k <= BALL; k++) { /* the point where the goals put it: goal + turn (point - ankle) */
+            const double *point = p + (k == HEEL ? 9 : 6);
+            double arm[3], at[3];
+            for (int e = 0; e < 3; e++)
+                arm[e] = point[e] - ankle[e];
+            mat_vec(q, arm, at);
+            for (int e = 0; e < 3; e++)
+                at[e] += goal[3 * t + e];
+            const double h = height(opt, at) - clearance[k];
+            low = k == HEEL || h < low ? h : low;
+        }
         depth[t] = low < 0 ? -low : 0.0;
     }
     const size_t half = opt->blend / 2;
+    double *bump = malloc((half + 1) * sizeof *bump);
+    if (!bump) {
+        free(lift_by);
+        return MT_ENOMEM;
+    }
+    for (size_t k = 1; k <= half; k++)
+        bump[k] = smoothstep(1 - (double)k / (double)(half + 1));
     for (size_t t = 0; t < frames; t++) {
         double best = depth[t];
-        for (size_t k = 1; k <= half; k++) {
-            const double bump = smoothstep(1 - (double)k / (double)(half + 1));
-            if (t >= k && bump * depth[t - k] > best)
-                best = bump * depth[t - k];
-            if (t + k < frames && bump * depth[t + k] > best)
-                best = bump * depth[t + k];
-        }
+        if (!(planted[2 * t] || planted[2 * t + 1]))
+            for (size_t k = 1; k <= half; k++) {
+                if (t >= k && bump[k] * depth[t - k] > best)
+                    best = bump[k] * depth[t - k];
+                if (t + k < frames && bump[k] * depth[t + k] > best)
+                    best = bump[k] * depth[t + k];
+            }
         lift_by[t] = planted[2 * t] || planted[2 * t + 1] ? 0.0 : best;
     }
+    free(bump);
     double aim[3];
     for (int e = 0; e < 3; e++)
         aim[e] = leg->segment[2][e] - leg->segment[3][e]; /* heel -> ball: what a two-channel ankle keeps */
@@ -1040,13 +1135,16 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
         const unsigned char *now = planted + 2 * t;
         const int some = now[HEEL] || now[BALL];
         const double *r = root + 3 * t;
-        struct leg_pose pose;
-        leg_fk(leg, hips + 3 * t, parents + 9 * t, angles + 12 * t, &pose);
         double *result = out + 12 * t, foot_now[9], ball_now[3];
         memcpy(result, angles + 12 * t, 12 * sizeof *result);
+        const int todo = some || weight[t] > 0 || r[0] != 0 || r[1] != 0 || r[2] != 0 || lift_by[t] > 0;
+        if (!todo && !(height(opt, points + 15 * t + 12) < clearance[2]))
+            continue; /* untouched, toes above the floor */
+        struct leg_pose pose;
+        leg_fk(leg, hips + 3 * t, parents + 9 * t, angles + 12 * t, &pose);
         memcpy(foot_now, pose.foot, sizeof foot_now);
         memcpy(ball_now, pose.point[2], sizeof ball_now);
-        if (some || weight[t] > 0 || r[0] != 0 || r[1] != 0 || r[2] != 0 || lift_by[t] > 0) {
+        if (todo) {
             double hip[3], q[9], foot_goal[9], first[3], target[3];
             for (int e = 0; e < 3; e++) {
                 hip[e] = hips[3 * t + e] + r[e];
@@ -1055,28 +1153,27 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
             rotvec_exp(turn + 3 * t, q);
             mat_mul(q, pose.foot, foot_goal);
             struct solved solved;
-            two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, knee, opt->knee_soft, first, foot_goal,
+            const struct hinge h = hinge_of(leg, pose.local[1], knee);
+            two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, first, foot_goal,
                      aim, &solved);
             memcpy(target, first, sizeof target);
             if (channels(leg, 2) < 3 && some) { /* the ankle cannot roll: re-aim it so that the pivot lands */
                 const double *pivot = leg->segment[now[HEEL] ? 3 : 2];
-                for (int pass = 0; pass < 2; pass++) {
-                    double want[3], got[3];
-                    mat_vec(foot_goal, pivot, want);
-                    mat_vec(solved.foot, pivot, got);
-                    for (int e = 0; e < 3; e++)
-                        target[e] = first[e] + want[e] - got[e];
-                    two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, knee, opt->knee_soft, target,
-                             foot_goal, aim, &solved);
-                }
+                double want[3], got[3]; /* once: the miss after it is a few micrometres */
+                mat_vec(foot_goal, pivot, want);
+                mat_vec(solved.foot, pivot, got);
+                for (int e = 0; e < 3; e++)
+                    target[e] = first[e] + want[e] - got[e];
+                two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, target,
+                         foot_goal, aim, &solved);
             }
             /* what the leg could not quite reach is lifted frame by frame */
             const double low = foot_low(leg, solved.ankle, solved.foot, clearance, opt);
             if (!some && low < 0) {
                 for (int e = 0; e < 3; e++)
                     target[e] -= low * opt->up[e];
-                two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, knee, opt->knee_soft, target, foot_goal,
-                         aim, &solved);
+                two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, target,
+                         foot_goal, aim, &solved);
             }
             memcpy(result, solved.angles, sizeof solved.angles);
             memcpy(foot_now, solved.foot, sizeof foot_now);

@@ -339,7 +339,8 @@ int mt_leg_points(const struct mt_leg *legs, size_t nlegs, size_t frames, const 
                   const double *parents, const double *angles, double *points, double *feet);
 
 /*
- * Phases 1 and 2 for one leg.  planted (frames x 2): heel and ball planted;
+ * Phases 1 and 2 for one leg, of its angles and points (frames x 5 x 3, as
+ * mt_leg_points gives them).  planted (frames x 2): heel and ball planted;
  * targets (frames x 2 x 3): where, read where planted; clearance (3): the
  * heights at which heel, ball and toe tip rest.
  * 1. Frame by frame a planted point keeps the target it had at the frame
@@ -363,10 +364,10 @@ int mt_leg_points(const struct mt_leg *legs, size_t nlegs, size_t frames, const 
  *    hip joint's frame, its channel's or the take's mean bend axis, and the
  *    side it bends to, +1 or -1).
  */
-int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *hips, const double *parents,
-                      const double *angles, const unsigned char *planted, const double *targets,
-                      const double *clearance, const struct mt_footskate *opt, double *enforced,
-                      double *goal, double *turn, double *weight, double *reach, double *knee);
+int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *angles, const double *points,
+                      const unsigned char *planted, const double *targets, const double *clearance,
+                      const struct mt_footskate *opt, double *enforced, double *goal, double *turn,
+                      double *weight, double *reach, double *knee);
 
 /*
  * Phase 3 for one or two legs (hips, goals legs x frames x 3; reaches,
@@ -382,7 +383,8 @@ int mt_footskate_root(size_t legs, size_t frames, const double *hips, const doub
                       double *root);
 
 /*
- * Phases 4 and 5 for one leg: the new angles (frames x 4 x 3).  Frames that
+ * Phases 4 and 5 for one leg (its points as for mt_footskate_plan): the new
+ * angles (frames x 4 x 3).  Frames that
  * are constrained, blended, or whose root moved, are solved by two-bone IK:
  * the knee bends about its hinge to the goal's distance (within reach, never
  * past straight), the hip turns the leg onto the goal, the ankle takes the
@@ -394,9 +396,10 @@ int mt_footskate_root(size_t legs, size_t frames, const double *hips, const doub
  * keep their angles bit for bit.
  */
 int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hips, const double *parents,
-                       const double *angles, const unsigned char *planted, const double *goal,
-                       const double *turn, const double *weight, const double *knee, const double *root,
-                       const double *clearance, const struct mt_footskate *opt, double *out);
+                       const double *angles, const double *points, const unsigned char *planted,
+                       const double *goal, const double *turn, const double *weight, const double *knee,
+                       const double *root, const double *clearance, const struct mt_footskate *opt,
+                       double *out);
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

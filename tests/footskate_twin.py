@@ -550,11 +550,11 @@ def bend_toes(chain, foot, ball, angles, locals3, clearance_tip, options):
 # ---------------------------------------------------------------- phases
 
 
-def plan_leg(chain, hips, parents, angles, planted, targets, clearance, options: CleanupOptions):
+def plan_leg(chain, angles, points, planted, targets, clearance, options: CleanupOptions):
     """Phases 1 and 2 for one leg: (enforced (frames, 2, 3), goal (frames, 3), turn (frames, 3),
     weight (frames,), reach (frames,), knee (4,)), as mtcore.footskate.plan_leg."""
     planted = np.asarray(planted, bool)
-    locals_, foot, points = leg_fk(chain, hips, parents, angles)
+    locals_ = [None, local(chain, 1, angles[:, 1])]
     foot_length = np.linalg.norm(chain.segments[2] - chain.segments[3])
     enforced, partner = enforced_targets(planted, targets, clearance, foot_length, options)
     goal, turn, weight = foot_targets(chain, planted, enforced, partner, points, options.blend, clearance, options)
@@ -579,13 +579,13 @@ def adjust_root(hips, goals, reaches, weights, options: CleanupOptions):
     return project_root(root, centres, radii, active)
 
 
-def solve_leg(chain, hips, parents, angles, planted, goal, turn, weight, knee, root, clearance, options):
+def solve_leg(chain, hips, parents, angles, points, planted, goal, turn, weight, knee, root, clearance, options):
     """Phases 4 and 5 for one leg: the new angles (frames, 4, 3) (see mtcore.footskate.solve_leg)."""
     planted = np.asarray(planted, bool)
     frames = len(hips)
     up = np.asarray(options.up)
     out = np.array(angles, dtype=float)
-    locals_, foot, points = leg_fk(chain, hips, parents, angles)
+    locals_, foot, _ = leg_fk(chain, hips, parents, angles)
     foot_goal = mm(from_rotvec(turn), foot)
     axis, side = np.asarray(knee[:3]), float(knee[3])
     some = planted.any(-1)
@@ -594,9 +594,10 @@ def solve_leg(chain, hips, parents, angles, planted, goal, turn, weight, knee, r
     pivot = np.where(planted[:, HEEL][:, None], s[3], s[2])
     # a free foot that its targets put below the floor is lifted, smoothly: by the upper envelope
     # of the depths under a bump half the blend wide
+    turned = from_rotvec(turn)
     low = np.minimum(
-        height(goal + mv(foot_goal, s[3]), options) - clearance[0],
-        height(goal + mv(foot_goal, s[2]), options) - clearance[1],
+        height(goal + mv(turned, points[:, 3] - points[:, 1]), options) - clearance[0],
+        height(goal + mv(turned, points[:, 2] - points[:, 1]), options) - clearance[1],
     )
     depth = np.where(some, 0.0, np.maximum(-low, 0.0))
     lift_by = np.where(some, 0.0, envelope(depth, options.blend // 2))
@@ -615,10 +616,9 @@ def solve_leg(chain, hips, parents, angles, planted, goal, turn, weight, knee, r
 
         new, achieved, ankle_now = solve(goal_f)
         if channels(chain, 2) < 3:  # the ankle cannot roll: re-aim the ankle so that the pivot lands
-            pinned, first = some[f], goal_f
-            for _ in range(2):
-                goal_f = np.where(pinned[:, None], first + mv(turn_f, pivot[f]) - mv(achieved, pivot[f]), first)
-                new, achieved, ankle_now = solve(goal_f)
+            # once: the miss after it is a few micrometres
+            goal_f = np.where(some[f][:, None], goal_f + mv(turn_f, pivot[f]) - mv(achieved, pivot[f]), goal_f)
+            new, achieved, ankle_now = solve(goal_f)
         # what the legs could not quite reach is lifted frame by frame
         low = np.minimum(
             height(ankle_now + mv(achieved, s[3]), options) - clearance[0],
@@ -634,17 +634,19 @@ def solve_leg(chain, hips, parents, angles, planted, goal, turn, weight, knee, r
     return out
 
 
-def cleanup(chains, hips, parents, angles, planted, targets, clearance, options: CleanupOptions):
+def cleanup(chains, hips, parents, angles, points, planted, targets, clearance, options: CleanupOptions):
     """All phases (see mtcore.footskate.cleanup): (angles, root, enforced)."""
     chains = tuple(chains)
     plans = [
-        plan_leg(c, hips[i], parents[i], angles[i], planted[i], targets[i], clearance[i], options)
-        for i, c in enumerate(chains)
+        plan_leg(c, angles[i], points[i], planted[i], targets[i], clearance[i], options) for i, c in enumerate(chains)
     ]
     root = adjust_root(hips, [p[1] for p in plans], [p[4] for p in plans], [p[3] for p in plans], options)
     out = np.stack(
         [
-            solve_leg(c, hips[i], parents[i], angles[i], planted[i], p[1], p[2], p[3], p[5], root, clearance[i], options)
+            solve_leg(
+                c, hips[i], parents[i], angles[i], points[i], planted[i], p[1], p[2], p[3], p[5], root, clearance[i],
+                options,
+            )
             for i, (c, p) in enumerate(zip(chains, plans))
         ]
     )

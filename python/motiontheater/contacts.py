@@ -256,21 +256,34 @@ def detect_masks(
     n = heights.shape[-1]
     rows = [a.reshape(-1, n) for a in (heights, close, firm, sure, slow)]
     out = np.zeros(rows[0].shape, bool)
+    index = np.arange(n)
     for r, (h, c, f, certain, moving_slowly) in enumerate(zip(*rows)):
         starts, ends = runs(c)
-        firm_count = np.add.reduceat(f.astype(np.int64), starts) if len(starts) else starts
+        if not len(starts):
+            continue
+        firm_count = np.add.reduceat(f.astype(np.int64), starts)
         starts, ends = starts[firm_count > 0], ends[firm_count > 0]
         if len(starts) > 1:  # merge short gaps that the point crosses slowly
             fast = np.r_[0, np.cumsum(~moving_slowly)]
             join = (starts[1:] - ends[:-1] <= gap) & (fast[starts[1:]] == fast[ends[:-1]])
             starts, ends = starts[np.r_[True, ~join]], ends[np.r_[~join, True]]
-        for s, e in zip(starts, ends):
-            # the ends of a plant where the point has risen from it (heel strike, push-off), sure frames kept
-            still = (h[s:e] <= h[s:e].min() + rise) | certain[s:e]
-            inside = np.flatnonzero(still)
-            s, e = s + inside[0], s + inside[-1] + 1
-            if e - s >= shortest or certain[s:e].any():
-                out[r, s:e] = True
+        if not len(starts):
+            continue
+        # cut the ends of each plant where the point has risen from it (heel strike, push-off), sure frames kept
+        bounds = np.ravel(np.column_stack([starts, ends]))
+        bounds = bounds[:-1] if bounds[-1] == n else bounds
+        plant = np.searchsorted(starts, index, side="right") - 1
+        inside = (plant >= 0) & (index < ends[np.maximum(plant, 0)])
+        lowest = np.minimum.reduceat(h, bounds)[::2]
+        still = inside & ((h <= lowest[np.maximum(plant, 0)] + rise) | certain)
+        first = np.minimum.reduceat(np.where(still, index, n), bounds)[::2]
+        last = np.maximum.reduceat(np.where(still, index, -1), bounds)[::2] + 1
+        held = np.r_[0, np.cumsum(certain)]
+        keep = (last > first) & ((last - first >= shortest) | (held[np.maximum(last, first)] > held[first]))
+        edges = np.zeros(n + 1, np.int64)
+        np.add.at(edges, first[keep], 1)
+        np.add.at(edges, last[keep], -1)
+        out[r] = np.cumsum(edges[:-1]) > 0
     return out.reshape(heights.shape)
 
 

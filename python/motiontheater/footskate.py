@@ -165,7 +165,7 @@ def clean_footskate(
         knee_soft=math.radians(knee_soft),
     )
     angles, root, enforced = kernels.cleanup(
-        arrays.chains, arrays.hips, arrays.parents, arrays.angles, masks, targets, ground.clearance, options
+        arrays.chains, arrays.hips, arrays.parents, arrays.angles, arrays.points, masks, targets, ground.clearance, options
     )
     values = motion.values.copy()
     changed = angles != arrays.angles  # unchanged angles keep their channel's bits

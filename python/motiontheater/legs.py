@@ -371,6 +371,34 @@ def _upper_tree(tree, keep: list[int]):
     )
 
 
+_CHUNK = 16384  # frames of forward kinematics at a time: the joints' rotations stay in cache, not in memory
+
+
+def _upper_kinematics(values: np.ndarray, tree, legs: Legs) -> tuple[np.ndarray, np.ndarray]:
+    """Hip points (legs, frames, 3) and the world rotations of the hip joints' parents (legs,
+    frames, 3, 3), by forward kinematics of the joints above the legs only, in chunks of frames."""
+    keep: set[int] = set()
+    for j in (*legs.parents, *legs.points[:, 0]):
+        j = int(j)
+        while j >= 0:
+            keep.add(j)
+            j = int(tree.parent[j])
+    order = sorted(keep)
+    where = {old: i for i, old in enumerate(order)}
+    upper = _upper_tree(tree, order)
+    hip_rows = [where[int(p)] for p in legs.points[:, 0]]
+    parent_rows = [where[int(p)] for p in legs.parents]
+    frames = len(values)
+    hips = np.empty((len(legs), frames, 3))
+    parents = np.empty((len(legs), frames, 3, 3))
+    for start in range(0, frames, _CHUNK):
+        stop = min(start + _CHUNK, frames)
+        positions, world, _ = forward_kinematics(values[start:stop], upper, world=True, workers=1)
+        hips[:, start:stop] = positions[:, hip_rows].transpose(1, 0, 2)
+        parents[:, start:stop] = world[:, parent_rows].transpose(1, 0, 2, 3)
+    return hips, parents
+
+
 def leg_arrays(
     motion: Motion, legs: Legs, *, up: str | np.ndarray | None = None, meters_per_unit: float | None = None
 ) -> LegArrays:
@@ -382,17 +410,7 @@ def leg_arrays(
 
     skeleton = motion.skeleton
     tree = joint_tree(skeleton)
-    keep: set[int] = set()
-    for hip in legs.rotators[:, 0]:
-        j = int(hip)
-        while j >= 0:
-            keep.add(j)
-            j = int(tree.parent[j])
-    order = sorted(keep)
-    where = {old: i for i, old in enumerate(order)}
-    positions, world, _ = forward_kinematics(motion.values, _upper_tree(tree, order), world=True, workers=1)
-    hips = np.ascontiguousarray(positions[:, [where[int(p)] for p in legs.points[:, 0]]].transpose(1, 0, 2))
-    parents = np.ascontiguousarray(world[:, [where[int(p)] for p in legs.parents]].transpose(1, 0, 2, 3))
+    hips, parents = _upper_kinematics(motion.values, tree, legs)
     n = len(legs)
     columns = np.full((n, 4, 3), -1, np.int64)
     axes = np.full((n, 4, 3), -1, np.intc)
@@ -405,8 +423,8 @@ def leg_arrays(
             for m, (k, c) in enumerate(rot):
                 axes[i, r, m], columns[i, r, m] = k, c
     angles = np.zeros((n, motion.frames, 4, 3))
-    used = columns >= 0
-    angles.transpose(0, 2, 3, 1)[used] = motion.values[:, columns[used]].T * tree.angle_scale
+    for i, r, m in zip(*np.nonzero(columns >= 0)):
+        np.multiply(motion.values[:, columns[i, r, m]], tree.angle_scale, out=angles[i, :, r, m])
     frames_axis = [np.stack([tree.axis[j] if j >= 0 else np.eye(3) for j in legs.rotators[i]]) for i in range(n)]
 
     def chains_of(segments: np.ndarray) -> tuple:
@@ -514,6 +532,7 @@ _REST_SPEED = 0.1  # m/s: a contact point slower than this (at the reference siz
 _FIT_BAND = 0.015  # m: resting samples more than this above the fitted floor are not on it
 _SLOPE_PRIOR = 0.15  # m: a horizontal spread of this much halves the fitted tilt (ridge)
 _MAX_TILT = np.tan(np.radians(5.0))
+_FIT_SAMPLES = 50_000
 
 
 def fit_ground(
@@ -567,9 +586,12 @@ def fit_ground(
                 if resting[i, :, k].any():
                     clearance[i, k] = max(0.0, float(np.median(vertical[i, resting[i, :, k], k])) - floor)
         return Ground(tuple(up_vector), float(floor), (0.0, 0.0, 0.0), clearance)
-    point_id = np.broadcast_to(np.arange(len(legs) * 3).reshape(len(legs), 1, 3), resting.shape)[resting]
-    xy = contact[resting][:, horizontal_axes]
-    z = vertical[resting]
+    where = np.flatnonzero(resting)
+    if len(where) > _FIT_SAMPLES:  # a long take: evenly spaced samples tell the plane as well
+        where = where[:: -(-len(where) // _FIT_SAMPLES)]
+    point_id = (where // 3 // frames) * 3 + where % 3
+    xy = contact.reshape(-1, 3)[where][:, horizontal_axes]
+    z = vertical.reshape(-1)[where]
     centre = xy.mean(0)
     xy = xy - centre
     ids = np.unique(point_id)

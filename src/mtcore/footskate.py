@@ -223,8 +223,13 @@ def _planted(planted, frames: int) -> np.ndarray:
     return np.ascontiguousarray(out != 0, dtype=np.uint8)
 
 
-def plan_leg(chain, hips, parents, angles, planted, targets, clearance, options: CleanupOptions) -> LegPlan:
-    """Phases 1 and 2 for one leg (``mt_footskate_plan``).
+def _points(points, frames: int) -> np.ndarray:
+    return _doubles(points, "points", (frames, 5, 3))
+
+
+def plan_leg(chain, angles, points, planted, targets, clearance, options: CleanupOptions) -> LegPlan:
+    """Phases 1 and 2 for one leg (``mt_footskate_plan``), of its angles (frames, 4, 3) and
+    points (frames, 5, 3) as :func:`leg_points` gives them.
 
     ``planted`` (frames, 2): whether the heel and the ball are planted;
     ``targets`` (frames, 2, 3): where (read where planted: the mean position
@@ -238,7 +243,13 @@ def plan_leg(chain, hips, parents, angles, planted, targets, clearance, options:
     hip-to-ankle distance the root must keep it within) and the knee's hinge
     axis in the thigh's frame with the side it bends to, (4,).
     """
-    hips, parents, angles, frames = _leg_frames(chain, hips, parents, angles)
+    if not isinstance(chain, LegChain):
+        raise TypeError(f"chain must be a LegChain, got {type(chain).__name__}")
+    angles = np.ascontiguousarray(angles, dtype=np.float64)
+    if angles.ndim != 3 or angles.shape[1:] != (4, 3):
+        raise ValueError(f"angles must have shape (frames, 4, 3), got {angles.shape}")
+    frames = angles.shape[0]
+    points = _points(points, frames)
     planted = _planted(planted, frames)
     targets = _doubles(targets, "targets", (frames, 2, 3))
     if not np.isfinite(targets[planted.astype(bool)]).all():
@@ -249,10 +260,9 @@ def plan_leg(chain, hips, parents, angles, planted, targets, clearance, options:
     )
     check(
         lib.mt_footskate_plan(
-            _leg_struct((chain,)), frames, c_array(hips), c_array(parents), c_array(angles),
-            c_array(planted, "unsigned char[]"), c_array(targets), c_array(_clearance(clearance)), options.struct(),
-            c_array(plan.enforced), c_array(plan.goal), c_array(plan.turn), c_array(plan.weight),
-            c_array(plan.reach), c_array(plan.knee),
+            _leg_struct((chain,)), frames, c_array(angles), c_array(points), c_array(planted, "unsigned char[]"),
+            c_array(targets), c_array(_clearance(clearance)), options.struct(), c_array(plan.enforced),
+            c_array(plan.goal), c_array(plan.turn), c_array(plan.weight), c_array(plan.reach), c_array(plan.knee),
         ),
         "mt_footskate_plan",
     )
@@ -282,26 +292,25 @@ def adjust_root(hips, goals, reaches, weights, options: CleanupOptions) -> np.nd
 
 
 def solve_leg(
-    chain, hips, parents, angles, planted, plan: LegPlan, root, clearance, options: CleanupOptions
+    chain, hips, parents, angles, points, planted, plan: LegPlan, root, clearance, options: CleanupOptions
 ) -> np.ndarray:
     """Phases 4 and 5 for one leg (``mt_footskate_solve``): the new angles (frames, 4, 3),
-    the input's bit for bit in frames that need no change.  ``root`` (frames, 3) is the root's
-    translation from :func:`adjust_root`."""
+    the input's bit for bit in frames that need no change.  ``points`` as for :func:`plan_leg`;
+    ``root`` (frames, 3) is the root's translation from :func:`adjust_root`."""
     hips, parents, angles, frames = _leg_frames(chain, hips, parents, angles)
+    points = _points(points, frames)
     planted = _planted(planted, frames)
     root = _doubles(root, "root", (frames, 3))
-    for name in ("goal", "turn"):
-        _doubles(getattr(plan, name), f"plan.{name}", (frames, 3))
-    _doubles(plan.weight, "plan.weight", (frames,))
-    _doubles(plan.knee, "plan.knee", (4,))
+    goal = _doubles(plan.goal, "plan.goal", (frames, 3))
+    turn = _doubles(plan.turn, "plan.turn", (frames, 3))
+    weight = _doubles(plan.weight, "plan.weight", (frames,))
+    knee = _doubles(plan.knee, "plan.knee", (4,))
     out = np.empty_like(angles)
     check(
         lib.mt_footskate_solve(
-            _leg_struct((chain,)), frames, c_array(hips), c_array(parents), c_array(angles),
-            c_array(planted, "unsigned char[]"), c_array(np.ascontiguousarray(plan.goal)),
-            c_array(np.ascontiguousarray(plan.turn)), c_array(np.ascontiguousarray(plan.weight)),
-            c_array(np.ascontiguousarray(plan.knee)), c_array(root), c_array(_clearance(clearance)),
-            options.struct(), c_array(out),
+            _leg_struct((chain,)), frames, c_array(hips), c_array(parents), c_array(angles), c_array(points),
+            c_array(planted, "unsigned char[]"), c_array(goal), c_array(turn), c_array(weight), c_array(knee),
+            c_array(root), c_array(_clearance(clearance)), options.struct(), c_array(out),
         ),
         "mt_footskate_solve",
     )
@@ -309,32 +318,34 @@ def solve_leg(
 
 
 def cleanup(
-    chains, hips, parents, angles, planted, targets, clearance, options: CleanupOptions
+    chains, hips, parents, angles, points, planted, targets, clearance, options: CleanupOptions
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Footskate cleanup of one or two legs over frames: (angles, root, enforced).
 
     The arrays are those of the phases, with a leading axis of legs:
     ``hips`` (legs, frames, 3), ``parents`` (legs, frames, 3, 3), ``angles``
-    (legs, frames, 4, 3), ``planted`` (legs, frames, 2), ``targets`` (legs,
-    frames, 2, 3), ``clearance`` (legs, 3).  Returns the new angles, the
-    root's translation to add (frames, 3) and the enforced targets (legs,
-    frames, 2, 3): :func:`plan_leg` per leg, :func:`adjust_root`,
-    :func:`solve_leg` per leg.
+    (legs, frames, 4, 3), ``points`` (legs, frames, 5, 3), ``planted``
+    (legs, frames, 2), ``targets`` (legs, frames, 2, 3), ``clearance`` (legs,
+    3).  Returns the new angles, the root's translation to add (frames, 3) and
+    the enforced targets (legs, frames, 2, 3): :func:`plan_leg` per leg,
+    :func:`adjust_root`, :func:`solve_leg` per leg.
     """
     chains = tuple(chains)
     if len(chains) not in (1, 2):
         raise ValueError(f"cleanup takes one or two legs, got {len(chains)}")
     plans = [
-        plan_leg(c, hips[i], parents[i], angles[i], planted[i], targets[i], clearance[i], options)
-        for i, c in enumerate(chains)
+        plan_leg(c, angles[i], points[i], planted[i], targets[i], clearance[i], options) for i, c in enumerate(chains)
     ]
     root = adjust_root(
-        hips, np.stack([p.goal for p in plans]), np.stack([p.reach for p in plans]),
-        np.stack([p.weight for p in plans]), options,
+        hips,
+        np.stack([p.goal for p in plans]),
+        np.stack([p.reach for p in plans]),
+        np.stack([p.weight for p in plans]),
+        options,
     )
     out = np.stack(
         [
-            solve_leg(c, hips[i], parents[i], angles[i], planted[i], p, root, clearance[i], options)
+            solve_leg(c, hips[i], parents[i], angles[i], points[i], planted[i], p, root, clearance[i], options)
             for i, (c, p) in enumerate(zip(chains, plans))
         ]
     )
