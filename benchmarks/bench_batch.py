@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from motiontheater import batch
+from motiontheater import Pipeline, batch
 
 DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 COPIES = 75
@@ -45,7 +45,7 @@ def test_batch_throughput(benchmark, record, corpus, tmp_path, jobs, where):
 
     def run():
         out = base / f"out{next(runs)}"
-        plan, settled = batch.plan_jobs([str(corpus)], out, batch.Recipe("median", 5))
+        plan, settled = batch.plan_jobs([str(corpus)], out, Pipeline.of("median", size=5))
         summary = batch.run(plan, settled, workers=jobs, out=out)
         assert not summary.failed
         return summary

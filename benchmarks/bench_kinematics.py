@@ -13,7 +13,6 @@ from pathlib import Path
 import pytest
 
 import motiontheater as mt
-from motiontheater.kinematics import joint_tree
 from mtcore.kinematics import forward_kinematics
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
@@ -78,7 +77,7 @@ def test_upc_pymotion_load_and_fk(benchmark, record, take):
 @pytest.mark.parametrize("threads", {"all cores": None, "1 thread": 1})
 def test_fk_kernel(benchmark, record, take, threads):
     _, motion = take
-    tree = joint_tree(motion.skeleton)
+    tree = motion.skeleton.tree
     workers = {"all cores": None, "1 thread": 1}[threads]
     benchmark.pedantic(forward_kinematics, (motion.values, tree), dict(workers=workers), **FAST)
     record(f"{KERNEL}, {threads}", "mtcore", transforms(motion), unit="M transforms", target=">= 20 M transforms/s")

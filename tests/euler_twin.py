@@ -31,3 +31,28 @@ def angles(m: np.ndarray, axes: str) -> np.ndarray:
     first = np.arctan2(e * m[..., k, j], m[..., k, k])
     last = np.arctan2(e * m[..., j, i], m[..., i, i])
     return np.stack([first, middle, last], axis=-1)
+
+
+# The same conversions under mtcore.rotations' names and conventions, so that code written
+# against mtcore.rotations can run on numpy alone (the combiner's numpy peer in benchmarks).
+
+
+def euler_to_matrices(a, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
+    a = np.radians(a) if degrees else np.asarray(a, float)
+    return matrices(a, order) if extrinsic else matrices(a[..., ::-1], order[::-1])
+
+
+def matrices_to_euler(m, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
+    out = angles(m, order) if extrinsic else angles(m, order[::-1])[..., ::-1]
+    return np.degrees(out) if degrees else out
+
+
+def rotvecs_to_matrices(v) -> np.ndarray:
+    """Rodrigues' formula."""
+    v = np.asarray(v, float)
+    angle = np.linalg.norm(v, axis=-1)[..., None, None]
+    axis = v / np.where(angle[..., 0] > 0, angle[..., 0], 1.0)
+    k = np.zeros(v.shape[:-1] + (3, 3))
+    k[..., 0, 1], k[..., 0, 2], k[..., 1, 2] = -axis[..., 2], axis[..., 1], -axis[..., 0]
+    k = k - np.swapaxes(k, -1, -2)
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)

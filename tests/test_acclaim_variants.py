@@ -42,7 +42,7 @@ def test_crlf_lf_cr_and_tabs(original, tmp_path):
     for newline in (b"\n", b"\r\n", b"\r"):
         for blank in (b" ", b"\t", b" \t "):
 
-            def variant(text):
+            def variant(text, newline=newline, blank=blank):
                 lines = re.split(rb"\r\n|\r|\n", text)
                 return newline.join(blank.join(line.split(b" ")) for line in lines)
 

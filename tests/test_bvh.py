@@ -30,7 +30,8 @@ def test_every_bvh_reads_and_writes_back_exactly(path):
 
 def test_walk01_positions_equal_bvh_toolbox(data_dir):
     motion = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
-    rows = list(csv.reader(open(data_dir / "bvh" / "walk01_pos.csv")))
+    with open(data_dir / "bvh" / "walk01_pos.csv") as f:
+        rows = list(csv.reader(f))
     header = [h.strip() for h in rows[0]]
     reference = np.array([[float(x) for x in row if x.strip()] for row in rows[1:]])
     positions = motion.positions()

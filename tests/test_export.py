@@ -65,7 +65,9 @@ def test_positions_command(data_dir, tmp_path, capsys):
         )
         == 0
     )
-    assert capsys.readouterr().out.strip() == f"wrote 343 frames x 31 joints (metres, npz) to {out}"
+    assert (
+        capsys.readouterr().out.strip() == f"positions: wrote 343 frames of {data_dir / 'cmu' / '02_01.amc'} to {out}"
+    )
     assert np.load(out)["positions"].shape == (343, 31, 3)
 
 

@@ -72,7 +72,6 @@ def test_zero_dimensional_input_has_no_axis(filt):
 
 def test_c_status_codes_map_to_exceptions():
     from mtcore._mtcore import ffi, lib
-
     from mtcore._status import check
 
     check(lib.MT_OK, "noop")

@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation, Slerp
 
 import motiontheater as mt
-from motiontheater.interpolate import Pipeline, interpolate, median3
+from motiontheater import Pipeline, interpolate, median3
 from mtcore import rotations as rot
 
 EPS = 0.1
@@ -39,7 +39,7 @@ def total_turn(motion, first, last):
     [("slerp", 2 * EPS), ("expmap", 2 * (np.pi - EPS)), ("euler", 2 * (np.pi - EPS)), ("aligned_expmap", 2 * EPS)],
 )
 def test_cs838_comparison(cs838, kind, turn):
-    result = interpolate(cs838, 100, 150, kind, ["arm"])
+    result = interpolate(cs838, kind, frames=(100, 150), joints=["arm"])
     assert total_turn(result, 100, 150) == pytest.approx(turn, abs=1e-9)
     np.testing.assert_array_equal(result.values[:100], cs838.values[:100])  # keys and outside untouched
     np.testing.assert_array_equal(result.values[149:], cs838.values[149:])
@@ -54,7 +54,7 @@ def test_slerp_equals_scipy_on_a_real_joint(data_dir, convention):
         motion = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
         joint, order = "RightUpLeg", "ZXY"  # intrinsic, as listed
     columns = motion.columns(joint, tuple(d for d in motion.skeleton.dofs(joint) if d.startswith("r")))
-    result = interpolate(motion, 20, 60, "slerp", [joint])
+    result = interpolate(motion, "slerp", frames=(20, 60), joints=[joint])
     keys = Rotation.from_euler(order, motion.values[[19, 59]][:, columns], degrees=True)
     expected = Slerp([20, 60], keys)(np.arange(21, 60))
     got = Rotation.from_euler(order, result.values[20:59, columns], degrees=True)
@@ -65,7 +65,7 @@ def test_slerp_equals_scipy_on_a_real_joint(data_dir, convention):
 
 def test_translations_and_partial_joints_interpolate_linearly(data_dir):
     motion = mt.read_amc(data_dir / "cmu" / "01_01.amc", mt.read_asf(data_dir / "cmu" / "01.asf"))
-    result = interpolate(motion, 10, 20, "slerp", ["root", "ltibia"])
+    result = interpolate(motion, "slerp", frames=(10, 20), joints=["root", "ltibia"])
     for joint, dof in (("root", "tx"), ("ltibia", "rx")):
         keys = motion.channel(joint, dof)[[9, 19]]  # the input's: the keys must not move
         np.testing.assert_allclose(result.channel(joint, dof)[9:20], np.linspace(*keys, 11), rtol=0, atol=1e-12)
@@ -73,7 +73,7 @@ def test_translations_and_partial_joints_interpolate_linearly(data_dir):
 
 def test_median3_touches_only_its_range(data_dir):
     motion = mt.read_amc(data_dir / "cmu" / "02_01.amc", mt.read_asf(data_dir / "cmu" / "02.asf"))
-    result = median3(motion, 50, 80)
+    result = motion.median3(frames=(50, 80))
     np.testing.assert_array_equal(result.values[:49], motion.values[:49])
     np.testing.assert_array_equal(result.values[80:], motion.values[80:])
     column = motion.values[49:80, 5]
@@ -84,23 +84,34 @@ def test_median3_touches_only_its_range(data_dir):
 
 def test_pipeline_applies_steps_in_order(data_dir):
     motion = mt.read_amc(data_dir / "cmu" / "02_01.amc", mt.read_asf(data_dir / "cmu" / "02.asf"))
-    pipeline = Pipeline().then("median3", 1, 343).then("slerp", 100, 140, ["lfemur"]).then("binomial", 200, 300, size=5)
-    expected = interpolate(median3(motion, 1, 343), 100, 140, "slerp", ["lfemur"])
+    pipeline = (
+        Pipeline()
+        .then("median3", frames=(1, 343))
+        .then("slerp", frames=(100, 140), joints=["lfemur"])
+        .then("binomial", frames=(200, 300), size=5)
+    )
+    expected = interpolate(median3(motion), "slerp", frames=(100, 140), joints=["lfemur"])
     piece = expected.replace(values=expected.values[199:300], first_frame=200).filter("binomial", 5)
     values = expected.values.copy()
     values[199:300] = piece.values
     np.testing.assert_array_equal(pipeline.apply(motion).values, values)
     assert len(pipeline.steps) == 3
+    assert Pipeline.from_toml(pipeline.to_toml()) == pipeline
 
 
 @pytest.mark.parametrize(
     "call,message",
     [
-        (lambda m: interpolate(m, 150, 100), r"the range 150..100 must lie within the motion's frames 1..200"),
-        (lambda m: interpolate(m, 0, 100), r"the range 0..100"),
-        (lambda m: interpolate(m, 10, 20, "cubic"), "kind must be one of euler, slerp, expmap, aligned_expmap"),
-        (lambda m: Pipeline().then("spline", 1, 5), "step kind must be one of"),
-        (lambda m: interpolate(m, 10, 20, "slerp", ["leg"]), "no bone 'leg'"),
+        (
+            lambda m: interpolate(m, frames=(150, 100)),
+            r"the key frames 150:100 must lie within the motion's frames 1..200, the first before the last",
+        ),
+        (lambda m: m.slerp(frames=(0, 100)), r"the key frames 0:100"),
+        (lambda m: interpolate(m, "cubic", frames=(10, 20)), "method must be one of slerp, euler, expmap"),
+        (lambda m: Pipeline().then("spline", frames=(1, 5)), "no step 'spline'; the steps are: "),
+        (lambda m: m.slerp(frames=(10, 20), joints=["leg"]), "no bone 'leg'"),
+        (lambda m: m.slerp(frames=(10, 20), size=3), "step 'slerp' has no option 'size'"),
+        (lambda m: m.slerp(), "step 'slerp' needs the option 'frames'"),
     ],
 )
 def test_bad_requests(cs838, call, message):

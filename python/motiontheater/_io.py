@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import contextlib
+import io
 import mmap
 import os
 import re
 import tempfile
+import typing
 from collections.abc import Iterator
-from typing import IO, Union
+from typing import IO
 
-Source = Union[str, os.PathLike, IO[bytes], IO[str]]
+Source = str | os.PathLike | IO[bytes] | IO[str]
+Text = bytes | mmap.mmap  # a file's bytes, read or mapped
 
 LINE_BREAK = re.compile(r"\r\n|\r|\n")  # as the C scanner: CRLF, lone CR and LF each end a line
 PARTIAL_PREFIX = ".mt-partial-"  # files being written; a killed run may leave them, the next removes them
@@ -54,7 +57,7 @@ def output(target: Source) -> Iterator[IO[bytes]]:
     beside it that replaces the path only when complete, so that a failure
     leaves no partial file."""
     if not isinstance(target, (str, os.PathLike)):
-        yield target.buffer if hasattr(target, "buffer") else target
+        yield typing.cast(IO[bytes], target.buffer if isinstance(target, io.TextIOWrapper) else target)
         return
     directory = os.path.dirname(os.path.abspath(target))
     fd, tmp = tempfile.mkstemp(prefix=PARTIAL_PREFIX, suffix="-" + os.path.basename(target), dir=directory)

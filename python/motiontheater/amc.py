@@ -2,16 +2,23 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
-import re
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
-from mtcore import format_frames, format_number, scan_frames
-from mtcore.errors import FormatError
+import numpy as np
 
-from ._io import Source, decode, encode, mapped_source, output
+from mtcore import format_frames, format_number, scan_frames
+from mtcore.text import frame_line, line_breaks
+
+from ._io import LINE_BREAK, Source, Text, decode, encode, mapped_source, output
+from .errors import FormatError, SequenceError
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Skeleton
+
+READ_BYTES = 8 << 20  # bytes read at a time when a take is streamed
 
 _RATE_KEYS = (":SAMPLES-PER-SECOND", ":SAMPLES_PER_SECOND", ":FRAME-RATE")
 
@@ -28,9 +35,9 @@ def skeleton_path_for(amc_path: str | os.PathLike) -> Path:
             continue
         stem = asf.stem.split("-")[0]
         rest = amc.stem[len(stem) :]
-        if amc.stem.startswith(stem) and (rest == "" or rest[0] in "_-."):
-            if best is None or len(stem) > len(best.stem.split("-")[0]):
-                best = asf
+        matches = amc.stem.startswith(stem) and (rest == "" or rest[0] in "_-.")
+        if matches and (best is None or len(stem) > len(best.stem.split("-")[0])):
+            best = asf
     if best is None:
         raise FileNotFoundError(f"no skeleton (.asf) for {amc} in {amc.parent}")
     return best
@@ -45,7 +52,7 @@ def _layout(skeleton: Skeleton, joints) -> tuple[list[bytes], list[int], list[in
     )
 
 
-def _split_header(data: bytes) -> tuple[list[tuple[int, str]], int, int]:
+def _split_header(data: Text) -> tuple[list[tuple[int, str]], int, int]:
     """(line number, text) of the header lines (comments and ':' keywords),
     the byte offset of the body and the number of lines before it."""
     header, pos, lines = [], 0, 0
@@ -95,7 +102,7 @@ def read_amc(
 
 
 def _read_header(
-    data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None
+    data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | None
 ) -> tuple[list[tuple[int, str]], int, int, float]:
     """The header lines as :func:`_split_header` gives them, where the frames
     begin, the lines before them, and the frame rate (the header's, else
@@ -111,7 +118,7 @@ def _read_header(
     return header, body, header_lines, rate or frame_rate or DEFAULT_FRAME_RATE
 
 
-def _read(data: bytes, name: str | None, skeleton: Skeleton, frame_rate: float | None, workers: int | None) -> Motion:
+def _read(data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | None, workers: int | None) -> Motion:
     header, body, header_lines, rate = _read_header(data, name, skeleton, frame_rate)
     joints = skeleton.joint_names
     keys, offsets, counts = _layout(skeleton, joints)
@@ -140,18 +147,15 @@ def _check_angle_unit(header: list[tuple[int, str]], skeleton: Skeleton) -> None
             raise FormatError(f"the AMC says {word} but its skeleton's angles are in {skeleton.angle_unit}", number)
 
 
-_NEXT_FRAME_LINE = re.compile(rb"[\r\n][ \t]*\d+[ \t]*(?=[\r\n]|$)")
-
-
-def _first_frame_order(data: bytes, body: int, joints: set[str]) -> tuple[str, ...]:
+def _first_frame_order(data: Text, body: int, joints: set[str]) -> tuple[str, ...]:
     """The bone lines of the first frame, in order."""
-    following = _NEXT_FRAME_LINE.search(data, body + 1)
-    block = data[body : following.start() if following else len(data)]
+    following = frame_line(data, body + 1)
+    block = decode(data[body : following if following != -1 else len(data)])
     order = []
-    for line in re.split(rb"\r\n|\r|\n", block)[1:]:
+    for line in LINE_BREAK.split(block)[1:]:
         words = line.split(None, 1)
-        if words and not words[0].startswith(b"#"):
-            name = decode(words[0])
+        if words and not words[0].startswith("#"):
+            name = words[0]
             if name in joints:
                 order.append(name)
     return tuple(order)
@@ -165,10 +169,90 @@ def write_amc(motion: Motion, target: Source) -> None:
     has one, else the root and the bones with dofs in skeleton order.  Every
     number is the shortest text that reads back to exactly the same float64.
     """
+    with amc_writer(motion, target) as write:
+        write(motion.values, motion.first_frame)
+
+
+@contextlib.contextmanager
+def amc_writer(motion: Motion, target: Source) -> Iterator[Callable[[np.ndarray, int], None]]:
+    """A function ``write(values, first_frame)`` that appends frames to an AMC with the header,
+    line order and skeleton of ``motion`` (its values are not written): :func:`write_amc` a
+    piece at a time.  A path is replaced only when the block ends without an error."""
     keys, offsets, counts = _layout(motion.skeleton, _write_order(motion.skeleton, motion.line_order))
     with output(target) as f:
         f.write(encode("".join(line + "\n" for line in _header_lines(motion))))
-        format_frames(motion.values, motion.first_frame, keys, offsets, counts, f.write)
+        yield lambda values, first: format_frames(values, first, keys, offsets, counts, f.write)
+
+
+@dataclass(frozen=True)
+class AmcStream:
+    """An AMC take read a piece at a time, for takes too large for memory (see :func:`open_amc`).
+
+    ``motion`` holds everything but the frames (skeleton, rate, header, line
+    order; no values); :meth:`pieces` reads the frames from the start each time
+    it is called.
+    """
+
+    path: str
+    motion: Motion
+    body: int  # offset of the first frame line
+    header_lines: int
+    read_bytes: int = READ_BYTES
+
+    def pieces(self) -> Iterator[np.ndarray]:
+        """The frames, a piece of about ``read_bytes`` of text at a time, checked to be consecutive."""
+        skeleton = self.motion.skeleton
+        keys, offsets, counts = _layout(skeleton, skeleton.joint_names)
+        pending, lines_done, expected = b"", self.header_lines, None
+        with open(self.path, "rb") as f:
+            f.seek(self.body)
+            while True:
+                more = f.read(self.read_bytes)
+                text = pending + more
+                # whole frames only: cut at the last frame line of the text (not at its very start)
+                cut = frame_line(text, 1, len(text), last=True) if more else len(text)
+                if cut <= 0:
+                    pending = text
+                    continue
+                piece, pending = text[:cut], text[cut:]
+                try:
+                    values, first = scan_frames(
+                        piece, keys, offsets, counts, len(skeleton.channels), noun="bone", workers=1
+                    )
+                except FormatError as e:
+                    raise e.at(self.path, lines_done) from None
+                if len(values):
+                    if expected is not None and first != expected:
+                        raise SequenceError(
+                            f"frame number {first} out of sequence: expected {expected}", lines_done + 1, self.path
+                        )
+                    expected = first + len(values)
+                    yield values
+                lines_done += line_breaks(piece)
+                if not more:
+                    return
+
+
+def open_amc(
+    path: str | os.PathLike, skeleton: Skeleton, frame_rate: float | None = None, *, read_bytes: int = READ_BYTES
+) -> AmcStream:
+    """An AMC take to read a piece at a time (:class:`AmcStream`); the header is read and checked
+    now, as :func:`read_amc` does, and the first frame's number and bone order from the first piece."""
+    with open(path, "rb") as f:
+        head = f.read(read_bytes)
+    name = os.fspath(path)
+    header, body, header_lines, rate = _read_header(head, name, skeleton, frame_rate)
+    start = frame_line(head, body)
+    first = int(LINE_BREAK.split(decode(head[start:]), 1)[0]) if start != -1 else 1
+    motion = Motion(
+        skeleton,
+        np.zeros((0, len(skeleton.channels))),
+        rate,
+        first,
+        tuple(text for _, text in header),
+        _first_frame_order(head, body, set(skeleton.joint_names)),
+    )
+    return AmcStream(name, motion, body, header_lines, read_bytes)
 
 
 def _write_order(skeleton: Skeleton, line_order: tuple[str, ...] | None) -> list[str]:

@@ -7,8 +7,8 @@ import re
 from mtcore import format_number
 from mtcore.errors import CountError, DuplicateError, FormatError, MissingError, NumberError, TruncatedError
 
-from . import __version__
 from ._io import LINE_BREAK, Source, decode, encode, output, read_source
+from ._version import __version__
 from .skeleton import BONE_DOFS, ROOT_DOFS, Bone, Root, Skeleton, canonical_hierarchy, name_problem
 
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|infinity|nan)", re.IGNORECASE)

@@ -1,76 +1,52 @@
 """Batch processing of capture databases: many takes, all cores or a Dask cluster, bounded memory.
 
-A recipe (a filter, for now) is applied to every AMC found under the inputs
-(files, folders searched recursively, globs); results go to an output folder
-that mirrors the input tree, each written to a temporary name and renamed
-when complete.  A take larger than a threshold is streamed in chunks of
-frames, so memory does not grow with its length, to the same bytes as
-processing it whole.
+A pipeline of steps (a recipe; ``motiontheater steps`` lists them) is
+applied to every AMC and BVH take found under the inputs (files, folders
+searched recursively, globs); results go to an output folder that mirrors
+the input tree, each written to a temporary name and renamed when complete.
+A take larger than a threshold is streamed in chunks of frames when its
+pipeline allows (:mod:`motiontheater.streaming`), so memory does not grow
+with its length, to the same bytes as processing it whole.  This module
+keeps jobs, pools, progress and reports; formats and steps live elsewhere.
 """
 
 from __future__ import annotations
 
 import functools
 import glob
-import itertools
 import json
 import os
 import shutil
 import signal
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
-import numpy as np
-
-from mtcore import format_frames, scan_frames
-from mtcore.errors import FormatError, SequenceError
-
-from ._io import PARTIAL_PREFIX, encode, output
-from .amc import (
-    _first_frame_order,
-    _header_lines,
-    _layout,
-    _read_header,
-    _write_order,
-    read_amc,
-    skeleton_path_for,
-    write_amc,
-)
-from .asf import read_asf
-from .bvh import read_bvh, write_bvh
-from .filtering import Smoother, TakeStats
+from ._io import PARTIAL_PREFIX, output
+from .amc import read_amc
+from .asf import read_asf, write_asf
+from .bvh import read_bvh
+from .errors import FormatError
+from .formats import TAKE_SUFFIXES, skeleton_for, write_take
 from .motion import Motion
+from .pipeline import Pipeline
+from .streaming import CHUNK_FRAMES, stream, streamable
 
-STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed
-CHUNK_FRAMES = 1 << 15  # frames per streamed chunk (a multiple of the filters' block length)
-READ_BYTES = 8 << 20
-
-
-@dataclass(frozen=True)
-class Recipe:
-    """What to do to every take: a filter as ``motiontheater filter`` takes it."""
-
-    kind: str
-    size: int
-    joints: tuple[str, ...] | None = None
-    translation: bool = True
-    mode: str = "nearest"
-
-    def smoother(self, skeleton, workers: int | None = 1) -> Smoother:
-        return Smoother(
-            skeleton, self.kind, self.size, self.joints, translation=self.translation, mode=self.mode, workers=workers
-        )
+STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed (when its pipeline allows)
+SUFFIXES = {"asf": ".amc", "bvh": ".bvh"}  # what a motion of each skeleton convention is written as
 
 
 @dataclass(frozen=True)
 class Job:
+    """One take to process: where it is, where its result goes (its suffix decided when written)."""
+
     input: str
     output: str
-    skeleton: str
-    recipe: Recipe
+    skeleton: str  # the AMC's ASF; "" for a BVH
+    pipeline: Pipeline
     frame_rate: float | None = None
     stream_above: int = STREAM_ABOVE
     chunk_frames: int = CHUNK_FRAMES
@@ -78,6 +54,8 @@ class Job:
 
 @dataclass
 class Result:
+    """What became of one take: where it went, whether it worked, and what it cost."""
+
     input: str
     output: str
     ok: bool = True
@@ -87,9 +65,6 @@ class Result:
     bytes: int = 0
     frames: int = 0
     seconds: float = 0.0
-
-
-TAKES = (".amc", ".bvh")
 
 
 def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
@@ -102,11 +77,11 @@ def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
             prefix = item[:wild]
             base = Path(prefix) if prefix.endswith(os.sep) else Path(prefix).parent
             for match in sorted(glob.glob(item, recursive=True)):
-                if match.lower().endswith(TAKES):
+                if match.lower().endswith(TAKE_SUFFIXES):
                     found.setdefault(Path(match), Path(match).relative_to(base))
         elif os.path.isdir(item):
             for path in sorted(Path(item).rglob("*")):
-                if path.suffix.lower() in TAKES and path.is_file():
+                if path.suffix.lower() in TAKE_SUFFIXES and path.is_file():
                     found.setdefault(path, path.relative_to(item))
         elif os.path.isfile(item):
             found.setdefault(Path(item), Path(Path(item).name))
@@ -118,7 +93,7 @@ def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
 def plan_jobs(
     inputs: Iterable[str],
     out: str | os.PathLike,
-    recipe: Recipe,
+    pipeline: Pipeline,
     *,
     skeleton: str | None = None,
     frame_rate: float | None = None,
@@ -131,7 +106,7 @@ def plan_jobs(
     for take, relative in find_takes(inputs):
         target = Path(out) / relative
         try:
-            asf = None if take.suffix.lower() == ".bvh" else Path(skeleton) if skeleton else skeleton_path_for(take)
+            asf = None if take.suffix.lower() == ".bvh" else skeleton_for(take, skeleton)
         except FileNotFoundError as e:
             settled.append(Result(str(take), str(target), ok=False, error=str(e)))
             continue
@@ -139,9 +114,8 @@ def plan_jobs(
         if resume and target.exists() and target.stat().st_mtime >= inputs_time:
             settled.append(Result(str(take), str(target), skipped=True, bytes=take.stat().st_size))
             continue
-        jobs.append(
-            Job(str(take), str(target), str(asf) if asf else "", recipe, frame_rate, stream_above, chunk_frames)
-        )
+        job = Job(str(take), str(target), str(asf) if asf else "", pipeline, frame_rate, stream_above, chunk_frames)
+        jobs.append(job)
     return jobs, settled
 
 
@@ -151,20 +125,16 @@ def run_job(job: Job) -> Result:
     result = Result(job.input, job.output, bytes=os.path.getsize(job.input))
     try:
         os.makedirs(os.path.dirname(job.output) or ".", exist_ok=True)
-        if not job.skeleton:  # a BVH take holds its skeleton
-            motion = read_bvh(job.input)
-            write_bvh(_smooth(motion, job.recipe), job.output)
-            result.frames = motion.frames
-            result.seconds = time.perf_counter() - start
-            return result
-        skeleton = _skeleton(job.skeleton, *_stamp(job.skeleton))
-        _copy_skeleton(job.skeleton, os.path.dirname(job.output))
-        if result.bytes > job.stream_above:
-            result.frames = stream_filter(job.input, job.output, skeleton, job.recipe, job.frame_rate, job.chunk_frames)
+        if job.skeleton and result.bytes > job.stream_above and streamable(job.pipeline):
+            skeleton = _skeleton(job.skeleton, *_stamp(job.skeleton))
+            _copy_skeleton(job.skeleton, os.path.dirname(job.output))
+            result.frames = stream(
+                job.input, job.output, skeleton, job.pipeline, job.frame_rate, chunk_frames=job.chunk_frames
+            )
             result.streamed = True
         else:
-            motion = read_amc(job.input, skeleton, job.frame_rate, workers=1)
-            write_amc(_smooth(motion, job.recipe), job.output)
+            motion = _read(job)
+            result.output = _write(job, job.pipeline.apply(motion), motion)
             result.frames = motion.frames
     except (FormatError, ValueError, OSError) as e:
         result.ok, result.error = False, str(e)
@@ -172,10 +142,30 @@ def run_job(job: Job) -> Result:
     return result
 
 
-def _smooth(motion: Motion, recipe: Recipe) -> Motion:
-    return motion.filter(
-        recipe.kind, recipe.size, recipe.joints, translation=recipe.translation, mode=recipe.mode, workers=1
-    )
+def _read(job: Job) -> Motion:
+    if not job.skeleton:
+        return read_bvh(job.input)
+    return read_amc(job.input, _skeleton(job.skeleton, *_stamp(job.skeleton)), job.frame_rate, workers=1)
+
+
+def _write(job: Job, result: Motion, motion: Motion) -> str:
+    """Write a take's result where the job says (an exporter's suffix, or its format's); returns the path."""
+    stem = os.path.splitext(job.output)[0]
+    exporter = job.pipeline.exporter
+    if exporter is not None:
+        chosen = dict(exporter.options).get("format")
+        target = stem + (f".{chosen}" if chosen else exporter.step.suffixes[0])
+        job.pipeline.write(result, target)
+        return target
+    target = stem + SUFFIXES[result.skeleton.convention]
+    folder = os.path.dirname(target)
+    if result.skeleton.convention == "asf":
+        if result.skeleton is motion.skeleton and job.skeleton:
+            _copy_skeleton(job.skeleton, folder)
+        else:
+            write_asf(result.skeleton, stem + ".asf")
+    write_take(result, target)
+    return target
 
 
 def _stamp(path: str) -> tuple[int, int]:
@@ -184,7 +174,7 @@ def _stamp(path: str) -> tuple[int, int]:
 
 
 @functools.lru_cache(maxsize=256)
-def _skeleton(path: str, mtime_ns: int, size: int):
+def _skeleton(path: str, mtime_ns: int, size: int) -> Any:
     """A worker reads each skeleton once (a database has a few, and thousands of takes);
     a changed file has a new stamp and is read again."""
     return read_asf(path)
@@ -198,136 +188,6 @@ def _copy_skeleton(asf: str, folder: str) -> None:
             shutil.copyfileobj(src, dst)
 
 
-def _frames_of(path: str, skeleton, keys, offsets, counts, frame_rate):
-    """(header, line order, rate) and an iterator of (first frame number, values) pieces of a take,
-    read READ_BYTES at a time and cut at frame lines."""
-    with open(path, "rb") as f:
-        head = f.read(READ_BYTES)
-    header, body, header_lines, rate = _read_header(head, path, skeleton, frame_rate)
-    order = _first_frame_order(head, body, set(skeleton.joint_names))
-
-    def pieces():
-        """Each call reads the take again from its first frame."""
-        pending, lines_done = b"", header_lines
-        with open(path, "rb") as f:
-            f.seek(body)
-            while True:
-                more = f.read(READ_BYTES)
-                text = pending + more
-                if more:
-                    cut = max(text.rfind(b"\n", 0, len(text) - 1), text.rfind(b"\r", 0, len(text) - 1))
-                    # back to the start of the last frame line, so that no frame is split
-                    cut = _last_frame_start(text, cut)
-                    if cut <= 0:
-                        pending = text
-                        continue
-                    piece, pending = text[:cut], text[cut:]
-                else:
-                    piece, pending = text, b""
-                try:
-                    values, first = scan_frames(
-                        piece, keys, offsets, counts, len(skeleton.channels), noun="bone", workers=1
-                    )
-                except FormatError as e:
-                    raise e.at(path, lines_done) from None
-                if len(values):
-                    yield first, values, lines_done
-                lines_done += piece.count(b"\n") + piece.count(b"\r") - piece.count(b"\r\n")
-                if not more:
-                    return
-
-    return header, order, rate, pieces
-
-
-def _last_frame_start(text: bytes, limit: int) -> int:
-    """The offset of the last line, before ``limit``, that holds only a frame number, or 0."""
-    end = limit
-    while end > 0:
-        start = max(text.rfind(b"\n", 0, end), text.rfind(b"\r", 0, end)) + 1
-        if text[start:end].strip().isdigit():
-            return start
-        end = start - 1
-    return 0
-
-
-def stream_filter(
-    path: str, target: str, skeleton, recipe: Recipe, frame_rate: float | None = None, chunk_frames: int = CHUNK_FRAMES
-) -> int:
-    """Filter a take of any length in chunks of frames; the same bytes as filtering it whole.
-
-    Two passes over the file: the first gathers what smoothing needs of the
-    whole take (channel ranges, first frame), the second unwraps, smooths
-    and writes chunk by chunk, each smoothed with a halo of neighbouring
-    frames and aligned to the filters' blocks.  Returns the frame count.
-    """
-    smoother = recipe.smoother(skeleton)
-    keys, offsets, counts = _layout(skeleton, skeleton.joint_names)
-    header, order, rate, pieces = _frames_of(path, skeleton, keys, offsets, counts, frame_rate)
-    stats, frames, first_frame = None, 0, None
-    for first, values, lines in pieces():
-        if first_frame is None:
-            first_frame = first
-        elif first != first_frame + frames:
-            raise SequenceError(
-                f"frame number {first} out of sequence: expected {first_frame + frames}", lines + 1, path
-            )
-        if stats is None:
-            stats = TakeStats.of(values)
-        else:
-            stats.update(values)
-        frames += len(values)
-    header_motion = Motion(
-        skeleton,
-        np.zeros((0, len(skeleton.channels))),
-        rate,
-        first_frame or 1,
-        tuple(text for _, text in header),
-        order,
-    )
-    write_keys, write_offsets, write_counts = _layout(skeleton, _write_order(skeleton, order))
-    block = smoother.block
-    chunk = max(block, chunk_frames // block * block)
-    lead = -(-smoother.halo // block) * block  # frames before a chunk: the halo, rounded up to a block
-
-    with output(target) as f:
-        f.write(encode("".join(line + "\n" for line in _header_lines(header_motion))))
-        if not frames:
-            return 0
-        unwrapped = _unwrapped_chunks(pieces, smoother, chunk)
-        tail = np.zeros((0, len(skeleton.channels)))  # unwrapped frames before the current chunk
-        current = next(unwrapped)
-        start = 0
-        for following in itertools.chain(unwrapped, [None]):  # one chunk of lookahead, no more
-            after = following[: smoother.halo] if following is not None else tail[:0]
-            buffer = np.concatenate([tail[len(tail) - min(lead, start) :], current, after])
-            before = min(lead, start)
-            smoothed = smoother.smooth(buffer, stats)[before : before + len(current)]
-            format_frames(smoothed, first_frame + start, write_keys, write_offsets, write_counts, f.write)
-            tail = np.concatenate([tail, current])[-lead:] if lead else tail
-            start += len(current)
-            current = following
-            if current is None:
-                break
-    return frames
-
-
-def _unwrapped_chunks(pieces: Callable, smoother: Smoother, chunk: int):
-    """The take's frames, unwrapped, in chunks of exactly ``chunk`` frames (the last shorter)."""
-    previous, turns, pending = None, None, []
-    held = 0
-    for _, values, _ in pieces():
-        unwrapped, turns = smoother.unwrap(values, previous, turns)
-        previous = values[-1]
-        pending.append(unwrapped)
-        held += len(unwrapped)
-        while held >= chunk:
-            joined = np.concatenate(pending)
-            yield joined[:chunk]
-            pending, held = [joined[chunk:]], held - chunk
-    if held:
-        yield np.concatenate(pending)
-
-
 class Progress:
     """A one-line progress bar on stderr (files and MB, rate, ETA); silent unless stderr is a terminal."""
 
@@ -338,6 +198,7 @@ class Progress:
         self.enabled = sys.stderr.isatty() if enabled is None else enabled
 
     def advance(self, result: Result) -> None:
+        """Count a finished take and redraw the bar."""
         self.done_files += 1
         self.done_bytes += result.bytes
         if not self.enabled:
@@ -355,20 +216,25 @@ class Progress:
         sys.stderr.flush()
 
     def close(self) -> None:
+        """End the bar's line."""
         if self.enabled:
             sys.stderr.write("\n")
 
 
 @dataclass
 class Summary:
+    """Every take's result and the run's time: what the batch command reports."""
+
     results: list[Result] = field(default_factory=list)
     seconds: float = 0.0
 
     @property
     def failed(self) -> list[Result]:
+        """The takes that failed."""
         return [r for r in self.results if not r.ok]
 
     def as_dict(self) -> dict:
+        """The totals and failures, ready for JSON."""
         done = [r for r in self.results if r.ok and not r.skipped]
         processed = sum(r.bytes for r in done)
         return {
@@ -384,6 +250,7 @@ class Summary:
         }
 
     def text(self) -> str:
+        """The totals in a line, then a line per failure."""
         d = self.as_dict()
         lines = [
             f"{d['processed']} processed, {d['skipped']} skipped (already done), {d['failed']} failed "
@@ -487,6 +354,7 @@ def _run_dask(jobs: list[Job], workers: int, scheduler: str | None):
 
 
 def report_json(summary: Summary) -> str:
+    """The summary and every take's result as JSON text."""
     data = summary.as_dict()
     data["results"] = [asdict(r) for r in summary.results]
     return json.dumps(data, indent=2)

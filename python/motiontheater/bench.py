@@ -15,6 +15,7 @@ import json
 import math
 import time
 from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 
@@ -108,19 +109,19 @@ def measure(
     scene_rows = []
     for kind in KINDS:
         for size in sizes:
-            fresh = best_time(lambda: OURS[kind](scene, size, axis=0, mode="nearest"), repeat * 20)
+            fresh = best_time(partial(OURS[kind], scene, size, axis=0, mode="nearest"), repeat * 20)
             slow_repeat = max(1, repeat // 2)
             row = {
                 "filter": kind,
                 "size": size,
                 "mtcore": fresh,
-                "python": best_time(lambda: python_filter(kind, rows_of_scene, size), slow_repeat),
+                "python": best_time(partial(python_filter, kind, rows_of_scene, size), slow_repeat),
             }
             for name, peer in available.items():
                 row[name] = (
                     None
                     if peer is None or peer(kind, scene, size) is None
-                    else best_time(lambda: peer(kind, scene, size), repeat * 4)
+                    else best_time(partial(peer, kind, scene, size), repeat * 4)
                 )
             row["mel_2004"], row["cpp_2004"] = THESIS_2004[kind] if size == 3 else (None, None)
             scene_rows.append(row)
@@ -135,14 +136,14 @@ def measure(
             row = {
                 "filter": kind,
                 "size": size,
-                "mtcore": best_time(lambda: OURS[kind](hour, size, axis=0, mode="nearest"), repeat),
-                "mtcore_output": best_time(lambda: OURS[kind](hour, size, 0, out, mode="nearest"), repeat),
+                "mtcore": best_time(partial(OURS[kind], hour, size, axis=0, mode="nearest"), repeat),
+                "mtcore_output": best_time(partial(OURS[kind], hour, size, 0, out, mode="nearest"), repeat),
             }
             for name, peer in available.items():
                 row[name] = (
                     None
                     if peer is None or peer(kind, hour[:10], size) is None
-                    else best_time(lambda: peer(kind, hour, size), max(2, repeat // 2))
+                    else best_time(partial(peer, kind, hour, size), max(2, repeat // 2))
                 )
             hour_rows.append(row)
     return {
@@ -165,6 +166,7 @@ def _x(numerator: float | None, denominator: float | None) -> str:
 
 
 def markdown(report: dict) -> str:
+    """The report of :func:`measure` as Markdown tables, the thesis's table first."""
     scene, hour = report["scene"], report["hour"]
     frames, channels = scene["shape"]
     lines = [
@@ -206,4 +208,5 @@ def markdown(report: dict) -> str:
 
 
 def as_json(report: dict) -> str:
+    """The report of :func:`measure` as JSON text."""
     return json.dumps(report, indent=2)

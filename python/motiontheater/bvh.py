@@ -11,6 +11,7 @@ Blender and MotionBuilder read them.
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -89,13 +90,24 @@ def _read(data) -> Motion:
     )
 
 
+@dataclass
+class _Open:
+    """A joint (or End Site) whose block is being read."""
+
+    name: str
+    line: int
+    offset: tuple[float, float, float] | None = None
+    channels: tuple[str, ...] = ()
+    end: bool = False
+
+
 def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
     if not lines or lines[0][1].upper() != "HIERARCHY":
         raise FormatError("expected HIERARCHY", lines[0][0] if lines else 1)
     bones: list[Bone] = []
     pairs: list[tuple[str, tuple[str, ...]]] = []
     root = None
-    stack: list[dict] = []  # the open joints, innermost last
+    stack: list[_Open] = []  # the open joints, innermost last
     pos = 1
     while pos < len(lines):
         number, text = lines[pos]
@@ -107,29 +119,30 @@ def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
                 raise FormatError("a second ROOT, or ROOT inside a joint", number)
             if key == "JOINT" and not stack:
                 raise FormatError("JOINT outside the ROOT", number)
-            joint = {"name": rest.strip(), "line": number, "offset": None, "channels": (), "end": False}
-            if not joint["name"]:
+            joint = _Open(rest.strip(), number)
+            if not joint.name:
                 raise FormatError(f"{key} needs a name", number)
-            if key == "JOINT" and (problem := name_problem(joint["name"], "bvh")):
+            if key == "JOINT" and (problem := name_problem(joint.name, "bvh")):
                 raise FormatError(problem, number)
             pos = _expect_brace(lines, pos, number)
             if stack:
-                pairs.append((stack[-1]["name"] if len(stack) > 1 else "root", (joint["name"],)))
+                pairs.append((stack[-1].name if len(stack) > 1 else "root", (joint.name,)))
             stack.append(joint)
         elif key == "END":
             if not stack:
                 raise FormatError("End Site outside a joint", number)
-            parent = stack[-1]["name"]
-            joint = {"name": f"{parent}_End", "line": number, "offset": None, "channels": (), "end": True}
+            parent = stack[-1].name
+            joint = _Open(f"{parent}_End", number, end=True)
             pos = _expect_brace(lines, pos, number)
-            pairs.append((parent if len(stack) > 1 else "root", (joint["name"],)))
+            pairs.append((parent if len(stack) > 1 else "root", (joint.name,)))
             stack.append(joint)
         elif key == "OFFSET":
             if not stack:
                 raise FormatError("OFFSET outside a joint", number)
-            stack[-1]["offset"] = _numbers(rest.split(), 3, number, "OFFSET")
+            x, y, z = _numbers(rest.split(), 3, number, "OFFSET")
+            stack[-1].offset = (x, y, z)
         elif key == "CHANNELS":
-            if not stack or stack[-1]["end"]:
+            if not stack or stack[-1].end:
                 raise FormatError("CHANNELS outside a joint", number)
             words = rest.split()
             try:
@@ -146,29 +159,29 @@ def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
                     "Xposition Yposition Zposition Xrotation Yrotation Zrotation",
                     number,
                 )
-            stack[-1]["channels"] = tuple(CHANNELS[n.lower()] for n in names)
+            stack[-1].channels = tuple(CHANNELS[n.lower()] for n in names)
         elif key == "}":
             if not stack:
                 raise FormatError("'}' closes nothing", number)
             joint = stack.pop()
-            if joint["offset"] is None:
-                raise MissingError(f"joint '{joint['name']}' has no OFFSET", joint["line"])
+            if joint.offset is None:
+                raise MissingError(f"joint '{joint.name}' has no OFFSET", joint.line)
             if not stack:
-                root = Root(order=joint["channels"], axis="XYZ", position=joint["offset"], name=joint["name"])
+                root = Root(order=joint.channels, axis="XYZ", position=joint.offset, name=joint.name)
             else:
                 bones.append(
                     Bone(
-                        name=joint["name"],
-                        direction=joint["offset"],
-                        length=float(np.linalg.norm(joint["offset"])),
-                        dofs=joint["channels"],
-                        end_site=joint["end"],
+                        name=joint.name,
+                        direction=joint.offset,
+                        length=float(np.linalg.norm(joint.offset)),
+                        dofs=joint.channels,
+                        end_site=joint.end,
                     )
                 )
         else:
             raise FormatError(f"expected ROOT, JOINT, End Site, OFFSET, CHANNELS or '}}', found '{text[:40]}'", number)
     if stack:
-        raise TruncatedError(f"joint '{stack[-1]['name']}' is not closed with '}}' before MOTION", lines[-1][0])
+        raise TruncatedError(f"joint '{stack[-1].name}' is not closed with '}}' before MOTION", lines[-1][0])
     if root is None:
         raise MissingError("no ROOT in the HIERARCHY", lines[0][0])
     # bones were appended as their blocks closed; the file's order is the order they opened

@@ -1,4 +1,9 @@
-"""The ``motiontheater`` command line."""
+"""The ``motiontheater`` command line.
+
+Every registered step (see :mod:`motiontheater.registry`) is a verb of its
+own, built here from its options; the other verbs (demo, steps, filter,
+apply, batch, combine, bench) are written out below.
+"""
 
 from __future__ import annotations
 
@@ -7,17 +12,35 @@ import os
 import sys
 import time
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
 import mtcore
 
-from . import __version__
-from .amc import read_amc, skeleton_path_for, write_amc
-from .asf import read_asf, write_asf
+from ._version import __version__
+from .asf import write_asf
 from .examples import noisy_rotations
-from .export import FORMATS, write_positions
 from .filtering import FILTERS
+from .formats import read_take, take_suffix, write_take
+from .motion import Motion
+from .pipeline import Pipeline
+from .registry import Option, Step, lookup, steps
+
+RECIPE_HELP = """\
+A recipe is a TOML file of [[step]] tables, applied in order; each names a step
+with run = "..." and gives its options (motiontheater steps lists them);
+frames = [A, B] confines a step to frames A..B:
+
+  [[step]]
+  run = "median"
+  size = 5
+
+  [[step]]
+  run = "slerp"
+  frames = [100, 150]
+  joints = ["lfemur", "rfemur"]
+"""
 
 
 def _demo(args: argparse.Namespace) -> int:
@@ -49,59 +72,148 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
-def _positions(args: argparse.Namespace) -> int:
-    motion = read_amc(args.motion, read_asf(args.skeleton), frame_rate=args.frame_rate)
-    written = write_positions(motion, args.output, meters=args.meters, format=args.format)
-    unit = "metres" if args.meters else "file units"
-    print(
-        f"wrote {motion.frames} frames x {len(motion.skeleton.joint_names)} joints ({unit}, {written}) to {args.output}"
-    )
+def _take_options(parser: argparse.ArgumentParser) -> None:
+    """How a take is read: the flags every verb that reads AMC takes shares."""
+    parser.add_argument("--asf", help="the AMC's skeleton (default: the ASF beside it, by the CMU/HDM05 naming)")
+    parser.add_argument("--frame-rate", type=float, metavar="HZ", help="frames per second when the AMC does not say")
+
+
+def _output_options(parser: argparse.ArgumentParser, what: str) -> None:
+    parser.add_argument("output_file", nargs="?", metavar="OUT", help=f"{what} (or give it with -o)")
+    parser.add_argument("-o", "--output", help=f"{what}")
+
+
+def _inputs(args: argparse.Namespace) -> tuple[str, str | None]:
+    """(take, skeleton): the older form ``verb SKELETON.asf TAKE.amc`` is read too."""
+    take, asf = args.input, args.asf
+    if take.lower().endswith(".asf") and args.output_file and args.output_file.lower().endswith(".amc"):
+        take, asf, args.output_file = args.output_file, take, None
+    return take, asf
+
+
+def _output(args: argparse.Namespace) -> str:
+    chosen = [o for o in (args.output_file, args.output) if o]
+    if len(chosen) != 1:
+        raise ValueError("give the output file once: as the second argument or with -o OUT")
+    return chosen[0]
+
+
+def _write(motion: Motion, result: Motion, source: str, target: str) -> str:
+    """Write a step's result as its suffix says; an AMC of a new skeleton gets its ASF beside it.
+    Returns what was written, in words."""
+    if os.path.exists(target) and os.path.samefile(source, target):
+        raise ValueError(f"{target} is the input: write the result to another file")
+    write_take(result, target)
+    if result.skeleton.convention == "asf" and result.skeleton is not motion.skeleton:
+        skeleton = os.path.splitext(target)[0] + ".asf"
+        write_asf(result.skeleton, skeleton)
+        return f"{target} and its skeleton {skeleton}"
+    return target
+
+
+def _run_step(args: argparse.Namespace) -> int:
+    step = lookup(args.step)
+    options = {o.name: getattr(args, o.name) for o in step.all_options if getattr(args, o.name) is not None}
+    source, asf = _inputs(args)
+    target = _output(args)
+    if not step.is_exporter:
+        take_suffix(target)
+    motion = read_take(source, asf, args.frame_rate)
+    if step.is_exporter:
+        step(motion, target, **options)
+        print(f"{step.name}: wrote {motion.frames} frames of {source} to {target}")
+        return 0
+    result = step(motion, **options)
+    written = _write(motion, result, source, target)
+    print(f"{step.name}: {motion.frames} frames of {source} -> {result.frames} frames in {written}")
     return 0
 
 
-def _chosen_filter(args: argparse.Namespace) -> tuple[str, int]:
+def _apply(args: argparse.Namespace) -> int:
+    pipeline = Pipeline.read(args.recipe)
+    source, asf = _inputs(args)
+    target = _output(args)
+    if pipeline.exporter is None:
+        take_suffix(target)
+    motion = read_take(source, asf, args.frame_rate)
+    result = pipeline.apply(motion)
+    if pipeline.exporter is not None:
+        pipeline.write(result, target)
+        written = target
+    else:
+        written = _write(motion, result, source, target)
+    names = ", ".join(entry.name for entry in pipeline.entries) or "no steps"
+    print(f"{args.recipe} ({names}) on {motion.frames} frames of {source}: wrote {written}")
+    return 0
+
+
+def _filter(args: argparse.Namespace) -> int:
+    pipeline = _filter_pipeline(args)
+    source, asf = _inputs(args)
+    target = _output(args)
+    take_suffix(target)
+    motion = read_take(source, asf, args.frame_rate)
+    written = _write(motion, pipeline.apply(motion), source, target)
+    entry = pipeline.entries[0]
+    which = ", ".join(args.joints) if args.joints else "all joints"
+    print(f"{entry.name} {dict(entry.options)['size']} over {motion.frames} frames of {which}: wrote {written}")
+    return 0
+
+
+def _filter_pipeline(args: argparse.Namespace) -> Pipeline:
     chosen = [(kind, getattr(args, kind)) for kind in FILTERS if getattr(args, kind) is not None]
     if len(chosen) != 1:
         raise ValueError("give exactly one of --median N, --mean N, --binomial N")
-    return chosen[0]
+    kind, size = chosen[0]
+    return Pipeline.of(kind, size=size, joints=args.joints, translation=not args.no_translation, mode=args.mode)
 
 
 def _filter_options(parser: argparse.ArgumentParser) -> None:
     """The filter flags shared by filter and batch."""
-    for kind, what in (
-        ("median", "moving median"),
-        ("mean", "moving average"),
-        ("binomial", "Pascal-weighted average (1 2 1 / 4 for 3)"),
-    ):
-        parser.add_argument(f"--{kind}", type=int, metavar="N", help=f"{what} over N frames (odd)")
-    parser.add_argument("--asf", help="the skeleton (default: the ASF beside each take, by the CMU/HDM05 naming)")
-    parser.add_argument("--joints", help="comma-separated joints to smooth (default: all)")
+    for kind in FILTERS:
+        parser.add_argument(f"--{kind}", type=int, metavar="N", help=f"{lookup(kind).summary} over N frames")
+    names = Option("joints", "names", None, "")
+    parser.add_argument("--joints", type=names.parse, help="comma-separated joints to smooth (default: all)")
     parser.add_argument("--no-translation", action="store_true", help="leave the root's translation alone")
-    parser.add_argument("--mode", default="nearest", help="edge mode: nearest, reflect, mirror, wrap, constant")
-    parser.add_argument("--frame-rate", type=float, help="frames per second when the AMC does not say")
+    parser.add_argument(
+        "--mode",
+        default="nearest",
+        choices=("nearest", "reflect", "mirror", "constant", "wrap"),
+        help="how the edges are extended (default: nearest, the edge value held)",
+    )
+
+
+def _steps(args: argparse.Namespace) -> int:
+    for name, step in steps().items():
+        kind = f"exporter ({', '.join(step.suffixes)})" if step.is_exporter else "step"
+        print(f"{name}: {step.summary} [{kind}]")
+        for option in step.all_options:
+            default = "required" if option.required else f"default {option.default!r}"
+            choices = f" ({', '.join(map(str, option.choices))})" if option.choices else ""
+            print(f"    {option.name}: {option.help}{choices}; {default}")
+    return 0
 
 
 def _batch(args: argparse.Namespace) -> int:
-    from . import batch
+    from .batch import Progress, plan_jobs, report_json, run
 
-    kind, size = _chosen_filter(args)
-    recipe = batch.Recipe(
-        kind, size, tuple(args.joints.split(",")) if args.joints else None, not args.no_translation, args.mode
-    )
-    recipe.smoother(read_asf(args.asf)) if args.asf else None  # bad joints fail before any work
-    jobs, settled = batch.plan_jobs(
+    has_filter = any(getattr(args, kind) is not None for kind in FILTERS)
+    if bool(args.recipe) == has_filter:
+        raise ValueError("give a recipe (--recipe FILE) or one filter (--median N, --mean N or --binomial N)")
+    pipeline = Pipeline.read(args.recipe) if args.recipe else _filter_pipeline(args)
+    jobs, settled = plan_jobs(
         args.inputs,
         args.output,
-        recipe,
+        pipeline,
         skeleton=args.asf,
         frame_rate=args.frame_rate,
         resume=args.resume,
         stream_above=int(args.stream_above * 1e6),
     )
-    progress = batch.Progress(
+    progress = Progress(
         len(jobs), sum(os.path.getsize(j.input) for j in jobs), enabled=False if args.quiet or args.json else None
     )
-    summary = batch.run(
+    summary = run(
         jobs,
         settled,
         workers=args.jobs,
@@ -111,65 +223,22 @@ def _batch(args: argparse.Namespace) -> int:
         out=args.output,
     )
     if args.json:
-        print(batch.report_json(summary))
+        print(report_json(summary))
     elif not args.quiet or summary.failed:
         print(summary.text(), file=sys.stderr if summary.failed else sys.stdout)
     return 1 if summary.failed else 0
 
 
-def _read_any(path: str, asf: str | None, frame_rate: float | None):
-    from .bvh import read_bvh
-
-    if path.lower().endswith(".bvh"):
-        return read_bvh(path)
-    return read_amc(path, read_asf(asf or skeleton_path_for(path)), frame_rate=frame_rate)
-
-
-def _convert(args: argparse.Namespace) -> int:
-    from .bvh import write_bvh
-    from .convert import to_asf, to_bvh
-
-    motion = _read_any(args.input, args.asf, args.frame_rate)
-    out = args.output
-    if out.lower().endswith(".bvh"):
-        write_bvh(to_bvh(motion, args.order), out)
-        print(f"wrote {motion.frames} frames to {out}")
-    elif out.lower().endswith(".amc"):
-        converted = to_asf(motion)
-        skeleton_out = os.path.splitext(out)[0] + ".asf"
-        write_asf(converted.skeleton, skeleton_out)
-        write_amc(converted, out)
-        print(f"wrote {motion.frames} frames to {out} and its skeleton to {skeleton_out}")
-    else:
-        raise ValueError(f"the output must end in .bvh or .amc, got {out}")
-    return 0
-
-
-def _filter(args: argparse.Namespace) -> int:
-    from .bvh import write_bvh
-
-    kind, size = _chosen_filter(args)
-    motion = _read_any(args.input, args.asf, args.frame_rate)
-    joints = args.joints.split(",") if args.joints else None
-    smoothed = motion.filter(kind, size, joints, translation=not args.no_translation, mode=args.mode)
-    (write_bvh if motion.skeleton.convention == "bvh" else write_amc)(smoothed, args.output)
-    which = ", ".join(joints) if joints else "all joints"
-    print(f"{kind} {size} over {motion.frames} frames of {which}: wrote {args.output}")
-    return 0
-
-
 def _bench(args: argparse.Namespace) -> int:
-    from . import bench
+    from .bench import HOUR, as_json, markdown, measure, scene_from_take
 
     scene, source = None, "synthetic random-walk angles"
     if args.amc:
-        take = read_amc(args.amc, read_asf(args.asf or skeleton_path_for(args.amc)))
-        scene = bench.scene_from_take(take)
+        take = read_take(args.amc, args.asf)
+        scene = scene_from_take(take)
         source = f"first {scene.shape[0]} frames of {args.amc}, rotation channels"
-    report = bench.measure(
-        scene, source, hour_frames=bench.HOUR[0] // (20 if args.quick else 1), repeat=2 if args.quick else 5
-    )
-    print(bench.as_json(report) if args.json else bench.markdown(report))
+    report = measure(scene, source, hour_frames=HOUR[0] // (20 if args.quick else 1), repeat=2 if args.quick else 5)
+    print(as_json(report) if args.json else markdown(report))
     return 0
 
 
@@ -185,20 +254,66 @@ def _combine(args: argparse.Namespace) -> int:
     if not args.output:
         raise ValueError("give -o OUT.amc (or --dry-run)")
     result = scene.render()
-    write_amc(result, args.output)
+    write_take(result, args.output)
     print(
         f"{len(scene.tracks)} track(s) over {scene.base.frames} frames: wrote {result.frames} frames "
-        f"({result.first_frame}..{result.first_frame + result.frames - 1}) to {args.output}"
+        f"({result.first_frame}..{result.last_frame}) to {args.output}"
     )
     return 0
 
 
+def _step_verb(verbs: Any, step: Step) -> None:
+    """The verb of a registered step: ``motiontheater NAME TAKE -o OUT --option ...``."""
+    what = "the file to write (" + (", ".join(step.suffixes) if step.is_exporter else ".amc or .bvh") + ")"
+    required = " ".join(f"{o.flag} {o.metavar or o.name.upper()}" for o in step.all_options if o.required)
+    example = f"Example: motiontheater {step.name} 01_01.amc {required + ' ' if required else ''}-o out"
+    example += step.suffixes[0] if step.is_exporter else ".amc"
+    parser = verbs.add_parser(
+        step.name,
+        aliases=list(step.aliases),
+        help=step.summary,
+        description=f"{step.summary[:1].upper()}{step.summary[1:]}. {step.description}".strip(),
+        epilog=example,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    _output_options(parser, what)
+    _take_options(parser)
+    for option in step.all_options:
+        shown = option.required or option.default is None  # the help says what None means
+        help_text = option.help + ("" if shown else f" (default: {_shown(option.default)})")
+        if option.kind == "bool":
+            parser.add_argument(option.flag, dest=option.name, action=argparse.BooleanOptionalAction, help=help_text)
+        elif option.kind == "choice":
+            parser.add_argument(
+                option.flag, dest=option.name, type=option.parse, choices=option.choices, help=help_text
+            )
+        else:
+            parser.add_argument(
+                option.flag,
+                dest=option.name,
+                type=option.parse,
+                metavar=option.metavar,
+                required=option.required,
+                help=help_text,
+            )
+    parser.set_defaults(run=_run_step, step=step.name)
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    return str(value)
+
+
 def build_parser() -> argparse.ArgumentParser:
+    """The parser of every verb: those written here and one per registered step."""
     parser = argparse.ArgumentParser(
         prog="motiontheater",
         description=(
-            "Clean, cut, splice and smooth motion-capture data. "
-            "Run 'motiontheater demo' to smooth a built-in noisy 120 Hz capture."
+            "Clean, cut, splice and smooth motion-capture data (ASF/AMC and BVH). "
+            "Run 'motiontheater demo' to smooth a built-in noisy 120 Hz capture; "
+            "'motiontheater steps' lists every step and its options."
         ),
     )
     parser.add_argument("--version", action="version", version=f"motiontheater {__version__}")
@@ -217,23 +332,8 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--seed", type=int, default=0, help="random seed of the synthetic data")
     demo.set_defaults(run=_demo)
 
-    positions = verbs.add_parser(
-        "positions",
-        help="export the world position of every joint per frame (CSV, NPZ or TRC)",
-        description=(
-            "Compute every joint's world position per frame by forward kinematics (the root, then "
-            "each bone's end point) and write them as CSV (frame, time, joint.x/.y/.z columns), "
-            "NumPy .npz or TRC (OpenSim markers). Example: motiontheater positions 01.asf 01_01.amc "
-            "-o 01_01.trc --meters"
-        ),
-    )
-    positions.add_argument("skeleton", help="the ASF file")
-    positions.add_argument("motion", help="the AMC file")
-    positions.add_argument("-o", "--output", required=True, help="output file: .csv, .npz or .trc")
-    positions.add_argument("--format", choices=FORMATS, help="output format (default: from the suffix)")
-    positions.add_argument("--meters", action="store_true", help="lengths in metres (default: file units)")
-    positions.add_argument("--frame-rate", type=float, help="frames per second when the AMC does not say")
-    positions.set_defaults(run=_positions)
+    listing = verbs.add_parser("steps", help="list every step and exporter with its options")
+    listing.set_defaults(run=_steps)
 
     smooth = verbs.add_parser(
         "filter",
@@ -241,33 +341,53 @@ def build_parser() -> argparse.ArgumentParser:
         description=(
             "Smooth every channel (or the channels of the --joints given) over frames. Rotation "
             "channels are unwrapped first, so crossings of ±180 degrees stay small steps. Edges "
-            "hold their value unless --mode says otherwise. Nothing is written when anything fails. "
-            "Example: motiontheater filter --median 5 --joints lhumerus,rhumerus 01_01.amc "
-            "--asf 01.asf -o smooth.amc"
+            "hold their value unless --mode says otherwise. Nothing is written when anything fails."
         ),
+        epilog="Example: motiontheater filter --median 5 --joints lhumerus,rhumerus 01_01.amc -o smooth.amc",
     )
     _filter_options(smooth)
-    smooth.add_argument("input", help="the AMC or BVH file")
-    smooth.add_argument("-o", "--output", required=True, help="the file to write (the input's format)")
+    smooth.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    _output_options(smooth, "the file to write (the input's format)")
+    _take_options(smooth)
     smooth.set_defaults(run=_filter)
+
+    recipe_run = verbs.add_parser(
+        "apply",
+        help="apply a recipe of steps (a TOML file) to a take",
+        description="Apply the steps of a recipe, in order, to a take and write the result.\n\n" + RECIPE_HELP,
+        epilog="Example: motiontheater apply 01_01.amc --recipe steps.toml -o cleaned.amc",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    recipe_run.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    _output_options(recipe_run, "the file to write")
+    recipe_run.add_argument("--recipe", required=True, metavar="FILE", help="the TOML recipe of steps")
+    _take_options(recipe_run)
+    recipe_run.set_defaults(run=_apply)
+
+    for step in steps().values():
+        _step_verb(verbs, step)
 
     many = verbs.add_parser(
         "batch",
-        help="filter whole capture databases: folders, globs, all cores or a Dask cluster",
+        help="apply a filter or a recipe to whole capture databases: folders, globs, all cores or a Dask cluster",
         description=(
-            "Apply a filter to every AMC under the inputs (files, folders searched recursively, "
-            "globs), writing into an output folder that mirrors the input tree, with each take's "
-            "skeleton found by the CMU/HDM05 naming (or --asf). Runs on all cores (--jobs), or on a "
-            "Dask cluster (--dask for a local one, --scheduler tcp://HOST:PORT). Each output is "
-            "written under a temporary name and renamed when complete; --resume skips outputs newer "
-            "than their inputs; a bad take is reported and the others go on; the exit status is 1 "
-            "when any take failed. Takes above --stream-above MB are streamed in chunks. Example: "
-            "motiontheater batch --median 5 --jobs 2 captures/ -o smoothed/"
+            "Apply a filter (--median N, --mean N, --binomial N) or a recipe of steps (--recipe FILE) to "
+            "every AMC and BVH take under the inputs (files, folders searched recursively, globs), writing "
+            "into an output folder that mirrors the input tree, with each take's skeleton found by the "
+            "CMU/HDM05 naming (or --asf). Runs on all cores (--jobs), or on a Dask cluster (--dask for a "
+            "local one, --scheduler tcp://HOST:PORT). Each output is written under a temporary name and "
+            "renamed when complete; --resume skips takes already done; a bad take is reported and the "
+            "others go on; the exit status is 1 when any take failed. Takes above --stream-above MB are "
+            "streamed in chunks when the recipe is a single filter.\n\n" + RECIPE_HELP
         ),
+        epilog="Example: motiontheater batch --median 5 --jobs 2 captures/ -o smoothed/",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     _filter_options(many)
+    many.add_argument("--recipe", metavar="FILE", help="a TOML recipe of steps (instead of a filter flag)")
     many.add_argument("inputs", nargs="+", help="AMC and BVH files, folders or globs")
     many.add_argument("-o", "--output", required=True, help="the output folder")
+    _take_options(many)
     many.add_argument("--jobs", type=int, default=0, help="processes (default: every core)")
     many.add_argument("--resume", action="store_true", help="skip takes whose output is newer than the input")
     many.add_argument("--quiet", action="store_true", help="no progress bar or summary (failures still reported)")
@@ -283,23 +403,6 @@ def build_parser() -> argparse.ArgumentParser:
     )
     many.set_defaults(run=_batch)
 
-    conversion = verbs.add_parser(
-        "convert",
-        help="convert between ASF/AMC and BVH (forward kinematics gives the same points)",
-        description=(
-            "Convert a motion between ASF/AMC and BVH, by the output's suffix. AMC to BVH: a joint at "
-            "each bone's start carries the bone's rotation. BVH to AMC: a bone per segment, named "
-            "after the joint it ends at; the skeleton is written beside it as OUT.asf. Examples: "
-            "motiontheater convert 01_01.amc 01_01.bvh --asf 01.asf; motiontheater convert walk.bvh walk.amc"
-        ),
-    )
-    conversion.add_argument("input", help="an AMC (with its ASF) or a BVH file")
-    conversion.add_argument("output", help="OUT.bvh or OUT.amc")
-    conversion.add_argument("--asf", help="the input AMC's skeleton (default: the ASF beside it)")
-    conversion.add_argument("--order", default="ZXY", help="rotation channel order of the BVH written (default ZXY)")
-    conversion.add_argument("--frame-rate", type=float, help="frames per second when the AMC does not say")
-    conversion.set_defaults(run=_convert)
-
     recipe = verbs.add_parser(
         "combine",
         help="lay motion tracks over a base motion, as a TOML recipe says, and write an AMC",
@@ -311,7 +414,7 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     recipe.add_argument("recipe", help="the TOML recipe")
-    recipe.add_argument("-o", "--output", help="the AMC file to write")
+    recipe.add_argument("-o", "--output", help="the take to write (.amc or .bvh, as the motions)")
     recipe.add_argument("--dry-run", action="store_true", help="print the frame maps and borders, write nothing")
     recipe.set_defaults(run=_combine)
 
@@ -333,13 +436,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status (2 with a one-line reason on failure)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.verb is None:
         parser.print_help()
         return 0
     try:
-        return args.run(args)
+        return int(args.run(args))
     except (ValueError, TypeError, OSError, RuntimeError) as exc:
         print(f"motiontheater {args.verb}: {exc}", file=sys.stderr)
         return 2

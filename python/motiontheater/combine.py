@@ -15,14 +15,16 @@ import math
 import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from mtcore import rotations as rot
 from mtcore.combine import combine_frames
 
-from . import _euler
+from .errors import UnknownNameError
 from .motion import Motion
-from .skeleton import ROTATIONS, TRANSLATIONS
+from .skeleton import TRANSLATIONS
 
 PRESERVE = (None, "literal", "ground")
 ROTATION_BLENDS = ("slerp", "linear")
@@ -119,6 +121,7 @@ def _pair(value, name: str) -> tuple[int, int] | None:
 def plan(
     old: Motion,
     new: Motion,
+    *,
     cut=None,
     scale=None,
     blend: int = 0,
@@ -223,7 +226,7 @@ def plan(
         x *= 2
         x += st - sf
         x //= 2 * (st - sf)
-    if gap_pose is not None:
+    if gap is not None and gap_pose is not None:
         x[at(max(gap[0], lo)) - at(lo) : at(min(gap[1], hi)) - at(lo) + 1] = source(gap_pose)
     new_row = np.full(count, -1, np.int64)
     x -= n1
@@ -265,20 +268,7 @@ def _ramps(rows: np.ndarray, next_row: np.ndarray, ramp: np.ndarray) -> None:
     ramp[:] = np.where(has_next, position / lengths[for_run], 0.0)
 
 
-def combine(
-    old: Motion,
-    new: Motion,
-    cut=None,
-    scale=None,
-    blend: int = 0,
-    preserve: str | None = None,
-    joints: Iterable[str] | None = None,
-    discard_old: bool = False,
-    interpolate: bool = False,
-    rotation_blend: str = "slerp",
-    up: str = "y",
-    workers: int | None = None,
-) -> Motion:
+def combine(old: Motion, new: Motion, **options: Any) -> Motion:
     """Lay ``new`` over ``old``: a new Motion (the inputs are not modified).
 
     - ``cut=(cf, ct)``: use frames cf..ct of ``new`` (default all of it).
@@ -303,38 +293,38 @@ def combine(
       of repeated frames become linear ramps to the next source frame.
     - ``rotation_blend``: "slerp" (quaternions, for joints with three rotation
       channels) or "linear" on the stored Euler angles (the thesis).
-    Raises ValueError naming the argument at fault.
+    - ``up``: the vertical axis for "ground" ("x", "y" or "z"; "y" by default).
+    - ``workers``: threads, as for the filters.
+    Raises ValueError naming the argument at fault.  The options and their
+    defaults are those of :func:`combine_planned` and :func:`plan`.
     """
-    return combine_planned(
-        old, new, cut, scale, blend, preserve, joints, discard_old, interpolate, rotation_blend, up, workers
-    )[1]
+    return combine_planned(old, new, **options)[1]
 
 
 def combine_planned(
     old: Motion,
     new: Motion,
-    cut=None,
-    scale=None,
-    blend: int = 0,
-    preserve: str | None = None,
+    *,
     joints: Iterable[str] | None = None,
-    discard_old: bool = False,
-    interpolate: bool = False,
     rotation_blend: str = "slerp",
     up: str = "y",
     workers: int | None = None,
+    **frame_map: Any,
 ) -> tuple[Plan, Motion]:
-    """:func:`combine`, returning the frame map it followed as well."""
+    """:func:`combine`, returning the frame map it followed as well; the options that make the
+    frame map (cut, scale, blend, preserve, discard_old, interpolate) are :func:`plan`'s."""
     if rotation_blend not in ROTATION_BLENDS:
         raise ValueError(f"rotation_blend must be one of {ROTATION_BLENDS}, got {rotation_blend!r}")
     if up not in UP_AXES:
         raise ValueError(f"up must be one of {UP_AXES}, got {up!r}")
     skeleton = old.skeleton
+    discard_old = frame_map.get("discard_old", False)
     chosen = skeleton.joint_names if joints is None or discard_old else tuple(joints)
+    chosen = tuple("root" if skeleton.is_root(joint) else joint for joint in chosen)
     for joint in chosen:
-        if joint not in skeleton.joint_names:
-            raise ValueError(f"joints: no joint '{joint}' in skeleton '{skeleton.name}'")
-    p = plan(old, new, cut, scale, blend, preserve, discard_old, interpolate)
+        if not skeleton.has_joint(joint):
+            raise UnknownNameError(f"joints: no joint '{joint}' in skeleton '{skeleton.name}'")
+    p = plan(old, new, **frame_map)
     selected = np.zeros(len(skeleton.channels), np.uint8)
     for joint in chosen:
         selected[old.columns(joint)] = 1
@@ -361,41 +351,42 @@ def combine_planned(
     return p, old.replace(values=values, first_frame=int(p.frames[0]) if len(p.frames) else 1)
 
 
-def _slerp_blends(values: np.ndarray, old: Motion, new: Motion, p: Plan, joints) -> None:
-    """Cross-faded frames of joints with three rotation channels, again, by SLERP."""
+def _slerp_blends(values: np.ndarray, old: Motion, new: Motion, p: Plan, joints: Iterable[str]) -> None:
+    """Cross-faded frames of the joints with three rotation channels, again, by SLERP: whole
+    arrays through the C rotation kernels, a few calls per Euler convention for all joints."""
     frames = p.blend_rows
     if not len(frames):
         return
     skeleton = old.skeleton
-    scale = math.pi / 180 if skeleton.angle_unit == "deg" else 1.0
-    period = 2 * math.pi / scale
-    u = p.weight[frames]
-    for joint in joints:
-        dofs = [d for d in skeleton.dofs(joint) if d in ROTATIONS]
-        if len(dofs) != 3:
-            continue  # no unique rotation to interpolate: the linear blend stands
-        columns = old.columns(joint, tuple(dofs))
-        axes = "".join(d[1] for d in dofs)
-        a = old.values[p.old_row[frames]][:, columns] * scale
-        b = new.values[p.new_row[frames]][:, columns]
-        if p.ramp is not None:
-            b = b + p.ramp[frames, None] * (new.values[p.next_row[frames]][:, columns] - b)
-        b = b * scale
-        q = _euler.slerp(_euler.quaternions(_euler.matrices(a, axes)), _euler.quaternions(_euler.matrices(b, axes)), u)
-        angles = _euler.angles(_euler.quaternion_matrices(q), axes) / scale
-        linear = values[np.ix_(frames, columns)]
-        values[np.ix_(frames, columns)] = _euler.nearest_equivalent(angles, linear, period)
+    u = p.weight[frames, None]
+    degrees = skeleton.angle_unit == "deg"
+    rows = (slice(None), None, None)  # (frames,) indices against (joints, 3) columns
+    for order, extrinsic, columns in skeleton.euler_groups(joints):
+        a = old.values[p.old_row[frames][rows], columns]
+        b = new.values[p.new_row[frames][rows], columns]
+        if p.ramp is not None and p.next_row is not None:
+            b = b + p.ramp[frames][rows] * (new.values[p.next_row[frames][rows], columns] - b)
+        q0, q1 = (rot.euler_to_quaternions(k, order, extrinsic=extrinsic, degrees=degrees) for k in (a, b))
+        angles = rot.quaternions_to_euler(rot.slerp(q0, q1, u), order, extrinsic=extrinsic, degrees=degrees)
+        where = (frames[rows], columns)
+        values[where] = _nearest_equivalent(angles, values[where], skeleton.period)
 
 
-def _root_rotation_axes(old: Motion) -> tuple[list[int], str]:
-    root = old.skeleton.root
-    dofs = [d for d in root.order if d in ROTATIONS]
-    if len(dofs) != 3:
+def _nearest_equivalent(angle: np.ndarray, reference: np.ndarray, period: float) -> np.ndarray:
+    """angle plus the multiple of period that brings it closest to reference."""
+    return angle + period * np.round((reference - angle) / period)
+
+
+def _root_rotations(old: Motion) -> tuple[list[int], str, bool]:
+    """The root's rotation columns, their Euler order and whether it is extrinsic (ASF) or not (BVH)."""
+    groups = old.skeleton.euler_groups(["root"])
+    if not groups:
         raise ValueError("preserve='ground' needs a root with three rotation channels")
-    return old.columns("root", tuple(dofs)), "".join(d[1] for d in dofs)
+    order, extrinsic, columns = groups[0]
+    return columns[0].tolist(), order, extrinsic
 
 
-def _root_offsets(old: Motion, new: Motion, p: Plan, up: str, rotations=_euler):
+def _root_offsets(old: Motion, new: Motion, p: Plan, up: str):
     """(offset_row, offsets, channels): what to add to the root channels of each output frame
     so that the root continues at each border.  The piece (with any gap frames that hold its
     pose) is moved to continue from the old frame before it, and the old frames after it to
@@ -437,38 +428,39 @@ def _root_offsets(old: Motion, new: Motion, p: Plan, up: str, rotations=_euler):
             offset_row[follow_rows] = 1
         return offset_row, np.array(rows), root.tolist()
     piece = raw(sf, end)
-    moved = _ground_moved(old, piece, piece[0], old_root(before), up, rotations) if before is not None else piece
+    moved = _ground_moved(old, piece, piece[0], old_root(before), up) if before is not None else piece
     tables = [moved - piece]
     offset_row[piece_rows] = np.arange(len(piece))
     if after is not None:
         follow = raw(end + 1, int(p.frames[-1]))
-        tables.append(_ground_moved(old, follow, follow[0], moved[-1], up, rotations) - follow)
+        tables.append(_ground_moved(old, follow, follow[0], moved[-1], up) - follow)
         offset_row[follow_rows] = len(piece) + np.arange(len(follow))
     return offset_row, np.concatenate(tables), root.tolist()
 
 
-def _ground_moved(
-    motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: np.ndarray, up: str, rotations
-) -> np.ndarray:
+def _ground_moved(motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: np.ndarray, up: str) -> np.ndarray:
     """Root channel rows moved rigidly so that ``start`` lands on ``anchor``: translated on the
-    ground plane, turned about the ``up`` axis to the anchor's heading.  ``rotations`` converts
-    Euler angles and matrices (``matrices``, ``angles``)."""
+    ground plane, turned about the ``up`` axis to the anchor's heading."""
     skeleton = motion.skeleton
     order = skeleton.root.order
     t_cols = [order.index(d) for d in TRANSLATIONS if d in order]
-    rot_cols, axes = _root_rotation_axes(motion)
-    r_cols = [list(motion.columns("root")).index(c) for c in rot_cols]
-    scale = math.pi / 180 if skeleton.angle_unit == "deg" else 1.0
+    rot_cols, axes, extrinsic = _root_rotations(motion)
+    root_columns = list(motion.columns("root"))
+    r_cols = [root_columns.index(c) for c in rot_cols]
+    degrees = skeleton.angle_unit == "deg"
     u = "xyz".index(up)
     ground = [i for i in range(3) if i != u]
 
-    def heading(row):
-        m = rotations.matrices(row[r_cols] * scale, axes)
+    def matrices(angles: np.ndarray) -> np.ndarray:
+        return rot.euler_to_matrices(angles, axes, extrinsic=extrinsic, degrees=degrees)
+
+    def heading(row: np.ndarray) -> float:
+        m = matrices(row[r_cols])
         forward = m[:, ground[1]] if up != "z" else m[:, 0]  # the root's forward, on the ground
         return math.atan2(forward[ground[0]], forward[ground[1]])
 
     turn = heading(anchor) - heading(start)
-    spin = rotations.matrices(np.array([turn]), up)
+    spin = rot.rotvecs_to_matrices(np.eye(3)[u] * turn)
     out = rows.copy()
     if len(t_cols) == 3:
         position = rows[:, t_cols] - start[t_cols]
@@ -477,9 +469,8 @@ def _ground_moved(
         for g in ground:
             moved[:, g] += anchor[t_cols][g]
         out[:, t_cols] = moved
-    # the turn about the up axis is one more rotation about a fixed axis, applied last
-    turned = rotations.matrices(np.column_stack([rows[:, r_cols] * scale, np.full(len(rows), turn)]), axes + up)
-    angles = rotations.angles(turned, axes) / scale
-    period = 2 * math.pi / scale
-    out[:, r_cols] = _euler.nearest_equivalent(np.unwrap(angles, period=period, axis=0), rows[:, r_cols], period)
+    # the turn about the up axis comes after the root's own rotation, about a fixed axis
+    angles = rot.matrices_to_euler(spin @ matrices(rows[:, r_cols]), axes, extrinsic=extrinsic, degrees=degrees)
+    period = skeleton.period
+    out[:, r_cols] = _nearest_equivalent(np.unwrap(angles, period=period, axis=0), rows[:, r_cols], period)
     return out

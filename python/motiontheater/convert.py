@@ -12,12 +12,15 @@ axis.  Angles are degrees in BVH; lengths keep their units.
 
 from __future__ import annotations
 
+from typing import Annotated, Literal
+
 import numpy as np
 
-from mtcore.kinematics import euler_angles, forward_kinematics
+from mtcore.kinematics import forward_kinematics
+from mtcore.rotations import matrices_to_euler
 
-from .kinematics import joint_tree
 from .motion import Motion
+from .registry import step
 from .skeleton import ROTATIONS, TRANSLATIONS, Bone, Root, Skeleton, canonical_hierarchy
 
 BVH_ORDERS = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
@@ -38,7 +41,7 @@ def to_bvh(motion: Motion, order: str = "ZXY") -> Motion:
             )
     rotation_dofs = tuple("r" + a.lower() for a in order)
     fixed = order[::-1].lower()  # BVH's R = R1 R2 R3 applies R3 first about fixed axes
-    tree = joint_tree(skeleton)
+    tree = skeleton.tree
     segments = dict(zip(skeleton.bone_names, tree.segment[1:]))
     bones, pairs = [], []
     for bone in skeleton.bones:
@@ -74,8 +77,9 @@ def to_bvh(motion: Motion, order: str = "ZXY") -> Motion:
         convention="bvh",
     )
     positions, _, local = forward_kinematics(motion.values, tree, local=True)
+    assert local is not None  # asked for
     turning = [j for j, name in enumerate(skeleton.joint_names) if name == "root" or skeleton.bone(name).dofs]
-    angles = np.degrees(euler_angles(local[:, turning], fixed))[..., ::-1]  # in the listed order
+    angles = np.degrees(matrices_to_euler(local[:, turning], fixed, extrinsic=True))[..., ::-1]  # in the listed order
     values = np.concatenate([positions[:, 0], angles.reshape(motion.frames, 3 * len(turning))], axis=1)
     values.flags.writeable = False
     return Motion(target, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame, header=())
@@ -94,7 +98,7 @@ def to_asf(motion: Motion) -> Motion:
     root = skeleton.root
     root_rotations = tuple(d for d in root.order if d in ROTATIONS)[::-1]
     root_translations = tuple(d for d in root.order if d in TRANSLATIONS)
-    position = tuple(0.0 if d in root_translations else v for d, v in zip(("tx", "ty", "tz"), root.position))
+    x, y, z = (0.0 if d in root_translations else v for d, v in zip(TRANSLATIONS, root.position))
     bones, pairs = [], []
     for bone in skeleton.bones:
         parent = skeleton.parent(bone.name)
@@ -114,7 +118,7 @@ def to_asf(motion: Motion) -> Motion:
     target = Skeleton(
         bones=tuple(bones),
         hierarchy=canonical_hierarchy(tuple(bones), pairs),
-        root=Root(order=(*root_translations, *root_rotations), position=position),
+        root=Root(order=(*root_translations, *root_rotations), position=(x, y, z)),
         name=skeleton.name or "converted",
         units=(("mass", "1.0"), ("length", "1.0"), ("angle", "deg")),
     )
@@ -135,3 +139,23 @@ def to_asf(motion: Motion) -> Motion:
         first_frame=motion.first_frame,
         header=(":FULLY-SPECIFIED", ":DEGREES"),
     )
+
+
+@step(
+    "convert", "turn an ASF/AMC motion into a BVH one or back (forward kinematics gives the same points)", frames="none"
+)
+def convert(
+    motion: Motion,
+    *,
+    to: Annotated[Literal["bvh", "asf"] | None, "the convention to convert to (default: the other one)"] = None,
+    order: Annotated[Literal["ZXY", "XYZ", "XZY", "YXZ", "YZX", "ZYX"], "rotation channel order of BVH joints"] = "ZXY",
+) -> Motion:
+    """The motion in the other file convention: see :func:`to_bvh` and :func:`to_asf`.
+
+    ASF/AMC to BVH: a joint at each bone's start carries the bone's rotation.
+    BVH to ASF/AMC: a bone per segment, named after the joint it ends at; the
+    skeleton is written beside an AMC output as OUT.asf.
+    """
+    if to is None:
+        to = "asf" if motion.skeleton.convention == "bvh" else "bvh"
+    return to_bvh(motion, order) if to == "bvh" else to_asf(motion)

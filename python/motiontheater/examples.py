@@ -24,7 +24,7 @@ def noisy_rotations(
     joints with 3 rotation values each.
     """
     rng = np.random.default_rng(seed)
-    frames = int(round(seconds * frame_rate))
+    frames = round(seconds * frame_rate)
     t = np.arange(frames)[:, None] / frame_rate
     freq = rng.uniform(0.2, 3.0, (3, channels))
     amp = rng.uniform(5.0, 45.0, (3, channels))

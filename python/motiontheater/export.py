@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import os
+import typing
+from typing import Annotated, Literal
 
 import numpy as np
 
 from ._io import Source, output
 from .motion import Motion
+from .registry import exporter
 
 FORMATS = ("csv", "npz", "trc")
 _NAMED_UNITS = {1.0: "m", 0.01: "cm", 0.001: "mm", 0.0254: "in"}
@@ -19,23 +22,28 @@ def length_unit_name(motion: Motion, meters: bool) -> str | None:
     return "m" if meters else _NAMED_UNITS.get(motion.skeleton.meters_per_unit)
 
 
+@exporter("positions", (".csv", ".npz", ".trc"), "write every joint's world position per frame (CSV, NPZ or TRC)")
 def write_positions(
-    motion: Motion, target: Source, *, meters: bool = False, format: str | None = None, workers: int | None = None
+    motion: Motion,
+    target: Source,
+    *,
+    meters: Annotated[bool, "lengths in metres rather than the skeleton's units"] = False,
+    format: Annotated[Literal["csv", "npz", "trc"] | None, "file format (default: from the suffix)"] = None,
+    workers: Annotated[int | None, "threads (default: every core for large takes)"] = None,
 ) -> str:
-    """Write the world position of every joint (``Motion.positions()``) to a file.
+    """Write the world position of every joint per frame (``Motion.positions()``) to a file.
 
-    ``format`` is "csv", "npz" or "trc" (default: the target's suffix).  CSV:
-    one row per frame, columns ``frame, time, <joint>.x, <joint>.y,
-    <joint>.z`` in ``joint_names`` order, 10 significant digits.  NPZ:
-    ``positions`` (frames, joints, 3) exact, ``joint_names``, ``frames``,
-    ``times``, ``frame_rate``, ``meters_per_unit``.  TRC needs a named unit
-    (m, cm, mm, in): use ``meters=True`` for CMU and HDM05.  Lengths are in
-    file units, or metres with ``meters``.  A path is written atomically.
-    Returns the format written.
+    The format is the target's suffix unless given.  CSV: one row per frame,
+    columns frame, time, <joint>.x, <joint>.y, <joint>.z in the skeleton's
+    joint order, 10 significant digits.  NPZ: positions (frames, joints, 3)
+    exact, joint_names, frames, times, frame_rate, meters_per_unit.  TRC
+    (OpenSim markers) needs a named unit (m, cm, mm, in): write CMU and HDM05
+    in metres.  Lengths are in the skeleton's units, or in metres.  A path is
+    written atomically.  Returns the format written.
     """
     if format is None:
         suffix = os.path.splitext(os.fspath(target) if isinstance(target, (str, os.PathLike)) else "")[1]
-        format = suffix.lstrip(".").lower()
+        format = typing.cast(Literal["csv", "npz", "trc"], suffix.lstrip(".").lower())
     if format not in FORMATS:
         raise ValueError(f"format must be one of {', '.join(FORMATS)} (or a target ending in one), got {format!r}")
     unit = length_unit_name(motion, meters)
@@ -65,6 +73,7 @@ def write_positions(
                 header = ",".join(["frame", "time", *(f"{n}.{a}" for n in names for a in "xyz")])
                 np.savetxt(f, table, delimiter=",", fmt=fmt, header=header, comments="", encoding="utf-8")
             else:
+                assert unit is not None  # refused above
                 f.write(_trc_header(motion, names, unit, target).encode())
                 np.savetxt(f, table, delimiter="\t", fmt=fmt, encoding="utf-8")
     return format

@@ -8,15 +8,20 @@ chunks (motiontheater.batch) to the same result, bit for bit, as whole.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Annotated, Literal
 
 import numpy as np
 
 import mtcore
 
 from .motion import Motion
+from .registry import Joints, register
 from .skeleton import ROTATIONS, Skeleton
+
+EdgeMode = Literal["nearest", "reflect", "mirror", "constant", "wrap"]
 
 FILTERS = {
     "median": mtcore.median_filter1d,
@@ -35,6 +40,7 @@ class TakeStats:
 
     @classmethod
     def of(cls, values: np.ndarray) -> TakeStats:
+        """The statistics of the first frames of a take."""
         return cls(values.min(axis=0), values.max(axis=0), values[0].copy())
 
     def update(self, values: np.ndarray) -> None:
@@ -77,10 +83,11 @@ class Smoother:
                     self.rotations.append(start + i)
                 elif translation:
                     self.others.append(start + i)
-        self.period = 360.0 if skeleton.angle_unit == "deg" else 2 * np.pi
+        self.period = skeleton.period
 
     @property
     def halo(self) -> int:
+        """Frames either side of a frame that its smoothed value depends on."""
         return self.size // 2
 
     @property
@@ -133,24 +140,21 @@ class Smoother:
 def filter_motion(
     motion: Motion,
     kind: str,
-    size: int,
-    joints: Iterable[str] | None = None,
     *,
-    translation: bool = True,
-    mode: str = "nearest",
-    workers: int | None = None,
+    size: Annotated[int, "window length in frames (odd: 3, 5, 7, ...)"],
+    joints: Annotated[Joints, "joints to smooth, comma-separated (default: all)"] = None,
+    translation: Annotated[bool, "smooth the root's translation too (--no-translation leaves it)"] = True,
+    mode: Annotated[EdgeMode, "how the edges are extended: nearest holds the edge value"] = "nearest",
+    workers: Annotated[int | None, "threads (default: every core for large takes)"] = None,
 ) -> Motion:
-    """A new motion whose channels are smoothed over frames.
+    """A new motion whose channels are smoothed over frames by the filter ``kind``.
 
-    ``kind`` is "median", "mean" (moving average) or "binomial" (Pascal
-    weights, 1 2 1 / 4 for size 3), ``size`` an odd number of frames.
-    ``joints`` names the joints to smooth ("root" and bone names; all by
-    default); every other channel stays bit-identical.  ``translation=False``
-    leaves translation channels (the root's position) alone.  ``mode`` is
-    the edge mode of :mod:`mtcore` ("nearest": hold the edge value).
-
-    Rotation channels are unwrapped before smoothing, so that an angle
-    crossing ±180° between frames is smoothed as the small step it is, and
+    The kinds are "median", "mean" (moving average) and "binomial" (Pascal
+    weights, 1 2 1 / 4 for size 3), over an odd number of frames.  Only the
+    chosen joints' channels change ("root" and bone names; all by default);
+    every other channel stays bit-identical, and so does the root's
+    translation when translation is off.  The edges are extended by the mode
+    (nearest: the edge value held).  Rotation channels are unwrapped before smoothing, so that an angle crossing ±180° between frames is smoothed as the small step it is, and
     wrapped back after into the range the channel used, [-180, 180] or
     [0, 360] (or left continuous if it used neither).  Means are computed
     relative to each channel's first value, so a constant channel comes out
@@ -177,3 +181,17 @@ def _wrap_into(filtered: np.ndarray, low: np.ndarray, high: np.ndarray, period: 
     p = filtered[:, positive]
     out[:, positive] = np.where((p >= 0) & (p <= period), p, p - period * np.floor(p / period))
     return out
+
+
+for _kind, _what in (
+    ("median", "moving median: removes spikes and marker pops, keeps steps"),
+    ("mean", "moving average: evens out jitter"),
+    ("binomial", "Pascal-weighted average (1 2 1 / 4 for size 3): the gentlest smoothing"),
+):
+    register(
+        _kind,
+        filter_motion,
+        f"smooth with a {_what}",
+        fixed={"kind": _kind},
+        streamer=functools.partial(Smoother, kind=_kind),
+    )

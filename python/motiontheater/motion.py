@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
-from mtcore.errors import UnknownNameError
-from mtcore.kinematics import forward_kinematics, rotations_to_quaternions
+from mtcore.kinematics import forward_kinematics
+from mtcore.rotations import matrices_to_quaternions
 
-from .kinematics import joint_tree
-from .skeleton import ROTATIONS, TRANSLATIONS, Skeleton
+from .errors import UnknownNameError
+from .registry import is_step, lookup
+from .skeleton import ROTATIONS, TRANSLATIONS, Skeleton, angle_factor
 
 DEFAULT_FRAME_RATE = 120.0
 """Frames per second assumed for an AMC without a rate (CMU and HDM05 record at 120 Hz)."""
@@ -56,7 +59,13 @@ class Motion:
 
     @property
     def frames(self) -> int:
+        """The number of frames."""
         return self.values.shape[0]
+
+    @property
+    def last_frame(self) -> int:
+        """The number of the last frame (``first_frame - 1`` when there are none)."""
+        return self.first_frame + self.frames - 1
 
     @property
     def channels(self) -> tuple[tuple[str, str], ...]:
@@ -93,7 +102,7 @@ class Motion:
         point (its start point, the end of its parent, with ``start=True``).
         In file length units, or metres with ``meters=True``.  NaN in a channel
         gives NaN for that joint and the joints below it."""
-        tree = joint_tree(self.skeleton)
+        tree = self.skeleton.tree
         positions, _, _ = forward_kinematics(self.values, tree, workers=workers)
         if start:
             positions = positions[:, np.maximum(tree.parent, 0)]
@@ -105,27 +114,56 @@ class Motion:
         rotations by default; ``local=True`` gives C M C^T, a joint's own
         rotation in world-aligned axes (what the HDM05 toolbox stores)."""
         _, world, own = forward_kinematics(
-            self.values, joint_tree(self.skeleton), world=not local, local=local, workers=workers
+            self.values, self.skeleton.tree, world=not local, local=local, workers=workers
         )
         matrices = own if local else world
-        return rotations_to_quaternions(matrices) if quaternions else matrices
+        assert matrices is not None  # asked for
+        return matrices_to_quaternions(matrices) if quaternions else matrices
 
-    def filter(
-        self,
-        kind: str,
-        size: int,
-        joints=None,
-        *,
-        translation: bool = True,
-        mode: str = "nearest",
-        workers: int | None = None,
-    ) -> Motion:
-        """Smoothed over frames: see :func:`motiontheater.filtering.filter_motion`."""
-        from .filtering import filter_motion  # filtering builds on Motion
+    def apply(self, step: str, **options: Any) -> Motion:
+        """The motion after the registered step ``step`` with ``options`` (see
+        :mod:`motiontheater.registry`; ``motiontheater.steps()`` lists them):
+        ``motion.apply("median", size=5)`` is ``motion.median(size=5)``."""
+        return lookup(step)(self, **options)
 
-        return filter_motion(self, kind, size, joints, translation=translation, mode=mode, workers=workers)
+    def __getattr__(self, name: str) -> Callable[..., Motion]:
+        # Registered steps are methods: motion.median(size=5), motion.slerp(frames=(10, 20)).
+        if name.startswith("_") or not is_step(name):
+            raise AttributeError(f"'Motion' object has no attribute {name!r}")
+        return lambda **options: self.apply(name, **options)
 
-    def replace(self, **changes) -> Motion:
+    def filter(self, kind: str, size: int, joints: Iterable[str] | None = None, **options: Any) -> Motion:
+        """Smoothed over frames by the filter step ``kind`` ("median", "mean" or "binomial") of
+        ``size`` frames, the ``joints`` given or all; the options (translation, mode, workers) are
+        those of :func:`motiontheater.filtering.filter_motion`."""
+        return self.apply(kind, size=size, joints=None if joints is None else tuple(joints), **options)
+
+    def crop(self, first: int, last: int) -> Motion:
+        """Frames ``first`` .. ``last`` (frame numbers, both included) as a motion of their own."""
+        if not self.first_frame <= first <= last <= self.last_frame:
+            raise ValueError(
+                f"frames {first}..{last} are not within the motion's frames {self.first_frame}..{self.last_frame}"
+            )
+        a = first - self.first_frame
+        return replace(self, values=self.values[a : a + last - first + 1], first_frame=first)
+
+    def splice(self, piece: Motion) -> Motion:
+        """This motion with the frames of ``piece`` (a motion of the same skeleton, within this
+        one's frames, as :meth:`crop` gives) put in their place; every other frame as it was."""
+        if piece.skeleton.channels != self.skeleton.channels:
+            raise ValueError("splice: the piece is a motion of another skeleton")
+        if not self.first_frame <= piece.first_frame <= piece.last_frame <= self.last_frame:
+            raise ValueError(
+                f"splice: frames {piece.first_frame}..{piece.last_frame} are not within "
+                f"{self.first_frame}..{self.last_frame}"
+            )
+        values = self.values.copy()
+        a = piece.first_frame - self.first_frame
+        values[a : a + piece.frames] = piece.values
+        values.flags.writeable = False
+        return replace(self, values=values)
+
+    def replace(self, **changes: Any) -> Motion:
         """A new motion with some fields changed (values are copied if writeable)."""
         return replace(self, **changes)
 
@@ -133,12 +171,10 @@ class Motion:
         """Lengths times ``length_factor`` (unit text ``length``) and angles in ``angle``
         ("deg" or "rad"), for the skeleton and the values alike."""
         skeleton = self.skeleton.with_units(length_factor=length_factor, length=length, angle=angle)
-        angle_factor = 1.0
-        if angle is not None and angle != self.skeleton.angle_unit:
-            angle_factor = np.pi / 180 if angle == "rad" else 180 / np.pi
+        turn = angle_factor(self.skeleton.angle_unit, angle)
         factors = np.array(
             [
-                angle_factor if dof in ROTATIONS else length_factor if dof in (*TRANSLATIONS, "l") else 1.0
+                turn if dof in ROTATIONS else length_factor if dof in (*TRANSLATIONS, "l") else 1.0
                 for _, dof in self.channels
             ]
         )
@@ -154,9 +190,11 @@ class Motion:
         return self.with_units(length_factor=self.skeleton.meters_per_unit, length="0.0254")
 
     def to_radians(self) -> Motion:
+        """Angles in radians (the skeleton's ``:units angle`` and the AMC header say so)."""
         return self.with_units(angle="rad")
 
     def to_degrees(self) -> Motion:
+        """Angles in degrees."""
         return self.with_units(angle="deg")
 
 

@@ -8,9 +8,8 @@ import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from .amc import read_amc, skeleton_path_for
-from .asf import read_asf
 from .combine import Plan, combine_planned
+from .formats import read_take
 from .motion import Motion
 
 if sys.version_info >= (3, 11):
@@ -42,6 +41,7 @@ class Scene:
     tracks: tuple[Track, ...] = ()
 
     def add(self, motion: Motion, name: str = "", **options) -> Scene:
+        """This scene with a track more: ``motion`` laid over it with :func:`~motiontheater.combine.combine` ``options``."""
         unknown = set(options) - set(TRACK_OPTIONS)
         if unknown:
             raise ValueError(
@@ -50,6 +50,7 @@ class Scene:
         return replace(self, tracks=(*self.tracks, Track(motion, dict(options), name)))
 
     def render(self, workers: int | None = None) -> Motion:
+        """The motion of the base with every track applied in order."""
         steps = self._apply(workers)
         return steps[-1][2] if steps else self.base
 
@@ -104,12 +105,12 @@ def read_recipe(path: str | os.PathLike) -> Scene:
     if base is None:
         raise ValueError(f'{path}: the recipe needs [base] with motion = "FILE.amc"')
     base = where(base, "base.motion")
-    skeleton = read_asf(where(recipe["skeleton"], "skeleton") if "skeleton" in recipe else skeleton_path_for(base))
+    skeleton = where(recipe["skeleton"], "skeleton") if "skeleton" in recipe else None
     rate = recipe.get("frame_rate")
 
     @functools.cache  # a take used by several tracks is read once; motions are read-only
     def motion(file: Path) -> Motion:
-        return read_amc(file, skeleton, frame_rate=rate)
+        return read_take(file, skeleton, frame_rate=rate)
 
     scene = Scene(motion(base))
     for n, track in enumerate(recipe.get("track", []), start=1):

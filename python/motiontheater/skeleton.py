@@ -1,13 +1,29 @@
-"""Skeletons: the bones of an ASF file, their rest pose and hierarchy."""
+"""Skeletons: the bones of an ASF or BVH file, their rest pose, hierarchy and kinematic tables.
+
+Forward kinematics (ASF/AMC semantics, those of the HDM05 toolbox, which the
+tests reproduce to 1e-13): a joint's local rotation is C M C^T, C from its
+``axis`` angles about x, y and z applied in the order of its letters, M from
+its rotation dofs applied in the order the ASF lists them, both about fixed
+axes; world rotations chain from the root; a bone ends at its parent's end
+plus its world rotation times its unit direction times its length.  The root
+is at ``:root position`` plus its translation channels.  A BVH joint's
+OFFSET turns with its parent instead, and its channels R = R1 R2 R3 apply the
+last first.  :attr:`Skeleton.tree` holds the tables the C kernel takes.
+"""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
-from mtcore.errors import DuplicateError, HierarchyError, UnknownNameError
+from mtcore import rotations
+from mtcore.kinematics import DOFS, JointTree, forward_kinematics
+
+from .errors import DuplicateError, HierarchyError, UnknownNameError
 
 Vec3 = tuple[float, float, float]
 
@@ -128,11 +144,14 @@ class Skeleton:
         object.__setattr__(self, "_parents", _parents_of(self.hierarchy, index))
         object.__setattr__(self, "_children", dict(self.hierarchy))
         # the layout is asked for on every column lookup: worked out once
-        channels, first = [], {}
+        channels: list[tuple[str, str]] = []
+        first: dict[str, int] = {}
         for joint in ("root", *(b.name for b in self.bones)):
             first[joint] = len(channels)
             channels.extend((joint, d) for d in (self.root.order if joint == "root" else self.bone(joint).dofs))
         object.__setattr__(self, "_channels", tuple(channels))
+        if self.root.name not in first:  # a BVH root answers to its own name too ("Hips")
+            first[self.root.name] = 0
         object.__setattr__(self, "_first_column", first)
 
     @property
@@ -152,6 +171,7 @@ class Skeleton:
         return (self.root.name, *self.bone_names)
 
     def bone(self, name: str) -> Bone:
+        """The bone called ``name``; UnknownNameError if there is none."""
         try:
             return self.bones[self._index[name]]
         except KeyError:
@@ -163,11 +183,20 @@ class Skeleton:
         return self._parents[name]
 
     def children(self, name: str) -> tuple[str, ...]:
+        """The joints whose parent is ``name``, as the hierarchy lists them."""
         return self._children.get(name, ())
 
     def dofs(self, joint: str) -> tuple[str, ...]:
-        """The channels of a joint ("root" or a bone name), in file order."""
-        return self.root.order if joint == "root" else self.bone(joint).dofs
+        """The channels of a joint ("root", the root's own name, or a bone name), in file order."""
+        return self.root.order if self.is_root(joint) else self.bone(joint).dofs
+
+    def is_root(self, joint: str) -> bool:
+        """Whether ``joint`` names the root: "root", or the name a BVH file gives it."""
+        return joint == "root" or (joint == self.root.name and joint not in self._index)
+
+    def has_joint(self, joint: str) -> bool:
+        """Whether ``joint`` names the root or a bone."""
+        return self.is_root(joint) or joint in self._index
 
     @property
     def channels(self) -> tuple[tuple[str, str], ...]:
@@ -182,19 +211,36 @@ class Skeleton:
         except KeyError:
             raise UnknownNameError(f"no bone '{joint}' in skeleton '{self.name}'") from None
 
+    def euler_groups(self, joints: Iterable[str] | None = None) -> list[tuple[str, bool, np.ndarray]]:
+        """The joints (all by default) with three rotation channels, grouped by Euler convention
+        so that each group converts in one call: (order, extrinsic, columns (joints, 3)), columns
+        in the canonical layout.  ASF applies a bone's dofs in their order about fixed axes
+        (extrinsic); BVH lists R = R1 R2 R3 (intrinsic, in the listed order)."""
+        groups: dict[str, list[list[int]]] = {}
+        for joint in self.joint_names if joints is None else joints:
+            start, dofs = self.first_column(joint), self.dofs(joint)
+            turns = [(start + i, dof) for i, dof in enumerate(dofs) if dof in ROTATIONS]
+            if len(turns) == 3:
+                groups.setdefault("".join(dof[1] for _, dof in turns), []).append([c for c, _ in turns])
+        extrinsic = self.convention != "bvh"
+        return [(order, extrinsic, np.array(columns, dtype=np.intp)) for order, columns in groups.items()]
+
     def rest_positions(self, *, start: bool = False) -> np.ndarray:
         """The calibration pose: (joints, 3) positions in ``joint_names`` order,
         the root at ``:root position`` and each bone's end point (start point
         with ``start=True``), p = p(parent) + direction * length, in file units."""
-        from mtcore.kinematics import forward_kinematics  # kinematics builds on this module
-
-        from .kinematics import joint_tree
-
-        tree = joint_tree(self)
+        tree = self.tree
         positions = forward_kinematics(np.zeros((1, len(self.channels))), tree)[0][0]
         return positions[np.maximum(tree.parent, 0)] if start else positions
 
+    @cached_property
+    def tree(self) -> JointTree:
+        """The C kernel's tables for this skeleton (see ``mt_forward_kinematics``): joints in
+        ``joint_names`` order, worked out once."""
+        return _joint_tree(self)
+
     def unit(self, key: str) -> str | None:
+        """The text of a ``:units`` key (``"length"``, ``"angle"``, ``"mass"``), or None."""
         return dict(self.units).get(key)
 
     @property
@@ -202,6 +248,16 @@ class Skeleton:
         """ "deg" or "rad": the unit of every angle in the skeleton and its motions."""
         unit = (self.unit("angle") or "deg").lower()
         return "rad" if unit.startswith("rad") else "deg"
+
+    @property
+    def angle_scale(self) -> float:
+        """Radians per angle unit: pi/180 for degrees, 1 for radians."""
+        return math.pi / 180 if self.angle_unit == "deg" else 1.0
+
+    @property
+    def period(self) -> float:
+        """A whole turn in the angle unit: 360 or 2 pi."""
+        return 2 * math.pi / self.angle_scale
 
     @property
     def meters_per_unit(self) -> float:
@@ -220,7 +276,7 @@ class Skeleton:
     ) -> Skeleton:
         """The same skeleton with lengths multiplied by ``length_factor`` (unit text
         ``length``) and angles converted to ``angle`` ("deg" or "rad")."""
-        angle_factor = _angle_factor(self.angle_unit, angle)
+        factor = angle_factor(self.angle_unit, angle)
         units = dict(self.units)
         if length is not None:
             units["length"] = length
@@ -230,12 +286,10 @@ class Skeleton:
             replace(
                 b,
                 length=b.length * length_factor,
-                axis=_scaled(b.axis, angle_factor),
+                axis=_scaled(b.axis, factor),
                 limits=tuple(
                     (lo * f, hi * f)
-                    for (lo, hi), f in zip(
-                        b.limits, (angle_factor if d in ROTATIONS else length_factor for d in b.dofs)
-                    )
+                    for (lo, hi), f in zip(b.limits, (factor if d in ROTATIONS else length_factor for d in b.dofs))
                 ),
             )
             for b in self.bones
@@ -243,12 +297,13 @@ class Skeleton:
         root = replace(
             self.root,
             position=_scaled(self.root.position, length_factor),
-            orientation=_scaled(self.root.orientation, angle_factor),
+            orientation=_scaled(self.root.orientation, factor),
         )
         return replace(self, bones=bones, root=root, units=tuple(units.items()))
 
 
-def _angle_factor(current: str, wanted: str | None) -> float:
+def angle_factor(current: str, wanted: str | None) -> float:
+    """What angles in ``current`` units are multiplied by to be in ``wanted`` units."""
     if wanted is None or wanted == current:
         return 1.0
     if wanted not in ("deg", "rad"):
@@ -293,3 +348,73 @@ def canonical_hierarchy(bones: tuple[Bone, ...], pairs) -> tuple[tuple[str, tupl
     ordered = [(p, tuple(children.pop(p))) for p in order if p in children]
     # Unknown parents stay, so that Skeleton reports them.
     return tuple(ordered + [(p, tuple(k)) for p, k in children.items()])
+
+
+def _joint_tree(skeleton: Skeleton) -> JointTree:
+    names = skeleton.joint_names
+    index = {name: i for i, name in enumerate(names)}
+    degrees = skeleton.angle_unit == "deg"
+    parent = [-1] + [index[skeleton.parent(b)] for b in skeleton.bone_names]
+    order: list[int] = []
+    queue = ["root"]
+    while queue:  # breadth first from the root: parents before children, whatever the bone order
+        name = queue.pop(0)
+        order.append(index[name])
+        queue.extend(skeleton.children(name))
+    root = skeleton.root
+    bvh = skeleton.convention == "bvh"
+    axis = [_axis_frame(root.axis, root.orientation, degrees)]
+    direction = [np.zeros(3)]
+    segment = [_replaced(root.position, root.order) if bvh else np.asarray(root.position)]
+    for bone in skeleton.bones:
+        d = np.asarray(bone.direction, float)
+        if bvh:  # the OFFSET itself, turned by the parent; position channels replace its components
+            axis.append(np.eye(3))
+            direction.append(np.zeros(3))
+            segment.append(_replaced(d, bone.dofs))
+            continue
+        axis.append(_axis_frame(bone.axis_order, bone.axis, degrees))
+        norm = np.linalg.norm(d)
+        unit = d / norm if norm > 0 else np.zeros(3)
+        direction.append(unit)
+        segment.append(unit * bone.length)
+    dof_start, dof_kind, dof_column = [0], [], []  # type: list[int], list[int], list[int]
+    column = 0
+    for name in names:
+        dofs = skeleton.dofs(name)
+        entries = [(DOFS[dof], column + i) for i, dof in enumerate(dofs)]
+        if bvh:  # BVH lists rotations as R = R1 R2 R3 (v' = R v): about fixed axes, the last applies first
+            turns = [e for e in entries if e[0] <= DOFS["rz"]][::-1]
+            entries = [e for e in entries if e[0] > DOFS["rz"]] + turns
+        for kind, col in entries:
+            dof_kind.append(kind)
+            dof_column.append(col)
+        column += len(dofs)
+        dof_start.append(len(dof_kind))
+    return JointTree(
+        parent=np.array(parent),
+        order=np.array(order),
+        axis=np.array(axis),
+        direction=np.array(direction),
+        segment=np.array(segment),
+        dof_start=np.array(dof_start),
+        dof_kind=np.array(dof_kind),
+        dof_column=np.array(dof_column),
+        angle_scale=skeleton.angle_scale,
+        parent_frame=np.array([0] + [1 if bvh else 0] * len(skeleton.bones)),
+    )
+
+
+def _axis_frame(order: str, angles: Vec3, degrees: bool) -> np.ndarray:
+    """C of an ASF ``axis``: the angles are about x, y and z, applied in ``order`` (e.g. "ZYX")."""
+    in_order = [angles["XYZ".index(letter)] for letter in order.upper()]
+    return rotations.euler_to_matrices(in_order, order.lower(), extrinsic=True, degrees=degrees)
+
+
+def _replaced(offset: Vec3 | np.ndarray, dofs: tuple[str, ...]) -> np.ndarray:
+    """A BVH offset with the components that position channels replace set to zero."""
+    out = np.asarray(offset, float).copy()
+    for i, dof in enumerate(TRANSLATIONS):
+        if dof in dofs:
+            out[i] = 0.0
+    return out

@@ -6,6 +6,7 @@ ranges of one array run truly in parallel.
 
 from __future__ import annotations
 
+import itertools
 import operator
 import os
 import threading
@@ -81,6 +82,6 @@ def even_bounds(count: int, threads: int) -> list[int]:
 
 def run_ranges(call: Callable[[int, int], int], bounds: Sequence[int], name: str) -> None:
     """Run the C function ``call(begin, end)`` over each range between bounds, in parallel, and check its status."""
-    parts = [lambda b=b, e=e: call(b, e) for b, e in zip(bounds, bounds[1:])]
+    parts = [lambda b=b, e=e: call(b, e) for b, e in itertools.pairwise(bounds)]
     for status in run_all(parts):
         check(status, name)

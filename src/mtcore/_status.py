@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import typing
 from collections.abc import Callable
 
 from . import errors
@@ -34,5 +35,5 @@ def check(status: int, what: str, describe: Callable[[int], tuple[str, int, bool
     if describe is not None and issubclass(exc, errors.FormatError):
         reason, line, truncated = describe(status)
         raise (errors.TruncatedError if truncated else exc)(reason, line)
-    message = ffi.string(lib.mt_strerror(status)).decode()
+    message = typing.cast(bytes, ffi.string(lib.mt_strerror(status))).decode()
     raise exc(f"{what}: {message} (status {status})")

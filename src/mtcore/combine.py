@@ -39,7 +39,10 @@ def combine_frames(
     (columns ``offset_channels``) to add.  ``selected`` marks the channels
     that take the new motion.  The C loop checks that every row it reads exists.
     """
-    channels = (old if old is not None else new).shape[1]
+    given = old if old is not None else new
+    if given is None:
+        raise ValueError("combine_frames needs an old or a new motion")
+    channels = given.shape[1]
     frames = len(weight)
 
     def ints(a):

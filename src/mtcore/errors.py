@@ -42,7 +42,8 @@ class CountError(FormatError):
 
 
 class UnknownNameError(FormatError):
-    """A name (bone, joint, key) that the file or skeleton does not define."""
+    """A name (bone, joint, key, channel) that the file or skeleton does not define, whether it
+    comes from a file (with its line) or from an argument (without)."""
 
 
 class DuplicateError(FormatError):
@@ -59,7 +60,3 @@ class SequenceError(FormatError):
 
 class TruncatedError(MissingError):
     """The file ends before its last record is complete."""
-
-
-class HierarchyError(FormatError):
-    """A skeleton hierarchy that is not a tree over all bones from the root."""

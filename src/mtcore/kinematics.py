@@ -12,17 +12,8 @@ import numpy as np
 from ._cdata import c_array
 from ._mtcore import lib
 from ._parallel import even_bounds, run_ranges, thread_count
-from .rotations import _sequence_matrices, matrices_to_euler, matrices_to_quaternions
 
-__all__ = [
-    "DOFS",
-    "JointTree",
-    "axis_rotations",
-    "euler_angles",
-    "euler_matrices",
-    "forward_kinematics",
-    "rotations_to_quaternions",
-]
+__all__ = ["DOFS", "JointTree", "forward_kinematics"]
 
 DOFS = {
     "rx": lib.MT_DOF_RX,
@@ -88,6 +79,7 @@ class JointTree:
 
     @property
     def joints(self) -> int:
+        """The number of joints."""
         return len(self.parent)
 
 
@@ -128,39 +120,3 @@ def forward_kinematics(
 
     run_ranges(lambda begin, end: lib.mt_forward_kinematics(*args, begin, end, *outs), bounds, "mt_forward_kinematics")
     return positions, world_out, local_out
-
-
-def axis_rotations(axes: str, angles, scale: float = 1.0) -> np.ndarray:
-    """The 3x3 rotation of rotations about ``axes`` (letters such as "XYZ") by
-    ``angles`` times ``scale`` radians, applied in that order about fixed axes."""
-    codes = _axis_codes(axes)
-    angles = _doubles(angles)
-    if angles.shape != (len(codes),):
-        raise ValueError(f"{len(codes)} axes but {len(angles)} angles")
-    return _sequence_matrices(angles[None], codes, False, scale)[0]
-
-
-def _axis_codes(axes: str) -> list[int]:
-    try:
-        return [DOFS["r" + a.lower()] for a in axes]
-    except KeyError:
-        raise ValueError(f"axes must be letters x, y, z, got {axes!r}") from None
-
-
-def euler_matrices(angles: np.ndarray, axes: str) -> np.ndarray:
-    """(..., 3, 3) rotations of angles (..., len(axes)) in radians about ``axes``
-    (letters such as "xyz", any number of them), applied in that order about fixed axes."""
-    codes = _axis_codes(axes)
-    angles = _doubles(angles)
-    if angles.shape[-1:] != (len(codes),):
-        raise ValueError(f"angles must end in an axis of {len(codes)} (one per axis), got shape {angles.shape}")
-    return _sequence_matrices(angles, codes, False, 1.0)
-
-
-def euler_angles(matrices: np.ndarray, axes: str) -> np.ndarray:
-    """The angles (..., 3) in radians about ``axes`` (one of mtcore.rotations.ORDERS) applied
-    in that order about fixed axes, of rotations (..., 3, 3): ``matrices_to_euler``, extrinsic."""
-    return matrices_to_euler(matrices, axes, extrinsic=True)
-
-
-rotations_to_quaternions = matrices_to_quaternions

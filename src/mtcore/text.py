@@ -8,17 +8,23 @@ and columns.
 
 from __future__ import annotations
 
+import itertools
+import mmap
 import re
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
+from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._parallel import run_all, thread_count
 from ._status import check
 from .errors import SequenceError
 
-__all__ = ["format_frames", "format_number", "format_table", "scan_frames", "scan_table"]
+Text = bytes | mmap.mmap  # text to scan: read into memory, or mapped from its file
+
+__all__ = ["format_frames", "format_number", "format_table", "frame_line", "line_breaks", "scan_frames", "scan_table"]
 
 _FORMAT_CHUNK = 2048  # frames per C call when writing: bounds the text buffer
 
@@ -44,7 +50,7 @@ class _KeyTable:
         self.n = len(keys)
 
 
-def _line_text(text: bytes, offset: int) -> str:
+def _line_text(text: Text, offset: int) -> str:
     end = len(text)
     for stop in (b"\n", b"\r"):
         found = text.find(stop, offset)
@@ -54,7 +60,7 @@ def _line_text(text: bytes, offset: int) -> str:
 
 
 def scan_frames(
-    text: bytes,
+    text: Text,
     keys: Sequence[bytes],
     offsets: Sequence[int],
     counts: Sequence[int],
@@ -84,8 +90,8 @@ def scan_frames(
     capacities = [(stop - begin) // least + 1 for begin, stop in pieces]
     bases = np.cumsum([0, *capacities]).tolist()
     values = np.empty((bases[-1], channels))
-    reports = [ffi.new("struct mt_scan_report *") for _ in pieces]
-    with ffi.from_buffer(text) as c_text, ffi.from_buffer("double[]", values) as c_values:
+    reports: list[Any] = [ffi.new("struct mt_scan_report *") for _ in pieces]  # structs: fields by name
+    with ffi.from_buffer(text) as c_text, c_array(values) as c_values:
 
         def piece(i: int):
             begin, stop = pieces[i]
@@ -104,13 +110,13 @@ def scan_frames(
             )
 
         statuses = run_all([piece(i) for i in range(len(pieces))])
-    frames = 0
+    frames, first = 0, 0
     for (begin, _), base, report, status in zip(pieces, bases, reports, statuses):
         check(status, "mt_scan_frames", _describer(text, start, begin, table, report, noun))
         if frames and report.frames and report.first_frame != first + frames:
             raise SequenceError(
                 f"frame number {report.first_frame} out of sequence: expected {first + frames}",
-                _line_breaks(text, start, begin) + 1,
+                line_breaks(text, start, begin) + 1,
             )
         if not frames:
             first = report.first_frame
@@ -125,35 +131,55 @@ def scan_frames(
 
 
 _PIECE_BYTES = 1 << 20  # below this a text is scanned in one piece
-_FRAME_LINE = re.compile(rb"[\r\n][ \t]*\d+[ \t]*(?=[\r\n])")
+_FRAME_LINE = re.compile(rb"(?:^|(?<=[\r\n]))[ \t]*\d+[ \t]*(?:\r\n|[\r\n]|\Z)")
+
+
+def frame_line(text: Text, start: int = 0, end: int | None = None, *, last: bool = False) -> int:
+    """The offset of the first (with ``last``, the last) line that begins within ``text[start:end]``
+    and holds only a frame number, or -1.  Lines end in LF, CRLF or CR."""
+    end = len(text) if end is None else end
+    if not last:
+        match = _FRAME_LINE.search(text, start, end)
+        return -1 if match is None else match.start()
+    window = 4096  # a frame is a few dozen lines: look back a window at a time, not over all of text
+    while True:
+        low = max(start, _line_start(text, max(start, end - window)))
+        hits = [m.start() for m in _FRAME_LINE.finditer(text, low, end)]
+        if hits or low == start:
+            return hits[-1] if hits else -1
+        window *= 2
+
+
+def _line_start(text: Text, offset: int) -> int:
+    """The offset of the start of the line holding ``offset``."""
+    return max(text.rfind(b"\n", 0, offset), text.rfind(b"\r", 0, offset)) + 1
 
 
 def _piece_count(workers: int | None, size: int) -> int:
     return max(1, min(thread_count(workers, True), size // _PIECE_BYTES))
 
 
-def _pieces(text: bytes, start: int, count: int) -> list[tuple[int, int]]:
+def _pieces(text: Text, start: int, count: int) -> list[tuple[int, int]]:
     """Byte ranges that together cover text[start:], each beginning at a frame line."""
     bounds = [start]
     for i in range(1, count):
         target = start + (len(text) - start) * i // count
-        match = _FRAME_LINE.search(text, max(target, bounds[-1]))
-        if match is None:
+        found = frame_line(text, max(target, bounds[-1]) + 1)
+        if found == -1:
             break
-        bounds.append(match.start() + 1)
+        bounds.append(found)
     bounds.append(len(text))
-    return list(zip(bounds, bounds[1:]))
+    return list(itertools.pairwise(bounds))
 
 
-def _line_breaks(text: bytes, begin: int, end: int) -> int:
-    if begin == end:
-        return 0
+def line_breaks(text: Text, begin: int = 0, end: int | None = None) -> int:
+    """The number of line ends (LF, CRLF or CR) in ``text[begin:end]``."""
     part = text[begin:end]
     return part.count(b"\n") + part.count(b"\r") - part.count(b"\r\n")
 
 
 def _describer(
-    text: bytes, start: int, begin: int, table: _KeyTable, report, noun: str
+    text: Text, start: int, begin: int, table: _KeyTable, report, noun: str
 ) -> Callable[[int], tuple[str, int, bool]]:
     """What went wrong in the piece of text that starts at ``begin`` (line numbers from ``start``)."""
 
@@ -187,7 +213,7 @@ def _describer(
             reason = f"frame number {report.found} out of sequence: expected {report.expected}"
         if truncated:
             reason += " (the file ends there: truncated?)"
-        return reason, _line_breaks(text, start, begin) + int(report.line), truncated
+        return reason, line_breaks(text, start, begin) + int(report.line), truncated
 
     return describe
 
@@ -213,7 +239,7 @@ def format_frames(
     chunk = max(1, min(frames, _FORMAT_CHUNK))
     buf = bytearray(lib.mt_format_bound(chunk, table.c_lens, table.c_counts, table.n))
     written = ffi.new("size_t *")
-    with ffi.from_buffer("double[]", values) as c_values, ffi.from_buffer(buf) as c_buf:
+    with c_array(values) as c_values, ffi.from_buffer(buf) as c_buf:
         for f0 in range(0, frames, chunk):
             n = min(chunk, frames - f0)
             status = lib.mt_format_frames(
@@ -245,8 +271,8 @@ def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers:
         raise ValueError(f"start must be within the text's {len(text)} bytes, got {start}")
     values = np.empty((rows, columns))
     pieces = _table_pieces(text, start, rows, _piece_count(workers, len(text) - start))
-    reports = [ffi.new("struct mt_scan_report *") for _ in pieces]
-    with ffi.from_buffer(text) as c_text, ffi.from_buffer("double[]", values) as c_values:
+    reports: list[Any] = [ffi.new("struct mt_scan_report *") for _ in pieces]  # structs: fields by name
+    with ffi.from_buffer(text) as c_text, c_array(values) as c_values:
 
         def piece(i: int):
             begin, stop, first_row, count = pieces[i]
@@ -258,9 +284,9 @@ def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers:
     for (begin, _, _, count), report, status in zip(pieces, reports, statuses):
         if status == lib.MT_OK:
             continue
-        lines_before = _line_breaks(text, start, begin)
+        lines_before = line_breaks(text, start, begin)
 
-        def describe(code: int, report=report, begin=begin, count=count) -> tuple[str, int, bool]:
+        def describe(code: int, report=report, begin=begin, lines_before=lines_before) -> tuple[str, int, bool]:
             line, at = _line_text(text, begin + report.offset), lines_before + report.line
             if code == lib.MT_ESYNTAX:
                 tokens = line.split()
@@ -324,7 +350,7 @@ def format_table(values: np.ndarray, write: Callable[[bytes], object]) -> None:
     chunk = max(1, min(rows, _FORMAT_CHUNK))
     buf = bytearray(chunk * (columns * (lib.MT_NUMBER_MAX + 1) + 1))
     written = ffi.new("size_t *")
-    with ffi.from_buffer("double[]", values) as c_values, ffi.from_buffer(buf) as c_buf:
+    with c_array(values) as c_values, ffi.from_buffer(buf) as c_buf:
         for r0 in range(0, rows, chunk):
             n = min(chunk, rows - r0)
             check(lib.mt_format_table(c_values + r0 * columns, n, columns, c_buf, len(buf), written), "mt_format_table")
@@ -334,4 +360,4 @@ def format_table(values: np.ndarray, write: Callable[[bytes], object]) -> None:
 def format_number(value: float) -> str:
     """The shortest text that reads back as exactly ``value`` (``%g`` style: 17.8693, 1e-05, 3)."""
     buf = ffi.new("char[]", lib.MT_NUMBER_MAX)
-    return ffi.unpack(buf, lib.mt_format_double(float(value), buf)).decode("ascii")
+    return bytes(ffi.buffer(buf, lib.mt_format_double(float(value), buf))).decode("ascii")

@@ -1,0 +1,52 @@
+"""Takes by file name: the reader and writer a suffix stands for, chosen in this one place."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from .amc import read_amc, skeleton_path_for, write_amc
+from .asf import read_asf
+from .bvh import read_bvh, write_bvh
+from .motion import Motion
+
+TAKE_SUFFIXES = (".amc", ".bvh")
+CONVENTIONS = {".amc": "asf", ".bvh": "bvh"}  # the skeleton convention a take file holds
+
+
+def take_suffix(path: str | os.PathLike) -> str:
+    """The lower-case suffix of a take file (.amc or .bvh); ValueError naming the file otherwise."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in TAKE_SUFFIXES:
+        raise ValueError(f"{os.fspath(path)}: a take's file name must end in .amc or .bvh")
+    return suffix
+
+
+def skeleton_for(path: str | os.PathLike, asf: str | os.PathLike | None = None) -> Path:
+    """The ASF of an AMC take: ``asf`` when given, else the one beside it by the CMU/HDM05 naming."""
+    if asf is not None:
+        return Path(asf)
+    return skeleton_path_for(path)
+
+
+def read_take(path: str | os.PathLike, asf: str | os.PathLike | None = None, frame_rate: float | None = None) -> Motion:
+    """The motion of an AMC (with its skeleton: ``asf``, or the ASF found beside it) or a BVH file."""
+    suffix = take_suffix(path)
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"{os.fspath(path)}: no such file")
+    if suffix == ".bvh":
+        return read_bvh(path)
+    return read_amc(path, read_asf(skeleton_for(path, asf)), frame_rate=frame_rate)
+
+
+def write_take(motion: Motion, path: str | os.PathLike) -> None:
+    """Write a motion in the format its suffix names; a motion of the other convention is refused
+    (``motiontheater convert`` turns one into the other)."""
+    suffix = take_suffix(path)
+    if motion.skeleton.convention != CONVENTIONS[suffix]:
+        other = ".bvh" if suffix == ".amc" else ".amc"
+        raise ValueError(
+            f"{os.fspath(path)}: this is a motion of a {motion.skeleton.convention.upper()} skeleton, written as "
+            f"{other}; name the output {other}, or convert it first (motiontheater convert)"
+        )
+    (write_bvh if suffix == ".bvh" else write_amc)(motion, path)

@@ -1,0 +1,110 @@
+"""Interpolators over frame ranges (the CS838 interpolators) and the 3-frame median "cut" filter.
+
+An interpolator replaces the frames strictly between two key frames A and B
+by interpolating the keys.  Rotation interpolators work on joints with three
+rotation channels, through unit quaternions (:mod:`mtcore.rotations`, in C,
+one call per Euler convention for all joints and frames at once); other
+channels interpolate linearly.  Each is a registered step (``slerp``,
+``euler``, ``expmap``, ``aligned_expmap``, ``median3``), so they stack in a
+:class:`~motiontheater.pipeline.Pipeline`.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import numpy as np
+
+from mtcore import median_filter1d
+from mtcore import rotations as rot
+
+from .motion import Motion
+from .registry import Joints, register
+
+INTERPOLATORS = {
+    "slerp": "interpolate rotations along the shorter arc between the keys (SLERP)",
+    "euler": "interpolate the stored Euler angles linearly between the keys",
+    "expmap": "interpolate exponential maps (rotation vectors) linearly between the keys",
+    "aligned_expmap": "interpolate exponential maps between the keys, the first flipped to take the short way",
+}
+
+
+def interpolate(
+    motion: Motion,
+    method: str = "slerp",
+    *,
+    frames: Annotated[tuple[int, int], "the key frames A:B; the frames between them are replaced"],
+    joints: Annotated[Joints, "joints to interpolate, comma-separated (default: all)"] = None,
+) -> Motion:
+    """A new motion whose frames strictly between the keys interpolate them.
+
+    ``method`` is "slerp" (quaternions, the short arc), "euler" (linear on
+    the stored angles), "expmap" (linear on exponential maps) or
+    "aligned_expmap" (the first key flipped to the second key's hemisphere,
+    so that it too takes the short way).  Joints with other than three
+    rotation channels, and every translation, interpolate linearly.  The
+    Euler angles written continue from the first key (no 360-degree jumps).
+    """
+    if method not in INTERPOLATORS:
+        raise ValueError(f"method must be one of {', '.join(INTERPOLATORS)}, got {method!r}")
+    a, b = _keys(motion, frames)
+    skeleton = motion.skeleton
+    chosen = skeleton.joint_names if joints is None else tuple(joints)
+    columns = [c for joint in chosen for c in motion.columns(joint)]
+    groups = [] if method == "euler" else skeleton.euler_groups(chosen)
+    turned = {int(c) for _, _, cols in groups for c in cols.ravel()}
+    linear = [c for c in columns if c not in turned]
+    values = motion.values.copy()
+    t = (np.arange(a + 1, b) - a) / (b - a)
+    values[a + 1 : b, linear] = values[a, linear] + t[:, None] * (values[b, linear] - values[a, linear])
+    degrees = skeleton.angle_unit == "deg"
+    for order, extrinsic, cols in groups:
+        keys = rot.euler_to_quaternions(values[[a, b]][:, cols], order, extrinsic=extrinsic, degrees=degrees)
+        if method == "slerp":
+            q = rot.slerp(keys[0], keys[1], t[:, None])
+        else:
+            v = rot.quaternions_to_rotvecs(keys)
+            q = rot.rotvecs_to_quaternions(
+                rot.interpolate_rotvecs(v[0], v[1], t[:, None], aligned=method == "aligned_expmap")
+            )
+        angles = rot.quaternions_to_euler(q, order, extrinsic=extrinsic, degrees=degrees)
+        # of the equivalent Euler triples, each frame's nearest the one before, from the first key on
+        path = rot.unroll_euler(np.concatenate([values[a : a + 1, cols], angles]), order, degrees=degrees)
+        values[a + 1 : b, cols] = path[1:]
+    values.flags.writeable = False
+    return motion.replace(values=values)
+
+
+def median3(
+    motion: Motion,
+    *,
+    joints: Annotated[Joints, "joints to filter, comma-separated (default: all)"] = None,
+) -> Motion:
+    """The 3-frame median "cut" filter of CS838 on the stored values (edges held).
+
+    Unlike the ``median`` step it does not unwrap angles first: it is the
+    editor's quick fix for single-frame glitches, on the numbers as stored.
+    Give ``frames`` to filter a range only.
+    """
+    chosen = motion.skeleton.joint_names if joints is None else tuple(joints)
+    columns = [c for joint in chosen for c in motion.columns(joint)]
+    values = motion.values.copy()
+    values[:, columns] = median_filter1d(values[:, columns], 3, axis=0, mode="nearest")
+    values.flags.writeable = False
+    return motion.replace(values=values)
+
+
+def _keys(motion: Motion, frames: tuple[int, int]) -> tuple[int, int]:
+    """The rows of the key frames; ValueError unless they lie in the motion, the first before the last."""
+    first, last = frames
+    if not motion.first_frame <= first < last <= motion.last_frame:
+        raise ValueError(
+            f"the key frames {first}:{last} must lie within the motion's frames "
+            f"{motion.first_frame}..{motion.last_frame}, the first before the last"
+        )
+    return first - motion.first_frame, last - motion.first_frame
+
+
+for _method, _summary in INTERPOLATORS.items():
+    register(_method, interpolate, _summary, frames="own", fixed={"method": _method})
+register("median3", median3, "the CS838 3-frame median filter on the stored values")
