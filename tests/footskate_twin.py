@@ -644,7 +644,18 @@ def cleanup(chains, hips, parents, angles, points, planted, targets, clearance, 
     out = np.stack(
         [
             solve_leg(
-                c, hips[i], parents[i], angles[i], points[i], planted[i], p[1], p[2], p[3], p[5], root, clearance[i],
+                c,
+                hips[i],
+                parents[i],
+                angles[i],
+                points[i],
+                planted[i],
+                p[1],
+                p[2],
+                p[3],
+                p[5],
+                root,
+                clearance[i],
                 options,
             )
             for i, (c, p) in enumerate(zip(chains, plans))

@@ -262,6 +262,46 @@ def _combine(args: argparse.Namespace) -> int:
     return 0
 
 
+def _ground_options(parser: argparse.ArgumentParser) -> None:
+    """The flags of the footskate verbs (skate, contacts): they are the cleanup step's."""
+    cleanup = {o.name: o for o in lookup("cleanup").options}
+    for name in ("floor", "up", "legs", "meters_per_unit"):
+        option = cleanup[name]
+        parser.add_argument(
+            option.flag,
+            dest=name,
+            type=option.parse,
+            metavar=option.metavar,
+            choices=option.choices or None,
+            help=option.help,
+        )
+
+
+def _skate(args: argparse.Namespace) -> int:
+    from .skate import skate_metrics
+
+    motion = read_take(args.input, args.asf, args.frame_rate)
+    report = skate_metrics(
+        motion, args.contacts, legs=args.legs, up=args.up, floor=args.floor, meters_per_unit=args.meters_per_unit
+    )
+    print(report.to_json() if args.json else report.text())
+    return 0
+
+
+def _contacts(args: argparse.Namespace) -> int:
+    from .footskate import contacts_of, prepare
+
+    target = _output(args)
+    motion = read_take(args.input, args.asf, args.frame_rate)
+    arrays, ground, mpu = prepare(
+        motion, legs=args.legs, up=args.up, floor=args.floor, meters_per_unit=args.meters_per_unit
+    )
+    table = contacts_of(None, motion, arrays, ground, mpu)
+    table.to_csv(target)
+    print(f"contacts: {len(table)} plants in {motion.frames} frames of {args.input}: wrote {target}")
+    return 0
+
+
 def _step_verb(verbs: Any, step: Step) -> None:
     """The verb of a registered step: ``motiontheater NAME TAKE -o OUT --option ...``."""
     what = "the file to write (" + (", ".join(step.suffixes) if step.is_exporter else ".amc or .bvh") + ")"
@@ -417,6 +457,42 @@ def build_parser() -> argparse.ArgumentParser:
     recipe.add_argument("-o", "--output", help="the take to write (.amc or .bvh, as the motions)")
     recipe.add_argument("--dry-run", action="store_true", help="print the frame maps and borders, write nothing")
     recipe.set_defaults(run=_combine)
+
+    skating = verbs.add_parser(
+        "skate",
+        help="measure footskate: sliding, skating ratio, penetration and float of each foot",
+        description=(
+            "Measure how much a take's planted feet slide (mm from where each plant began), how often "
+            "they skate (the motion-generation papers' ratio, and the same over planted frames), how "
+            "deep they go below the floor and how high planted points float. The plants are detected "
+            "unless --contacts gives a table; the floor is fitted unless --floor gives its level. "
+            "Prints a Markdown table, or JSON."
+        ),
+        epilog="Example: motiontheater skate 07_05-walk.amc --json",
+    )
+    skating.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    skating.add_argument("--contacts", metavar="FILE", help="the footplants CSV to measure on (default: detected)")
+    skating.add_argument("--json", action="store_true", help="print JSON")
+    _ground_options(skating)
+    _take_options(skating)
+    skating.set_defaults(run=_skate)
+
+    plants = verbs.add_parser(
+        "contacts",
+        help="detect the footplants of a take and write them as a CSV table to read and edit",
+        description=(
+            "Detect when each foot's heel and ball stand on the floor (height above rest and speed, "
+            "with hysteresis) and write the table: one row per plant, foot,point,first,last (frame "
+            "numbers, both included). Edit it (delete a row, add one) and give it back to cleanup "
+            "with --contacts."
+        ),
+        epilog="Example: motiontheater contacts 07_05-walk.amc -o plants.csv",
+    )
+    plants.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    _output_options(plants, "the CSV file to write")
+    _ground_options(plants)
+    _take_options(plants)
+    plants.set_defaults(run=_contacts)
 
     timing = verbs.add_parser(
         "bench",

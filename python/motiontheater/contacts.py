@@ -36,9 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mtcore.errors import FormatError, UnknownNameError
-
 from ._io import Source, decode, encode, output, read_source
+from .errors import FormatError, UnknownNameError
 from .legs import Legs, body_scale, speeds
 
 PLANT_POINTS = ("heel", "ball")
@@ -99,6 +98,7 @@ class Contacts:
         return len(self.plants)
 
     def of(self, foot: str, point: str | None = None) -> tuple[Plant, ...]:
+        """The plants of a foot (its ankle joint's name), of one point or both."""
         return tuple(p for p in self.plants if p.foot == foot and (point is None or p.point == point))
 
     def masks(self, legs: Legs) -> np.ndarray:
@@ -112,9 +112,9 @@ class Contacts:
                     f"the contacts name foot '{p.foot}', which is not a foot of this skeleton "
                     f"({', '.join(legs.feet)}): are they for another take?"
                 )
-            out[feet[p.foot], p.first - self.first_frame : p.last - self.first_frame + 1, PLANT_POINTS.index(p.point)] = (
-                True
-            )
+            out[
+                feet[p.foot], p.first - self.first_frame : p.last - self.first_frame + 1, PLANT_POINTS.index(p.point)
+            ] = True
         return out
 
     @classmethod
@@ -251,8 +251,8 @@ def detect_masks(
     firm = (heights < th.enter_height * unit) & (speed < min(th.enter_speed * unit, fastest)) | sure
     slow = speed < th.merge_speed / meters_per_unit
     rise = th.rise * unit
-    gap = int(round(th.gap * frame_rate))
-    shortest = int(round(th.min_length * frame_rate))
+    gap = round(th.gap * frame_rate)
+    shortest = round(th.min_length * frame_rate)
     n = heights.shape[-1]
     rows = [a.reshape(-1, n) for a in (heights, close, firm, sure, slow)]
     out = np.zeros(rows[0].shape, bool)

@@ -40,16 +40,16 @@ thresholds of detection are in metres and m/s, converted with the skeleton's
 
 from __future__ import annotations
 
+import itertools
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from mtcore.errors import UnknownNameError
 from mtcore.kinematics import forward_kinematics
 
-from .kinematics import joint_tree
+from .errors import UnknownNameError
 from .motion import Motion
 from .skeleton import ROTATIONS, Skeleton
 
@@ -79,6 +79,7 @@ class Leg:
 
     @property
     def joints(self) -> tuple[str, ...]:
+        """The leg's joints, hip to toe."""
         return (self.hip, self.knee, self.ankle) + ((self.toe,) if self.toe else ())
 
 
@@ -163,16 +164,22 @@ def find_legs(skeleton: Skeleton, names: Sequence[str] | None = None) -> tuple[L
 
 
 def _find_leg(skeleton: Skeleton, side: str) -> Leg:
-    ankles = [b.name for b in skeleton.bones if not b.end_site and _side_part(b.name, side, _PARTS["ankle"])]
+    named = [b.name for b in skeleton.bones if not b.end_site and _side_part(b.name, side, _PARTS["ankle"])]
+    below: list[str | None] = list(named)
     if skeleton.convention != "bvh":
         # an ASF bone named after the point it ends at ("LeftFoot": knee to ankle) is a shin: its foot is below
-        ankles = [_below_if_shin(skeleton, a) for a in ankles]
-    ankles = [a for a in ankles if a is not None and _turns(skeleton, a)]
+        below = [_below_if_shin(skeleton, a) for a in named]
+    ankles = [a for a in below if a is not None and _turns(skeleton, a)]
     if not ankles:
+        why = (
+            f"'{named[0]}' is as long as a shin and has no foot below it"
+            if named
+            else f"no joint with rotation channels is named like a {side} foot or ankle "
+            f"({side[0]}foot, {side.capitalize()}Foot, {side}_ankle, ...)"
+        )
         raise ValueError(
-            f"no {side} leg in skeleton '{skeleton.name or '(unnamed)'}': no joint with rotation channels is "
-            f"named like a {side} foot or ankle ({side[0]}foot, {side.capitalize()}Foot, {side}_ankle, ...); "
-            "name the legs with legs=hip,knee,ankle[,toe] of the left leg then of the right leg (--legs)"
+            f"no {side} leg in skeleton '{skeleton.name or '(unnamed)'}': {why}; name the legs with "
+            "legs=hip,knee,ankle[,toe] of the left leg then of the right leg (--legs)"
         )
     ankle = ankles[0]
     knee = skeleton.parent(ankle)
@@ -202,54 +209,21 @@ def resolve_legs(skeleton: Skeleton, legs: Sequence[Leg] | Sequence[str] | None 
 
     ``legs``: None (find them), names as for :func:`find_legs`, or Leg objects.
     Raises ValueError when a chain is not a chain (each joint the child of the
-    one before), a hip or knee does not turn, or no heel can be derived.
+    one before), a hip or knee does not turn, or a leg joint has translation
+    channels; UnknownNameError for a joint the skeleton does not have.
     """
     if legs is None or (legs and isinstance(next(iter(legs)), str)):
         found = find_legs(skeleton, legs)  # type: ignore[arg-type]
     else:
         found = tuple(legs)  # type: ignore[arg-type]
-    names = skeleton.joint_names
-    index = {n: i for i, n in enumerate(names)}
-    bvh = skeleton.convention == "bvh"
+    index = {n: i for i, n in enumerate(skeleton.joint_names)}
     rest = skeleton.rest_positions()
+    for leg in found:
+        _check_chain(skeleton, leg)
     down = _rest_down(rest, found, index, skeleton)
     rotators, points, segments, parents = [], [], [], []
     for leg in found:
-        for name in leg.joints:
-            if name not in index or name == "root":
-                raise UnknownNameError(f"no joint '{name}' in skeleton '{skeleton.name}' (legs)")
-        chain = list(leg.joints)
-        for upper, lower in zip(chain, chain[1:]):
-            if skeleton.parent(lower) != upper:
-                raise ValueError(f"{leg.side} leg: '{lower}' is not a child of '{upper}' (legs must be chains)")
-        for name, what in ((leg.hip, "hip"), (leg.knee, "knee")):
-            if not _turns(skeleton, name):
-                raise ValueError(f"{leg.side} leg: the {what} '{name}' has no rotation channels")
-        for name in chain:
-            extra = [d for d in skeleton.dofs(name) if d not in ROTATIONS]
-            if extra:
-                raise ValueError(
-                    f"{leg.side} leg: '{name}' has translation or stretch channels ({', '.join(extra)}): "
-                    "footskate cleanup turns leg joints only"
-                )
-
-        def start(name: str) -> int:
-            return index[name] if bvh else index[skeleton.parent(name)]
-
-        def end(name: str) -> int:
-            if not bvh:
-                return index[name]
-            kids = skeleton.children(name)
-            following = [k for k in kids if k in chain] or [k for k in kids if not _is_heel(k)]
-            return index[following[0]] if following else -1
-
-        hip, knee, ankle = start(leg.hip), start(leg.knee), start(leg.ankle)
-        ball = start(leg.toe) if leg.toe else end(leg.ankle)
-        if ball < 0:
-            raise ValueError(f"{leg.side} leg: the foot '{leg.ankle}' has no end point (a toe or End Site) for a ball")
-        tip = end(leg.toe) if leg.toe else -1
-        heels = [c for c in skeleton.children(leg.ankle) if _is_heel(c)]
-        heel = index[heels[0]] if heels else -1  # ASF: the heel bone's end; BVH: the heel joint
+        hip, knee, ankle, ball, tip, heel = _points_of(skeleton, index, leg)
         foot = rest[ball] - rest[ankle]
         if heel >= 0:
             heel_vector = rest[heel] - rest[ankle]
@@ -278,6 +252,50 @@ def resolve_legs(skeleton: Skeleton, legs: Sequence[Leg] | Sequence[str] | None 
         np.array(segments, float),
         np.array(parents, np.int64),
     )
+
+
+def _check_chain(skeleton: Skeleton, leg: Leg) -> None:
+    for name in leg.joints:
+        if name == "root":
+            raise UnknownNameError(f"the root cannot be a leg joint ({leg.side} leg)")
+        skeleton.bone(name)  # UnknownNameError names it
+    chain = leg.joints
+    for upper, lower in itertools.pairwise(chain):
+        if skeleton.parent(lower) != upper:
+            raise ValueError(f"{leg.side} leg: '{lower}' is not a child of '{upper}' (legs must be chains)")
+    for name, what in ((leg.hip, "hip"), (leg.knee, "knee")):
+        if not _turns(skeleton, name):
+            raise ValueError(f"{leg.side} leg: the {what} '{name}' has no rotation channels")
+    for name in chain:
+        extra = [d for d in skeleton.dofs(name) if d not in ROTATIONS]
+        if extra:
+            raise ValueError(
+                f"{leg.side} leg: '{name}' has translation or stretch channels ({', '.join(extra)}): "
+                "footskate cleanup turns leg joints only"
+            )
+
+
+def _points_of(skeleton: Skeleton, index: dict[str, int], leg: Leg) -> tuple[int, int, int, int, int, int]:
+    """Indices in Motion.positions() of a leg's hip, knee, ankle, ball, toe tip and heel (-1: none):
+    in ASF a bone's end point, in BVH a joint's own position."""
+    bvh = skeleton.convention == "bvh"
+
+    def start(name: str) -> int:  # where the segment a joint turns begins
+        return index[name] if bvh else index[skeleton.parent(name)]
+
+    def end(name: str) -> int:  # where it ends
+        if not bvh:
+            return index[name]
+        kids = skeleton.children(name)
+        following = [k for k in kids if k in leg.joints] or [k for k in kids if not _is_heel(k)]
+        return index[following[0]] if following else -1
+
+    ball = start(leg.toe) if leg.toe else end(leg.ankle)
+    if ball < 0:
+        raise ValueError(f"{leg.side} leg: the foot '{leg.ankle}' has no end point (a toe or End Site) for a ball")
+    heels = [c for c in skeleton.children(leg.ankle) if _is_heel(c)]
+    heel = index[heels[0]] if heels else -1  # ASF: the heel bone's end; BVH: the heel joint
+    return start(leg.hip), start(leg.knee), start(leg.ankle), ball, end(leg.toe) if leg.toe else -1, heel
 
 
 def _is_heel(name: str) -> bool:
@@ -317,6 +335,7 @@ def parse_up(up: str) -> np.ndarray:
 
 
 def axis_name(v: np.ndarray) -> str:
+    """The name of the signed coordinate axis nearest to v: "y", "-z"..."""
     axis = int(np.argmax(np.abs(v)))
     return ("-" if v[axis] < 0 else "") + "xyz"[axis]
 
@@ -358,12 +377,12 @@ def _upper_tree(tree, keep: list[int]):
         cols.extend(tree.dof_column[a:b])
         starts.append(len(kinds))
     return JointTree(
-        parent=[new[p] if p >= 0 else -1 for p in tree.parent[keep]],
-        order=[new[j] for j in tree.order if j in new],
+        parent=np.array([new[p] if p >= 0 else -1 for p in tree.parent[keep]]),
+        order=np.array([new[j] for j in tree.order if j in new]),
         axis=tree.axis[keep],
         direction=tree.direction[keep],
         segment=tree.segment[keep],
-        dof_start=starts,
+        dof_start=np.array(starts),
         dof_kind=np.array(kinds, np.intc),
         dof_column=np.array(cols, np.uintp),
         angle_scale=tree.angle_scale,
@@ -394,6 +413,7 @@ def _upper_kinematics(values: np.ndarray, tree, legs: Legs) -> tuple[np.ndarray,
     for start in range(0, frames, _CHUNK):
         stop = min(start + _CHUNK, frames)
         positions, world, _ = forward_kinematics(values[start:stop], upper, world=True, workers=1)
+        assert world is not None
         hips[:, start:stop] = positions[:, hip_rows].transpose(1, 0, 2)
         parents[:, start:stop] = world[:, parent_rows].transpose(1, 0, 2, 3)
     return hips, parents
@@ -409,7 +429,7 @@ def leg_arrays(
     from mtcore import footskate as kernels
 
     skeleton = motion.skeleton
-    tree = joint_tree(skeleton)
+    tree = skeleton.tree
     hips, parents = _upper_kinematics(motion.values, tree, legs)
     n = len(legs)
     columns = np.full((n, 4, 3), -1, np.int64)
@@ -438,7 +458,7 @@ def leg_arrays(
         partial = LegArrays(legs, chains_of(segments), hips, parents, angles, columns, points, tree.angle_scale)
         mpu = skeleton.meters_per_unit if meters_per_unit is None else meters_per_unit
         direction = choose_up(partial, up)
-        for i in np.flatnonzero(missing):
+        for i in map(int, np.flatnonzero(missing)):
             segments[i, 3] = _heel_from_take(points[i], feet[i], direction, motion.frame_rate, mpu, legs, i)
         legs = Legs(legs.skeleton, legs.legs, legs.rotators, legs.points, segments, legs.parents)
     chains = chains_of(legs.segments)
@@ -525,6 +545,7 @@ class Ground:
 
     @property
     def tilt_degrees(self) -> float:
+        """How far the floor leans from level, in degrees."""
         return float(np.degrees(np.arctan(np.linalg.norm(self.slope))))
 
 
@@ -562,7 +583,7 @@ def fit_ground(
     speed = speeds(contact.transpose(0, 2, 1, 3), frame_rate).transpose(0, 2, 1) * meters_per_unit
     vertical = contact @ up_vector
     resting = speed < _REST_SPEED * scale
-    needed = max(3, int(round(0.05 * frame_rate)))
+    needed = max(3, round(0.05 * frame_rate))
     for i in range(len(legs)):  # a point that never rests (a run on the balls): its slowest low frames
         for k in range(3):
             if resting[i, :, k].sum() < needed:
@@ -585,7 +606,7 @@ def fit_ground(
             for k in range(3):
                 if resting[i, :, k].any():
                     clearance[i, k] = max(0.0, float(np.median(vertical[i, resting[i, :, k], k])) - floor)
-        return Ground(tuple(up_vector), float(floor), (0.0, 0.0, 0.0), clearance)
+        return Ground(_triple(up_vector), float(floor), (0.0, 0.0, 0.0), clearance)
     where = np.flatnonzero(resting)
     if len(where) > _FIT_SAMPLES:  # a long take: evenly spaced samples tell the plane as well
         where = where[:: -(-len(where) // _FIT_SAMPLES)]
@@ -618,4 +639,8 @@ def fit_ground(
     clearance = np.nan_to_num(rests.reshape(len(legs), 3) - base)
     clearance[~has_tip, 2] = clearance[~has_tip, 1]
     level = base - float(slope[horizontal_axes] @ centre)
-    return Ground(tuple(up_vector), level, tuple(slope), clearance)
+    return Ground(_triple(up_vector), level, _triple(slope), clearance)
+
+
+def _triple(v: np.ndarray) -> tuple[float, float, float]:
+    return float(v[0]), float(v[1]), float(v[2])

@@ -1,33 +1,39 @@
 """Footskate metrics of a take: how much its planted feet slide, sink and float, and how often they skate.
 
-Per foot (its heel and ball; heights are above where each point rests, see
-:mod:`motiontheater.legs`):
+Per foot, over its heel and ball (heights are above where each point rests
+on the floor, see :mod:`motiontheater.legs`; plants are a contacts table,
+detected unless given):
 
-- ``plants``: footplants of the heel and of the ball;
+- ``plants``: the footplants of the heel and of the ball;
 - ``sliding_mean_mm``, ``sliding_max_mm``: over every planted frame, the
-  horizontal distance of the planted point from where it was at the plant's
+  horizontal distance of the planted point from where it was at its plant's
   first frame;
-- ``skating_ratio``: the share of frame steps t -> t+1 (frames - 1 of them) in
-  which the foot skates, as motion-generation papers count it: a point within
-  5 cm of the floor at t and t+1 whose horizontal speed and that speed's
-  moving average over 5 frames at 20 Hz (0.25 s, rescaled to the take's
-  frame rate) both exceed 0.5 m/s;
-- ``penetration_mm``: the deepest any of its heel, ball and toe tip goes below
-  where it rests, over all frames;
+- ``skating_ratio``: the share of frame steps t -> t+1 (frames - 1 of them)
+  in which the foot skates, as motion-generation papers count it (GMD,
+  OmniControl): a point within 5 cm of the floor at t and t+1 whose
+  horizontal speed and that speed's moving average (5 frames at the papers'
+  20 Hz, i.e. 0.25 s at the take's rate) both exceed 0.5 m/s.  Real walks
+  score 20-40 % on it: a swinging foot passes the floor lower than 5 cm and
+  faster than 0.5 m/s.  ``planted_skating_ratio`` counts only steps where the
+  point is planted at t and t+1: the skating a cleanup can remove;
+- ``penetration_mm``: the deepest any of its heel, ball and toe tip goes
+  below where it rests, over all frames;
 - ``float_mm``: the mean height of planted points over their plants.
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+import os
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from .contacts import PLANT_POINTS, Contacts, runs
-from .footskate import _contacts, prepare
+from .footskate import contacts_of, prepare
 from .legs import Ground, LegArrays, Legs
 from .motion import Motion
+from .registry import Joints
 
 SKATE_HEIGHT = 0.05  # m
 SKATE_SPEED = 0.5  # m/s
@@ -36,53 +42,50 @@ SKATE_WINDOW = 5 / 20.0  # s: 5 frames at 20 Hz
 
 @dataclass(frozen=True)
 class FootMetrics:
+    """The metrics of one foot (see the module docstring)."""
+
     foot: str
     plants: dict[str, int]
     sliding_mean_mm: float
     sliding_max_mm: float
     skating_ratio: float
+    planted_skating_ratio: float
     penetration_mm: float
     float_mm: float
 
 
 @dataclass(frozen=True)
 class SkateReport:
-    """Metrics per foot (see the module docstring), the frames and the take's frame rate."""
+    """Metrics per foot (see the module docstring) of a take of ``frames`` frames at ``frame_rate``."""
 
     feet: tuple[FootMetrics, ...]
     frames: int
     frame_rate: float
 
+    def worst(self, name: str) -> float:
+        """The largest value of metric ``name`` (e.g. "sliding_max_mm") over the feet."""
+        return max((float(getattr(f, name)) for f in self.feet), default=0.0)
+
     def as_dict(self) -> dict:
-        return {
-            "frames": self.frames,
-            "frame_rate": self.frame_rate,
-            "feet": [
-                {
-                    "foot": f.foot,
-                    "plants": f.plants,
-                    "sliding_mean_mm": f.sliding_mean_mm,
-                    "sliding_max_mm": f.sliding_max_mm,
-                    "skating_ratio": f.skating_ratio,
-                    "penetration_mm": f.penetration_mm,
-                    "float_mm": f.float_mm,
-                }
-                for f in self.feet
-            ],
-        }
+        """The report as plain data (what ``--json`` prints)."""
+        return {"frames": self.frames, "frame_rate": self.frame_rate, "feet": [asdict(f) for f in self.feet]}
 
     def to_json(self) -> str:
+        """The report as JSON text."""
         return json.dumps(self.as_dict(), indent=2)
 
     def text(self) -> str:
+        """The report as a Markdown table."""
         lines = [
-            "| foot | plants (heel, ball) | sliding mean mm | sliding max mm | skating % | penetration mm | float mm |",
-            "|---|---|---:|---:|---:|---:|---:|",
+            "| foot | plants (heel, ball) | sliding mean mm | sliding max mm | skating % | skating planted % "
+            "| penetration mm | float mm |",
+            "|---|---|---:|---:|---:|---:|---:|---:|",
         ]
         for f in self.feet:
             lines.append(
                 f"| {f.foot} | {f.plants['heel']}, {f.plants['ball']} | {f.sliding_mean_mm:.2f} | "
-                f"{f.sliding_max_mm:.2f} | {100 * f.skating_ratio:.2f} | {f.penetration_mm:.2f} | {f.float_mm:.2f} |"
+                f"{f.sliding_max_mm:.2f} | {100 * f.skating_ratio:.2f} | {100 * f.planted_skating_ratio:.2f} | "
+                f"{f.penetration_mm:.2f} | {f.float_mm:.2f} |"
             )
         return "\n".join(lines)
 
@@ -91,54 +94,57 @@ def _horizontal(p: np.ndarray, up: np.ndarray) -> np.ndarray:
     return p - (p @ up)[..., None] * up
 
 
-def moving_average(x: np.ndarray, width: int) -> np.ndarray:
-    """Centred mean over ``width`` samples (odd), the window cut at the ends."""
+def _moving_average(x: np.ndarray, width: int) -> np.ndarray:
+    """Centred mean over ``width`` samples (odd), zeros beyond the ends (as scipy's mode 'constant')."""
     if width <= 1 or len(x) == 0:
         return x.astype(float)
     half = width // 2
-    c = np.r_[0.0, np.cumsum(x)]
-    idx = np.arange(len(x))
-    lo, hi = np.maximum(idx - half, 0), np.minimum(idx + half + 1, len(x))
-    return (c[hi] - c[lo]) / (hi - lo)
+    padded = np.r_[np.zeros(half), x, np.zeros(half)]
+    c = np.r_[0.0, np.cumsum(padded)]
+    return (c[width:] - c[:-width]) / width
 
 
-def measure(arrays: LegArrays, ground: Ground, contacts: Contacts, frame_rate: float, mpu: float) -> SkateReport:
-    """The metrics of leg arrays on a ground with a contacts table."""
+def measure(
+    arrays: LegArrays, ground: Ground, contacts: Contacts, frame_rate: float, meters_per_unit: float
+) -> SkateReport:
+    """The metrics of a take's legs (:func:`~motiontheater.legs.leg_arrays`) on a ground with a contacts table."""
     legs = arrays.legs
     up = np.asarray(ground.up)
     masks = contacts.masks(legs)
-    heights = ground.heights(arrays.points)  # (legs, frames, 3): heel, ball, tip
+    heights = ground.heights(arrays.points) * meters_per_unit  # (legs, frames, 3) heel, ball, tip, metres
     frames = arrays.points.shape[1]
-    window = max(1, int(round(SKATE_WINDOW * frame_rate)) // 2 * 2 + 1)
+    window = max(1, round(SKATE_WINDOW * frame_rate) // 2 * 2 + 1)
     feet = []
     for i, foot in enumerate(legs.feet):
         slides = []
-        for k, column in enumerate((3, 2)):
-            starts, ends = runs(masks[i, :, k])
-            p = _horizontal(arrays.points[i, :, column], up)
-            for s, e in zip(starts, ends):
-                slides.append(np.linalg.norm(p[s:e] - p[s], axis=-1))
-        slide = np.concatenate(slides) * mpu * 1000 if slides else np.zeros(0)
         skating = np.zeros(max(frames - 1, 0), bool)
+        planted_skating = skating.copy()
         for k, column in enumerate((3, 2)):
-            if frames < 2:
-                break
             p = _horizontal(arrays.points[i, :, column], up)
-            speed = np.linalg.norm(np.diff(p, axis=0), axis=-1) * frame_rate * mpu
-            low = heights[i, :, k] * mpu < SKATE_HEIGHT
-            skating |= low[:-1] & low[1:] & (speed > SKATE_SPEED) & (moving_average(speed, window) > SKATE_SPEED)
-        valid = [k for k in range(3) if k < 2 or legs.points[i, 4] >= 0]
-        depth = -np.nanmin(heights[i][:, valid]) if frames else 0.0
-        planted_heights = heights[i, :, :2][masks[i]]
+            starts, ends = runs(masks[i, :, k])
+            slides += [np.linalg.norm(p[s:e] - p[s], axis=-1) for s, e in zip(starts, ends)]
+            if frames < 2:
+                continue
+            speed = np.linalg.norm(np.diff(p, axis=0), axis=-1) * frame_rate * meters_per_unit
+            low = heights[i, :, k] < SKATE_HEIGHT
+            skates = low[:-1] & low[1:] & (speed > SKATE_SPEED) & (_moving_average(speed, window) > SKATE_SPEED)
+            skating |= skates
+            planted_skating |= skates & masks[i, :-1, k] & masks[i, 1:, k]
+        slide = np.concatenate(slides) * meters_per_unit * 1000 if slides else np.zeros(0)
+        points = [0, 1, 2] if legs.points[i, 4] >= 0 else [0, 1]
+        depth = -float(np.nanmin(heights[i][:, points])) if frames else 0.0
+        planted = heights[i, :, :2][masks[i]]
+        steps = max(frames - 1, 1)
         feet.append(
             FootMetrics(
                 foot=foot,
                 plants={point: len(contacts.of(foot, point)) for point in PLANT_POINTS},
                 sliding_mean_mm=float(slide.mean()) if len(slide) else 0.0,
                 sliding_max_mm=float(slide.max()) if len(slide) else 0.0,
-                skating_ratio=float(skating.sum() / (frames - 1)) if frames > 1 else 0.0,
-                penetration_mm=float(max(depth, 0.0) * mpu * 1000),
-                float_mm=float(np.mean(np.maximum(planted_heights, 0)) * mpu * 1000) if len(planted_heights) else 0.0,
+                skating_ratio=float(skating.sum() / steps),
+                planted_skating_ratio=float(planted_skating.sum() / steps),
+                penetration_mm=max(depth, 0.0) * 1000,
+                float_mm=float(np.mean(np.maximum(planted, 0.0))) * 1000 if len(planted) else 0.0,
             )
         )
     return SkateReport(tuple(feet), frames, frame_rate)
@@ -146,37 +152,31 @@ def measure(arrays: LegArrays, ground: Ground, contacts: Contacts, frame_rate: f
 
 def skate_metrics(
     motion: Motion,
-    contacts=None,
+    contacts: Contacts | str | os.PathLike | None = None,
     *,
-    legs=None,
+    legs: Legs | Joints = None,
     up: str | None = None,
     floor: float | None = None,
     ground: Ground | None = None,
     meters_per_unit: float | None = None,
 ) -> SkateReport:
-    """Footskate metrics of a motion (see the module docstring).  ``contacts``: a table or its
-    CSV (default: detected on this motion); ``ground``: the floor to measure against (default:
-    fitted to this motion, or level at ``floor``); the other options as for cleanup."""
-    found, arrays, fitted, mpu = prepare(motion, legs=legs, up=up, floor=floor, meters_per_unit=meters_per_unit)
-    if ground is not None:
-        fitted = ground
-    table = _contacts(contacts, motion, arrays, fitted, mpu, _default_thresholds())
-    del found
-    return measure(arrays, fitted, table, motion.frame_rate, mpu)
+    """Footskate metrics of a motion (see the module docstring).
+
+    ``contacts``: a table or its CSV (default: detected on this motion);
+    ``legs``: as for cleanup, or the :class:`~motiontheater.legs.Legs` of a
+    cleanup (``Cleanup.legs``, so that heels derived from the input are
+    kept); ``ground``: the floor to measure against (default: fitted to this
+    motion, or level at ``floor``), e.g. ``Cleanup.ground`` to measure a
+    cleaned motion against the floor it was cleaned on.
+    """
+    arrays, fitted, mpu = prepare(motion, legs=legs, up=up, floor=floor, meters_per_unit=meters_per_unit)
+    ground = fitted if ground is None else ground
+    return measure(arrays, ground, contacts_of(contacts, motion, arrays, ground, mpu), motion.frame_rate, mpu)
 
 
-def _default_thresholds():
-    from .contacts import Thresholds
-
-    return Thresholds()
-
-
-def knee_angles(arrays: LegArrays) -> np.ndarray:
-    """Each leg's knee bend (legs, frames) in degrees: the angle between thigh and shin."""
+def knee_bends(arrays: LegArrays) -> np.ndarray:
+    """Each leg's knee bend (legs, frames) in degrees: the angle between thigh and shin (0 straight)."""
     thigh = arrays.points[:, :, 0] - arrays.hips
     shin = arrays.points[:, :, 1] - arrays.points[:, :, 0]
     cos = np.sum(thigh * shin, -1) / (np.linalg.norm(thigh, axis=-1) * np.linalg.norm(shin, axis=-1))
     return np.degrees(np.arccos(np.clip(cos, -1, 1)))
-
-
-__all__ = ["FootMetrics", "SkateReport", "knee_angles", "measure", "skate_metrics", "Legs"]

@@ -29,7 +29,17 @@ from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._status import check
 
-__all__ = ["POINTS", "CleanupOptions", "LegChain", "LegPlan", "adjust_root", "cleanup", "leg_points", "plan_leg", "solve_leg"]
+__all__ = [
+    "POINTS",
+    "CleanupOptions",
+    "LegChain",
+    "LegPlan",
+    "adjust_root",
+    "cleanup",
+    "leg_points",
+    "plan_leg",
+    "solve_leg",
+]
 
 POINTS = ("knee", "ankle", "ball", "heel", "tip")
 SEGMENTS = ("thigh", "shin", "ball", "heel", "toes")
@@ -86,6 +96,7 @@ class LegChain:
         return row.index(-1) if -1 in row else 3
 
     def channels(self, joint: int) -> int:
+        """Rotation channels of joint 0-3 (hip, knee, ankle, toe)."""
         return self.count(joint, self.axes)
 
 
@@ -132,6 +143,7 @@ class CleanupOptions:
             raise ValueError(f"knee_keep must be in [0, 1], got {self.knee_keep}")
 
     def struct(self):
+        """The options as the kernels take them (``struct mt_footskate``)."""
         opt = ffi.new("struct mt_footskate *")
         opt.up = list(self.up)
         opt.slope = list(self.slope)
@@ -201,7 +213,13 @@ def leg_points(chains, hips, parents, angles, *, feet: bool = False):
     rotations = np.empty((n, frames, 3, 3)) if feet else None
     check(
         lib.mt_leg_points(
-            _leg_struct(chains), n, frames, c_array(hips), c_array(parents), c_array(angles), c_array(out),
+            _leg_struct(chains),
+            n,
+            frames,
+            c_array(hips),
+            c_array(parents),
+            c_array(angles),
+            c_array(out),
             c_array(rotations),
         ),
         "mt_leg_points",
@@ -255,14 +273,29 @@ def plan_leg(chain, angles, points, planted, targets, clearance, options: Cleanu
     if not np.isfinite(targets[planted.astype(bool)]).all():
         raise ValueError("targets must be finite where planted")
     plan = LegPlan(
-        np.empty((frames, 2, 3)), np.empty((frames, 3)), np.empty((frames, 3)), np.empty(frames), np.empty(frames),
+        np.empty((frames, 2, 3)),
+        np.empty((frames, 3)),
+        np.empty((frames, 3)),
+        np.empty(frames),
+        np.empty(frames),
         np.empty(4),
     )
     check(
         lib.mt_footskate_plan(
-            _leg_struct((chain,)), frames, c_array(angles), c_array(points), c_array(planted, "unsigned char[]"),
-            c_array(targets), c_array(_clearance(clearance)), options.struct(), c_array(plan.enforced),
-            c_array(plan.goal), c_array(plan.turn), c_array(plan.weight), c_array(plan.reach), c_array(plan.knee),
+            _leg_struct((chain,)),
+            frames,
+            c_array(angles),
+            c_array(points),
+            c_array(planted, "unsigned char[]"),
+            c_array(targets),
+            c_array(_clearance(clearance)),
+            options.struct(),
+            c_array(plan.enforced),
+            c_array(plan.goal),
+            c_array(plan.turn),
+            c_array(plan.weight),
+            c_array(plan.reach),
+            c_array(plan.knee),
         ),
         "mt_footskate_plan",
     )
@@ -283,7 +316,13 @@ def adjust_root(hips, goals, reaches, weights, options: CleanupOptions) -> np.nd
     root = np.empty((frames, 3))
     check(
         lib.mt_footskate_root(
-            n, frames, c_array(hips), c_array(goals), c_array(reaches), c_array(weights), options.struct(),
+            n,
+            frames,
+            c_array(hips),
+            c_array(goals),
+            c_array(reaches),
+            c_array(weights),
+            options.struct(),
             c_array(root),
         ),
         "mt_footskate_root",
@@ -308,9 +347,21 @@ def solve_leg(
     out = np.empty_like(angles)
     check(
         lib.mt_footskate_solve(
-            _leg_struct((chain,)), frames, c_array(hips), c_array(parents), c_array(angles), c_array(points),
-            c_array(planted, "unsigned char[]"), c_array(goal), c_array(turn), c_array(weight), c_array(knee),
-            c_array(root), c_array(_clearance(clearance)), options.struct(), c_array(out),
+            _leg_struct((chain,)),
+            frames,
+            c_array(hips),
+            c_array(parents),
+            c_array(angles),
+            c_array(points),
+            c_array(planted, "unsigned char[]"),
+            c_array(goal),
+            c_array(turn),
+            c_array(weight),
+            c_array(knee),
+            c_array(root),
+            c_array(_clearance(clearance)),
+            options.struct(),
+            c_array(out),
         ),
         "mt_footskate_solve",
     )
