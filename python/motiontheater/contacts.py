@@ -2,15 +2,20 @@
 
 :func:`detect_contacts` finds them from each point's height above where it
 rests (see :mod:`motiontheater.legs`) and its speed, the larger of the
-distances to the frames before and after, per second.  A frame is *close*
-when a point is within ``height`` of its resting level and slower than
-``speed``; a plant is a run of close frames that holds at least one *firm*
-frame (within ``enter_height`` and slower than ``enter_speed``): the
-hysteresis that keeps a noisy threshold from cutting a plant into pieces.
-Plants of the same point apart by at most ``gap`` seconds are merged when
-the point stays slower than ``speed`` in between; plants shorter than
-``min_length`` seconds are dropped unless they hold a frame within 2 cm of
-rest and slower than 5 cm/s, which is always a plant.  Thresholds are in
+distances to the frames before and after, per second (so that neither
+difference quotient finds a planted point faster).  A frame is *close* when a
+point is within ``height`` of its resting level and slower than ``speed``; a
+plant is a run of close frames that holds at least one *firm* frame (within
+``enter_height`` and slower than ``enter_speed``): the hysteresis that keeps a
+noisy threshold from cutting a plant into pieces.  A frame within 2 cm of
+rest whose central-difference speed is under 5 cm/s is always planted (a
+*sure* frame).  The ends of a plant where the point has risen more than
+``rise`` above its lowest frame are cut off (heel strike, push-off).  Plants
+of the same point apart by at most ``gap`` seconds are merged when the point
+stays slower than ``merge_speed`` in between; plants shorter than
+``min_length`` seconds are dropped unless they hold a sure frame.  No plant
+holds a frame faster than 0.45 m/s by the larger difference (or 5 cm/s by
+the central one).  Thresholds are in
 metres, m/s and seconds at the reference leg length (0.85 m hip to ankle),
 multiplied by :func:`~motiontheater.legs.body_scale`; frames come from the
 frame rate.
@@ -125,7 +130,9 @@ class Contacts:
         for i, foot in enumerate(legs.feet):
             for k, point in enumerate(PLANT_POINTS):
                 starts, ends = runs(masks[i, :, k])
-                plants += [Plant(foot, point, first_frame + s, first_frame + e - 1) for s, e in zip(starts, ends)]
+                plants += [
+                    Plant(foot, point, first_frame + int(s), first_frame + int(e) - 1) for s, e in zip(starts, ends)
+                ]
         return cls(plants, first_frame, frames, frame_rate)
 
     def to_csv(self, target: Source) -> None:
@@ -229,6 +236,7 @@ class Thresholds:
             raise ValueError("the enter thresholds must not exceed height and speed (hysteresis)")
 
 
+DEFAULT = Thresholds()
 SURE_HEIGHT, SURE_SPEED = 0.02, 0.05  # m, m/s: within these a point is planted, whatever else
 FASTEST = 0.45  # m/s: the speed threshold once scaled never exceeds this
 
@@ -236,17 +244,20 @@ FASTEST = 0.45  # m/s: the speed threshold once scaled never exceeds this
 def detect_masks(
     heights: np.ndarray,
     speed: np.ndarray,
+    central: np.ndarray,
     frame_rate: float,
     meters_per_unit: float,
     scale: float,
-    thresholds: Thresholds = Thresholds(),
+    thresholds: Thresholds = DEFAULT,
 ) -> np.ndarray:
     """Footplant masks (..., frames) from heights (..., frames) in file units above rest and
-    speeds (..., frames) in file units per second (see the module docstring)."""
+    speeds (..., frames) in file units per second: ``speed`` the larger of the forward and backward
+    differences, ``central`` the central difference (:func:`~motiontheater.legs.speeds`); see the
+    module docstring."""
     th = thresholds
     unit = scale / meters_per_unit
     fastest = FASTEST / meters_per_unit
-    sure = (heights < SURE_HEIGHT / meters_per_unit) & (speed < SURE_SPEED / meters_per_unit)
+    sure = (heights < SURE_HEIGHT / meters_per_unit) & (central < SURE_SPEED / meters_per_unit)
     close = (heights < th.height * unit) & (speed < min(th.speed * unit, fastest)) | sure
     firm = (heights < th.enter_height * unit) & (speed < min(th.enter_speed * unit, fastest)) | sure
     slow = speed < th.merge_speed / meters_per_unit
@@ -293,16 +304,15 @@ def detect_contacts(
     frame_rate: float,
     meters_per_unit: float,
     first_frame: int = 1,
-    thresholds: Thresholds = Thresholds(),
+    thresholds: Thresholds = DEFAULT,
 ) -> Contacts:
     """The footplants of a take's legs (:class:`~motiontheater.legs.LegArrays`) on its ground."""
-    heights = ground.heights(arrays.points)[:, :, :2]  # heel, ball
-    heel_ball = arrays.points[:, :, [3, 2]]
-    speed = speeds(heel_ball.transpose(0, 2, 1, 3), frame_rate).transpose(0, 2, 1)
+    heights = ground.heights(arrays.points)[:, :, :2].transpose(0, 2, 1)  # (legs, heel and ball, frames)
+    heel_ball = arrays.points[:, :, [3, 2]].transpose(0, 2, 1, 3)
+    speed = speeds(heel_ball, frame_rate)
+    central = speeds(heel_ball, frame_rate, central=True)
     scale = body_scale(arrays.legs, meters_per_unit)
-    masks = detect_masks(
-        heights.transpose(0, 2, 1), speed.transpose(0, 2, 1), frame_rate, meters_per_unit, scale, thresholds
-    ).transpose(0, 2, 1)
+    masks = detect_masks(heights, speed, central, frame_rate, meters_per_unit, scale, thresholds).transpose(0, 2, 1)
     return Contacts.from_masks(masks, arrays.legs, first_frame, frame_rate)
 
 

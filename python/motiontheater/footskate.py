@@ -59,13 +59,12 @@ import numpy as np
 
 from mtcore import footskate as kernels
 
-from .contacts import Contacts, Thresholds, detect_contacts, plant_targets
+from .contacts import DEFAULT, Contacts, Thresholds, detect_contacts, plant_targets
 from .legs import Ground, LegArrays, Legs, fit_ground, leg_arrays, resolve_legs
 from .motion import Motion
 from .registry import Joints, step
 
 UP_AXES = ("x", "y", "z", "-x", "-y", "-z")
-DETECTION = Thresholds()
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,7 +121,7 @@ def contacts_of(
     arrays: LegArrays,
     ground: Ground,
     meters_per_unit: float,
-    thresholds: Thresholds = DETECTION,
+    thresholds: Thresholds = DEFAULT,
 ) -> Contacts:
     """The footplants of a motion: ``contacts`` given (a table, or its CSV file, checked to be
     of this take), else detected."""
@@ -154,7 +153,7 @@ def clean_footskate(
     blend: float = 0.2,
     root_window: float = 0.1,
     knee_soft: float = 3.0,
-    thresholds: Thresholds = DETECTION,
+    thresholds: Thresholds = DEFAULT,
 ) -> Cleanup:
     """Footskate cleanup of a motion, with what it stood on (see :class:`Cleanup` and the
     module docstring); the step ``cleanup`` (``motion.cleanup(...)``, ``motiontheater

@@ -510,12 +510,16 @@ def detect_up(arrays: LegArrays) -> np.ndarray:
     return signed_axis_vector(v.mean(0))
 
 
-def speeds(p: np.ndarray, frame_rate: float) -> np.ndarray:
+def speeds(p: np.ndarray, frame_rate: float, *, central: bool = False) -> np.ndarray:
     """Speed (..., frames) of points (..., frames, 3), in their unit per second: the larger of the
-    distances to the frames before and after (one frame: 0)."""
-    step = np.linalg.norm(np.diff(p, axis=-2), axis=-1) * frame_rate
-    if step.shape[-1] == 0:
+    distances to the frames before and after (one frame: 0), so that neither difference quotient
+    finds it faster; with ``central``, the central difference (numpy.gradient's: one-sided at the
+    ends)."""
+    if p.shape[-2] < 2:
         return np.zeros(p.shape[:-1])
+    if central:
+        return np.linalg.norm(np.gradient(p, axis=-2), axis=-1) * frame_rate
+    step = np.linalg.norm(np.diff(p, axis=-2), axis=-1) * frame_rate
     pad = [(0, 0)] * (step.ndim - 1)
     return np.maximum(np.pad(step, pad + [(1, 0)]), np.pad(step, pad + [(0, 1)]))
 
