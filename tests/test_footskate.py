@@ -3,6 +3,7 @@ states of every take (as captured, drifting, smoothed, spliced, legs resized), e
 honoured, bad input refused, the metrics, and the step on the command line and in recipes."""
 
 import dataclasses
+import itertools
 import json
 from pathlib import Path
 
@@ -12,9 +13,9 @@ import pytest
 import motiontheater as mt
 from conftest import DATA
 from motiontheater.cli import main
-from motiontheater.contacts import Contacts, Plant, runs
+from motiontheater.contacts import Contacts, Plant
 from motiontheater.footskate import clean_footskate, contacts_of, prepare
-from motiontheater.legs import find_legs, leg_arrays, resolve_legs, speeds
+from motiontheater.legs import find_legs, leg_arrays, resolve_legs
 from motiontheater.skate import knee_bends, measure, skate_metrics
 
 CMU = 0.0254 / 0.45  # metres per CMU/HDM05 unit
@@ -131,7 +132,7 @@ def test_a_skeleton_without_feet_is_refused_with_the_reason(data_dir):
 
 def test_legs_can_be_named(data_dir):
     skeleton = mt.read_asf(data_dir / "cmu" / "01.asf")
-    names = "lfemur,ltibia,lfoot,rfemur,rtibia,rfoot".split(",")
+    names = ["lfemur", "ltibia", "lfoot", "rfemur", "rtibia", "rfoot"]
     left, right = find_legs(skeleton, names)
     assert (left.toe, right.ankle) == (None, "rfoot")
     with pytest.raises(ValueError, match="6 or 8 names"):
@@ -147,7 +148,7 @@ def test_legs_can_be_named(data_dir):
 @pytest.mark.parametrize(("take", "up"), [("07_05", "y"), ("bvh 01_01", "y"), ("bvh zombie (z up)", "z")])
 def test_the_up_axis(take, up):
     motion, mpu = load(take)
-    arrays, ground, _ = prepare(motion, meters_per_unit=mpu)
+    _arrays, ground, _ = prepare(motion, meters_per_unit=mpu)
     assert ground.up == tuple(float(axis == up) for axis in "xyz")
 
 
@@ -305,7 +306,7 @@ def test_the_cleanup_holds_its_bounds(take, state):
 def test_a_cleanup_of_a_clean_cleanup_moves_little():
     # the feet, not the angles or the knees: a knee near straight turns degrees, and moves a
     # centimetre sideways, for a fraction of a millimetre between hip and ankle
-    motion, result, mpu = cleaned("07_05", "as captured")
+    _motion, result, mpu = cleaned("07_05", "as captured")
     again = clean_footskate(result.motion, result.contacts, legs=result.legs)
     first, second = (leg_arrays(r.motion, result.legs).points[:, :, 1:] for r in (result, again))
     assert np.abs(second - first).max() * mpu < 0.002
@@ -334,7 +335,7 @@ def test_removed_plants_are_not_enforced_and_added_ones_are():
     assert np.linalg.norm(free - free[0], axis=-1).max() * mpu > 0.005  # no longer held
     # a plant added where the ball was not planted: the ball is held there
     ball = [p for p in table.of(dropped.foot, "ball")]
-    gaps = [(a.last + 1, b.first - 1) for a, b in zip(ball, ball[1:]) if b.first - a.last > 20]
+    gaps = [(a.last + 1, b.first - 1) for a, b in itertools.pairwise(ball) if b.first - a.last > 20]
     first, last = gaps[0][0] + 2, gaps[0][0] + 8
     more = Contacts([*table.plants, Plant(dropped.foot, "ball", first, last)], table.first_frame, table.frames)
     added = clean_footskate(motion, more, legs=legs)
@@ -388,7 +389,7 @@ def test_the_skating_ratio_is_the_papers(rng):
 
 
 def test_the_metrics_of_a_sliding_take_and_of_its_cleanup():
-    motion, result, mpu = cleaned("07_05", "drifting")
+    motion, result, _mpu = cleaned("07_05", "drifting")
     before = skate_metrics(motion, result.contacts, legs=result.legs, ground=result.ground)
     after = skate_metrics(result.motion, result.contacts, legs=result.legs, ground=result.ground)
     assert before.worst("sliding_max_mm") > 20 and after.worst("sliding_max_mm") < 1
