@@ -100,13 +100,19 @@ static void mat_mult(const double *a, const double *b, double *out)
     memcpy(out, r, sizeof r);
 }
 
-/* The rotation by angle about the unit axis (Rodrigues). */
-static void about(const double *axis, double angle, double *out)
+/* The rotation about the unit axis by the angle of cosine c and sine s (Rodrigues). */
+static void about_cs(const double *axis, double c, double s, double *out)
 {
-    const double x = axis[0], y = axis[1], z = axis[2], c = cos(angle), s = sin(angle), t = 1 - c;
+    const double x = axis[0], y = axis[1], z = axis[2], t = 1 - c;
     out[0] = c + t * x * x, out[1] = t * x * y - s * z, out[2] = t * x * z + s * y;
     out[3] = t * x * y + s * z, out[4] = c + t * y * y, out[5] = t * y * z - s * x;
     out[6] = t * x * z - s * y, out[7] = t * y * z + s * x, out[8] = c + t * z * z;
+}
+
+/* The rotation by angle about the unit axis. */
+static void about(const double *axis, double angle, double *out)
+{
+    about_cs(axis, cos(angle), sin(angle), out);
 }
 
 /* The smallest rotation taking the direction of u onto that of v (a half turn for opposite ones). */
@@ -243,23 +249,31 @@ static void rotate_right(double *m, int axis, double s, double c)
     }
 }
 
-/* L = C M C^T of joint j, M its channels' rotations, each about a fixed axis after the ones before:
- * C M built by turning C's columns, the last channel's rotation first. */
-static void local_rotation(const struct mt_leg *leg, int j, const double *angles, double *out)
+/* L = C M C^T of joint j, M its channels' rotations (given by the sines and cosines of their angles),
+ * each about a fixed axis after the ones before: C M built by turning C's columns, the last first. */
+static void local_rotation_of(const struct mt_leg *leg, int j, const double *sines, const double *cosines, double *out)
 {
     const int count = channels(leg, j);
     if (is_identity(leg->axis[j])) {
         double m[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
         for (int n = 0; n < count; n++)
-            rotate_left(m, leg->axes[j][n], sin(angles[n]), cos(angles[n]));
+            rotate_left(m, leg->axes[j][n], sines[n], cosines[n]);
         memcpy(out, m, sizeof m);
         return;
     }
     double m[9];
     memcpy(m, leg->axis[j], sizeof m);
     for (int n = count - 1; n >= 0; n--)
-        rotate_right(m, leg->axes[j][n], sin(angles[n]), cos(angles[n]));
+        rotate_right(m, leg->axes[j][n], sines[n], cosines[n]);
     mat_mult(m, leg->axis[j], out);
+}
+
+static void local_rotation(const struct mt_leg *leg, int j, const double *angles, double *out)
+{
+    double sines[3], cosines[3];
+    for (int n = 0; n < channels(leg, j); n++)
+        sines[n] = sin(angles[n]), cosines[n] = cos(angles[n]);
+    local_rotation_of(leg, j, sines, cosines, out);
 }
 
 /*
@@ -310,10 +324,11 @@ static void euler_nearest(const double *m, const int *axes, const double *ref, d
  * The angles of joint j nearest to the wanted local rotation that its
  * channels can take: three give it exactly; two turn the body vector aim
  * where wanted turns it; one turns aim as near as its axis allows; none keep
- * ref.  Angles are whole turns from ref.
+ * ref.  Angles are whole turns from ref.  With one or two channels, sines and
+ * cosines receive those of the angles found (for local_rotation_of).
  */
 static void realize(const struct mt_leg *leg, int j, const double *wanted, const double *aim, const double *ref,
-                    double *out)
+                    double *out, double *sines, double *cosines)
 {
     const int count = channels(leg, j);
     const double *c = leg->axis[j];
@@ -340,7 +355,9 @@ static void realize(const struct mt_leg *leg, int j, const double *wanted, const
         perpendicular(p, e, pp);
         perpendicular(q, e, qq);
         cross3(pp, qq, n);
-        out[0] = wrap_near(atan2(dot3(e, n), dot3(pp, qq)), ref[0]);
+        const double y = dot3(e, n), x = dot3(pp, qq), h = hypot(x, y);
+        out[0] = wrap_near(atan2(y, x), ref[0]);
+        sines[0] = h > 0 ? y / h : 0.0, cosines[0] = h > 0 ? x / h : 1.0;
         return;
     }
     const int ai = leg->axes[j][0], aj = leg->axes[j][1];
@@ -348,24 +365,36 @@ static void realize(const struct mt_leg *leg, int j, const double *wanted, const
     double eip[3];
     cross3(ei, p, eip);
     const double big_a = p[aj], big_b = eip[aj], rho = hypot(big_a, big_b);
-    if (!(rho > tiny))
+    if (!(rho > tiny)) { /* aim along the first axis: nothing to turn, the angles kept */
+        for (int n = 0; n < 2; n++)
+            sines[n] = sin(ref[n]), cosines[n] = cos(ref[n]);
         return;
+    }
     const double kappa = clip(q[aj] / rho, -1.0, 1.0), base = atan2(big_b, big_a), spread = acos(kappa);
-    double best[2] = {0, 0}, best_cost = 0;
+    /* sines and cosines of base +- spread by the angle sums, from base's (B, A) / rho and spread's cosine */
+    const double cb = big_a / rho, sb = big_b / rho, ss = sqrt(1 - kappa * kappa);
+    double best[6] = {0, 0, 0, 1, 0, 1}, best_cost = 0; /* a, b, sin a, cos a, sin b, cos b */
     for (int s = 0; s < 2; s++) {
         double v[3], rp[3], qp[3], n[3];
-        const double a = wrap_near(base + (s == 0 ? spread : -spread), ref[0]);
+        const double sign = s == 0 ? 1.0 : -1.0;
+        const double a = wrap_near(base + sign * spread, ref[0]);
+        const double sa = sb * kappa + sign * cb * ss, ca = cb * kappa - sign * sb * ss;
         memcpy(v, p, sizeof v);
-        rotate_vector(v, ai, sin(a), cos(a));
+        rotate_vector(v, ai, sa, ca);
         perpendicular(v, ej, rp);
         perpendicular(q, ej, qp);
         cross3(rp, qp, n);
-        const double b = wrap_near(atan2(dot3(ej, n), dot3(rp, qp)), ref[1]);
+        const double y = dot3(ej, n), x = dot3(rp, qp), h = hypot(x, y);
+        const double b = wrap_near(atan2(y, x), ref[1]);
         const double cost = (a - ref[0]) * (a - ref[0]) + (b - ref[1]) * (b - ref[1]);
-        if (s == 0 || cost < best_cost)
-            best[0] = a, best[1] = b, best_cost = cost;
+        if (s == 0 || cost < best_cost) {
+            const double pick[6] = {a, b, sa, ca, h > 0 ? y / h : 0.0, h > 0 ? x / h : 1.0};
+            memcpy(best, pick, sizeof best);
+            best_cost = cost;
+        }
     }
     out[0] = best[0], out[1] = best[1];
+    sines[0] = best[2], cosines[0] = best[3], sines[1] = best[4], cosines[1] = best[5];
 }
 
 /* ---------------------------------------------------------------- legs */
@@ -619,6 +648,7 @@ static void raise_lever(const double *lever, const double *pivot, double rest, c
 
 struct hinge {
     double base, rho, phi; /* |hip -> ankle|^2 = base + 2 rho cos(delta - phi) turning the knee by delta */
+    double cos_phi, sin_phi;
 };
 
 static struct hinge hinge_of(const struct mt_leg *leg, const double *knee_local, const double *axis)
@@ -628,7 +658,9 @@ static struct hinge hinge_of(const struct mt_leg *leg, const double *knee_local,
     mat_vec(knee_local, leg->segment[1], u);
     cross3(axis, u, au);
     const double c0 = dot3(s1, axis) * dot3(u, axis), x = dot3(s1, u) - c0, y = dot3(s1, au);
-    struct hinge h = {dot3(s1, s1) + dot3(u, u) + 2 * c0, hypot(x, y), atan2(y, x)};
+    const double rho = hypot(x, y);
+    struct hinge h = {dot3(s1, s1) + dot3(u, u) + 2 * c0, rho, atan2(y, x), rho > 0 ? x / rho : 1.0,
+                      rho > 0 ? y / rho : 0.0};
     return h;
 }
 
@@ -637,7 +669,8 @@ static double reach(struct hinge h, double soft, double keep)
 {
     const double now = fabs(wrap(-h.phi)), least = now < soft ? now : soft;
     const double bend = keep * now > least ? keep * now : least;
-    const double r2 = h.base + 2 * h.rho * cos(bend);
+    /* the bend now is phi's (cos is even and whole turns round): its cosine without a call */
+    const double r2 = h.base + 2 * h.rho * (bend == now ? h.cos_phi : cos(bend));
     return sqrt(r2 > 0 ? r2 : 0.0);
 }
 
@@ -956,6 +989,8 @@ int mt_footskate_root(size_t legs, size_t frames, const double *hips, const doub
 
 struct solved {
     double angles[12];
+    double knee_delta;  /* the turn about the knee's hinge */
+    double wanted[3][9]; /* the local rotations asked of hip, knee and ankle */
     double foot[9];
     double ankle[3];
 };
@@ -964,7 +999,10 @@ struct solved {
  * Two-bone IK of one frame: the knee bends about its hinge so that hip ->
  * ankle has the goal's length (within the knee's reach, never past straight,
  * to the side it bends), the hip turns the leg onto the goal, the ankle
- * takes foot_goal (its aim exactly, with fewer than three channels).
+ * takes foot_goal (its aim exactly, with fewer than three channels).  Joints
+ * that take the rotation asked exactly (three channels; a one-channel knee
+ * turning about its channel's axis) are left for finish_angles: a foot
+ * re-aimed solves the leg again, and their Euler angles are needed once.
  */
 static void two_bone(const struct mt_leg *leg, const double *hip, const double *parent, const double *angles,
                      const struct leg_pose *pose, const struct hinge *h, const double *knee, double soft,
@@ -980,44 +1018,60 @@ static void two_bone(const struct mt_leg *leg, const double *hip, const double *
     const double d = clip(norm3(goal), shortest, longest);
     const double cosine = clip((d * d - h->base) / (2 * (h->rho > tiny ? h->rho : 1.0)), -1.0, 1.0);
     const double bend = h->rho > tiny ? acos(cosine) : 0.0;
-    double r[9], wanted[9], knee_local[9], thigh[9], shin[9], v[3], leg_vector[3], world[3], hip_local[9];
-    about(knee, h->phi + knee[3] * bend, r);
-    mat_mul(r, pose->local[1], wanted);
-    realize(leg, 1, wanted, s2, angles + 3, out->angles + 3);
-    /* a joint with three channels takes the wanted rotation itself (to rounding), and so does a
-     * one-channel knee, whose hinge is its channel's axis */
-    if (channels(leg, 1) != 2)
-        memcpy(knee_local, wanted, sizeof wanted);
-    else
-        local_rotation(leg, 1, out->angles + 3, knee_local);
+    double r[9], knee_local[9], thigh[9], shin[9], v[3], leg_vector[3], world[3], hip_local[9], sines[3], cosines[3];
+    out->knee_delta = h->phi + knee[3] * bend;
+    /* cos and sin of phi + side bend by the angle sums: phi's from the hinge, bend's from its cosine */
+    const double sin_bend = sqrt(1 - cosine * cosine) * (h->rho > tiny), cos_bend = h->rho > tiny ? cosine : 1.0;
+    about_cs(knee, h->cos_phi * cos_bend - knee[3] * h->sin_phi * sin_bend,
+             h->sin_phi * cos_bend + knee[3] * h->cos_phi * sin_bend, r);
+    mat_mul(r, pose->local[1], out->wanted[1]);
+    if (channels(leg, 1) == 2) {
+        realize(leg, 1, out->wanted[1], s2, angles + 3, out->angles + 3, sines, cosines);
+        local_rotation_of(leg, 1, sines, cosines, knee_local);
+    } else {
+        memcpy(knee_local, out->wanted[1], sizeof knee_local);
+    }
     mat_mul(parent, pose->local[0], thigh);
     mat_vec(knee_local, s2, v);
     for (int e = 0; e < 3; e++)
         leg_vector[e] = s1[e] + v[e];
     mat_vec(thigh, leg_vector, world);
     between(world, goal, r);
-    mat_mul(r, thigh, wanted);
-    mat_tmul(parent, wanted, wanted);
-    realize(leg, 0, wanted, leg_vector, angles, out->angles);
-    if (channels(leg, 0) == 3)
-        memcpy(hip_local, wanted, sizeof wanted);
-    else
-        local_rotation(leg, 0, out->angles, hip_local);
+    mat_mul(r, thigh, out->wanted[0]);
+    mat_tmul(parent, out->wanted[0], out->wanted[0]);
+    if (channels(leg, 0) < 3) {
+        realize(leg, 0, out->wanted[0], leg_vector, angles, out->angles, sines, cosines);
+        local_rotation_of(leg, 0, sines, cosines, hip_local);
+    } else {
+        memcpy(hip_local, out->wanted[0], sizeof hip_local);
+    }
     mat_mul(parent, hip_local, thigh);
     mat_mul(thigh, knee_local, shin);
-    mat_tmul(shin, foot_goal, wanted);
-    realize(leg, 2, wanted, aim, angles + 6, out->angles + 6);
-    if (channels(leg, 2) == 3)
-        mat_mul(shin, wanted, out->foot);
-    else {
-        local_rotation(leg, 2, out->angles + 6, r);
+    mat_tmul(shin, foot_goal, out->wanted[2]);
+    if (channels(leg, 2) < 3) {
+        realize(leg, 2, out->wanted[2], aim, angles + 6, out->angles + 6, sines, cosines);
+        local_rotation_of(leg, 2, sines, cosines, r);
         mat_mul(shin, r, out->foot);
+    } else {
+        mat_mul(shin, out->wanted[2], out->foot);
     }
     double a[3], b[3];
     mat_vec(thigh, s1, a);
     mat_vec(shin, s2, b);
     for (int e = 0; e < 3; e++)
         out->ankle[e] = hip[e] + a[e] + b[e];
+}
+
+/* The Euler angles two_bone left: joints of three channels, and a one-channel knee (its angle plus
+ * the turn about its hinge, which is its channel's axis). */
+static void finish_angles(const struct mt_leg *leg, const double *angles, const double *aim, struct solved *solved)
+{
+    double sines[3], cosines[3];
+    for (int j = 0; j < 3; j++)
+        if (channels(leg, j) == 3)
+            realize(leg, j, solved->wanted[j], aim, angles + 3 * j, solved->angles + 3 * j, sines, cosines);
+    if (channels(leg, 1) == 1)
+        solved->angles[3] = angles[3] + wrap(solved->knee_delta);
 }
 
 /* the toe angles that raise a toe tip below the floor onto it, about the toe joint's axis */
@@ -1051,8 +1105,9 @@ static void bend_toes(const struct mt_leg *leg, const double *foot, const double
     double r[9], wanted[9], ref[3];
     about(axis, fabs(first) <= fabs(second) ? first : second, r);
     mat_mul(r, toe_local, wanted);
+    double sines[3], cosines[3];
     memcpy(ref, angles, sizeof ref);
-    realize(leg, 3, wanted, t, ref, angles);
+    realize(leg, 3, wanted, t, ref, angles, sines, cosines);
 }
 
 /* how far the lower of heel and ball, of a foot at ankle turned to foot, is above where they rest */
@@ -1175,6 +1230,7 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
                 two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, target,
                          foot_goal, aim, &solved);
             }
+            finish_angles(leg, angles + 12 * t, aim, &solved);
             memcpy(result, solved.angles, sizeof solved.angles);
             memcpy(foot_now, solved.foot, sizeof foot_now);
             double v[3];

@@ -491,9 +491,12 @@ def smooth_root(offset, half):
 
 
 def two_bone(chain, hips, parents, angles, locals_, knee_axis, side, soft, ankle_goal, foot_goal, aim):
-    """Phase 4 for frames of one leg: knee, hip and ankle angles (frames, 4, 3) that put the
-    ankle on ankle_goal and turn the foot to foot_goal (its aim vector exactly, with fewer than
-    three ankle channels).  Returns the angles, the foot's world rotation and the ankle."""
+    """Phase 4 for frames of one leg: the knee bends about its hinge so that hip -> ankle has the
+    goal's length, the hip turns the leg onto it, the ankle takes foot_goal (its aim vector
+    exactly, with fewer than three channels).  Returns the angles (frames, 4, 3) of the joints
+    that do not take the rotation asked exactly, the turn about the knee's hinge, the local
+    rotations asked of hip, knee and ankle (for :func:`finish_angles`), the foot's world rotation
+    and the ankle."""
     s1, s2 = chain.segments[0], chain.segments[1]
     out = angles.copy()
     base, rho, phi = hinge(chain, locals_, knee_axis)
@@ -506,20 +509,41 @@ def two_bone(chain, hips, parents, angles, locals_, knee_axis, side, soft, ankle
     bend = np.where(rho > TINY, np.arccos(cosine), 0.0)
     delta = phi + side * bend
     knee_wanted = mm(about(knee_axis, delta), locals_[1])
-    out[:, 1] = realize(chain, 1, knee_wanted, s2, angles[:, 1])
-    knee_local = local(chain, 1, out[:, 1])
+    knee_local = knee_wanted
+    if channels(chain, 1) == 2:
+        out[:, 1] = realize(chain, 1, knee_wanted, s2, angles[:, 1])
+        knee_local = local(chain, 1, out[:, 1])
     thigh = mm(parents, locals_[0])
     leg_vector = s1 + mv(knee_local, s2)
     turn = between(mv(thigh, leg_vector), goal)
     hip_wanted = mm(tr(parents), mm(turn, thigh))
-    out[:, 0] = realize(chain, 0, hip_wanted, leg_vector, angles[:, 0])
-    thigh = mm(parents, local(chain, 0, out[:, 0]))
+    hip_local = hip_wanted
+    if channels(chain, 0) < 3:
+        out[:, 0] = realize(chain, 0, hip_wanted, leg_vector, angles[:, 0])
+        hip_local = local(chain, 0, out[:, 0])
+    thigh = mm(parents, hip_local)
     shin = mm(thigh, knee_local)
     foot_wanted = mm(tr(shin), foot_goal)
-    out[:, 2] = realize(chain, 2, foot_wanted, aim, angles[:, 2])
-    foot = mm(shin, local(chain, 2, out[:, 2]))
+    foot_local = foot_wanted
+    if channels(chain, 2) < 3:
+        out[:, 2] = realize(chain, 2, foot_wanted, aim, angles[:, 2])
+        foot_local = local(chain, 2, out[:, 2])
+    foot = mm(shin, foot_local)
     ankle = hips + mv(thigh, s1) + mv(shin, s2)
-    return out, foot, ankle
+    return (out, delta, (hip_wanted, knee_wanted, foot_wanted)), foot, ankle
+
+
+def finish_angles(chain, angles, solved, aim):
+    """The angles two_bone left: joints of three channels, and a one-channel knee (its angle
+    plus the turn about its hinge, which is its channel's axis)."""
+    out, delta, wanted = solved
+    out = out.copy()
+    for j in range(3):
+        if channels(chain, j) == 3:
+            out[:, j] = realize(chain, j, wanted[j], aim, angles[:, j])
+    if channels(chain, 1) == 1:
+        out[:, 1, 0] = angles[:, 1, 0] + wrap(delta)
+    return out
 
 
 def bend_toes(chain, foot, ball, angles, locals3, clearance_tip, options):
@@ -628,13 +652,13 @@ def solve_leg(chain, hips, parents, angles, points, planted, goal, turn, weight,
         if sink.any():
             goal_f = np.where(sink[:, None], goal_f - low[:, None] * up, goal_f)
             new, achieved, ankle_now = solve(goal_f)
-        out[f] = new
+        out[f] = finish_angles(chain, a, new, aim[f])
         foot_now[f], ball_now[f] = achieved, ankle_now + mv(achieved, s[2])
     out[:, 3] = bend_toes(chain, foot_now, ball_now, out[:, 3], locals_[3], clearance[2], options)
     return out
 
 
-def cleanup(chains, hips, parents, angles, points, planted, targets, clearance, options: CleanupOptions):
+def cleanup(chains, hips, parents, angles, points, planted, targets, clearance, options: CleanupOptions, workers=None):
     """All phases (see mtcore.footskate.cleanup): (angles, root, enforced)."""
     chains = tuple(chains)
     plans = [

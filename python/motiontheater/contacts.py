@@ -83,7 +83,7 @@ class Contacts:
 
     def __init__(self, plants: Iterable[Plant], first_frame: int, frames: int, frame_rate: float | None = None):
         merged: list[Plant] = []
-        for p in sorted(plants):
+        for p in sorted(plants, key=lambda p: (p.foot, p.point, p.first, p.last)):
             if not first_frame <= p.first <= p.last <= first_frame + frames - 1:
                 raise ValueError(
                     f"plant {p.foot} {p.point} {p.first}..{p.last} is outside the take's frames "

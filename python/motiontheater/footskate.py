@@ -154,6 +154,7 @@ def clean_footskate(
     root_window: float = 0.1,
     knee_soft: float = 3.0,
     thresholds: Thresholds = DEFAULT,
+    workers: int | None = None,
 ) -> Cleanup:
     """Footskate cleanup of a motion, with what it stood on (see :class:`Cleanup` and the
     module docstring); the step ``cleanup`` (``motion.cleanup(...)``, ``motiontheater
@@ -169,6 +170,8 @@ def clean_footskate(
     - ``blend``: seconds over which adjustments fade in and out around constraints;
       ``root_window``: seconds of smoothing of the root's moves; ``knee_soft``: degrees short
       of straight that a constrained knee keeps unless the input's is straighter.
+    - ``workers``: threads for the two legs (None: both on takes of 1,000 frames or more; 1: the
+      calling thread only).
 
     Raises ValueError (UnknownNameError and FormatError among its kinds) naming
     what is wrong: no recognisable legs, contacts of another take, a floor
@@ -203,6 +206,7 @@ def clean_footskate(
         plant_targets(masks, arrays.points),
         ground.clearance,
         options,
+        workers=workers,
     )
     values = motion.values.copy()
     for i, r, n in zip(*np.nonzero(arrays.columns >= 0)):

@@ -314,6 +314,12 @@ def _rest_down(rest: np.ndarray, legs: Sequence[Leg], index: dict[str, int], ske
     return signed_axis_vector(total)
 
 
+def along(p: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """p . v for points (..., 3) and a vector v, the dot product written out (matmul with a vector
+    takes a slow path for stacked points)."""
+    return p[..., 0] * v[0] + p[..., 1] * v[1] + p[..., 2] * v[2]
+
+
 def signed_axis_vector(v: np.ndarray) -> np.ndarray:
     """The unit coordinate axis (with sign) nearest to the direction of v."""
     axis = int(np.argmax(np.abs(v)))
@@ -540,7 +546,7 @@ class Ground:
 
     def above(self, p: np.ndarray) -> np.ndarray:
         """Distance of points (..., 3) above the floor plane, along up."""
-        return p @ (np.asarray(self.up) - np.asarray(self.slope)) - self.level
+        return along(p, np.asarray(self.up) - np.asarray(self.slope)) - self.level
 
     def heights(self, points: np.ndarray) -> np.ndarray:
         """Heights (legs, frames, 3) of heel, ball and toe tip above where they rest,
@@ -585,7 +591,7 @@ def fit_ground(
     contact = arrays.points[:, :, [3, 2, 4]]  # heel, ball, tip
     has_tip = legs.points[:, 4] >= 0
     speed = speeds(contact.transpose(0, 2, 1, 3), frame_rate).transpose(0, 2, 1) * meters_per_unit
-    vertical = contact @ up_vector
+    vertical = along(contact, up_vector)
     resting = speed < _REST_SPEED * scale
     needed = max(3, round(0.05 * frame_rate))
     for i in range(len(legs)):  # a point that never rests (a run on the balls): its slowest low frames
@@ -598,7 +604,7 @@ def fit_ground(
     resting &= np.isfinite(vertical)
     horizontal_axes = [a for a in range(3) if up_vector[a] == 0]
     if floor is not None:
-        ankles = arrays.points[:, :, 1] @ up_vector
+        ankles = along(arrays.points[:, :, 1], up_vector)
         median_ankle = float(np.nanmedian(ankles))
         if floor > median_ankle:
             raise ValueError(
@@ -615,22 +621,27 @@ def fit_ground(
     if len(where) > _FIT_SAMPLES:  # a long take: evenly spaced samples tell the plane as well
         where = where[:: -(-len(where) // _FIT_SAMPLES)]
     point_id = (where // 3 // frames) * 3 + where % 3
-    xy = contact.reshape(-1, 3)[where][:, horizontal_axes]
+    ids, point = np.unique(point_id, return_inverse=True)
+    flat = contact.reshape(-1, 3)[where]
+    x, y = flat[:, horizontal_axes[0]], flat[:, horizontal_axes[1]]
     z = vertical.reshape(-1)[where]
-    centre = xy.mean(0)
-    xy = xy - centre
-    ids = np.unique(point_id)
-    onehot = (point_id[:, None] == ids[None, :]).astype(float)
-    design = np.concatenate([xy, onehot], axis=1)
+    centre = np.array([x.mean(), y.mean()])
+    x, y = x - centre[0], y - centre[1]
     band = _FIT_BAND * scale / meters_per_unit
     prior = np.sqrt(len(z)) * _SLOPE_PRIOR * scale / meters_per_unit
     keep = np.ones(len(z), bool)
-    penalty = np.zeros((design.shape[1], design.shape[1]))
-    penalty[0, 0] = penalty[1, 1] = prior**2
-    for _ in range(3):  # least squares by its normal equations, without the samples above the floor found
-        kept = design[keep]
-        coef = np.linalg.solve(kept.T @ kept + penalty, kept.T @ z[keep])
-        keep = z - design @ coef < band
+    n = len(ids)
+    for _ in range(3):  # z = gx x + gy y + c[point]: least squares by its normal equations, summed by point
+        w = keep.astype(float)
+        a = np.zeros((2 + n, 2 + n))
+        a[0, 0], a[1, 1] = (w * x * x).sum() + prior**2, (w * y * y).sum() + prior**2
+        a[0, 1] = a[1, 0] = (w * x * y).sum()
+        a[0, 2:] = a[2:, 0] = np.bincount(point, w * x, n)
+        a[1, 2:] = a[2:, 1] = np.bincount(point, w * y, n)
+        a[2:, 2:] = np.diag(np.bincount(point, w, n))
+        b = np.r_[(w * x * z).sum(), (w * y * z).sum(), np.bincount(point, w * z, n)]
+        coef = np.linalg.solve(a, b)
+        keep = z - (coef[0] * x + coef[1] * y + coef[2:][point]) < band
     gradient = coef[:2]
     norm = np.linalg.norm(gradient)
     if norm > _MAX_TILT:

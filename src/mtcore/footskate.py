@@ -27,6 +27,7 @@ import numpy as np
 
 from ._cdata import c_array
 from ._mtcore import ffi, lib
+from ._parallel import run_all, thread_count
 from ._status import check
 
 __all__ = [
@@ -42,6 +43,7 @@ __all__ = [
 ]
 
 POINTS = ("knee", "ankle", "ball", "heel", "tip")
+_PARALLEL_MIN_FRAMES = 1000  # frames below which the second leg's thread costs more than it gains
 SEGMENTS = ("thigh", "shin", "ball", "heel", "toes")
 JOINTS = ("hip", "knee", "ankle", "toe")
 
@@ -369,7 +371,17 @@ def solve_leg(
 
 
 def cleanup(
-    chains, hips, parents, angles, points, planted, targets, clearance, options: CleanupOptions
+    chains,
+    hips,
+    parents,
+    angles,
+    points,
+    planted,
+    targets,
+    clearance,
+    options: CleanupOptions,
+    *,
+    workers: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Footskate cleanup of one or two legs over frames: (angles, root, enforced).
 
@@ -379,14 +391,20 @@ def cleanup(
     (legs, frames, 2), ``targets`` (legs, frames, 2, 3), ``clearance`` (legs,
     3).  Returns the new angles, the root's translation to add (frames, 3) and
     the enforced targets (legs, frames, 2, 3): :func:`plan_leg` per leg,
-    :func:`adjust_root`, :func:`solve_leg` per leg.
+    :func:`adjust_root`, :func:`solve_leg` per leg; the legs in two threads
+    (``workers`` as for the filters: None for every core on takes of a
+    thousand frames or more, 1 for the calling thread alone).
     """
     chains = tuple(chains)
     if len(chains) not in (1, 2):
         raise ValueError(f"cleanup takes one or two legs, got {len(chains)}")
-    plans = [
-        plan_leg(c, angles[i], points[i], planted[i], targets[i], clearance[i], options) for i, c in enumerate(chains)
-    ]
+    threads = thread_count(workers, len(hips[0]) >= _PARALLEL_MIN_FRAMES if len(hips) else False)
+
+    def each_leg(task):
+        calls = [lambda i=i: task(i) for i in range(len(chains))]
+        return run_all(calls) if threads > 1 else [call() for call in calls]
+
+    plans = each_leg(lambda i: plan_leg(chains[i], angles[i], points[i], planted[i], targets[i], clearance[i], options))
     root = adjust_root(
         hips,
         np.stack([p.goal for p in plans]),
@@ -395,9 +413,10 @@ def cleanup(
         options,
     )
     out = np.stack(
-        [
-            solve_leg(c, hips[i], parents[i], angles[i], points[i], planted[i], p, root, clearance[i], options)
-            for i, (c, p) in enumerate(zip(chains, plans))
-        ]
+        each_leg(
+            lambda i: solve_leg(
+                chains[i], hips[i], parents[i], angles[i], points[i], planted[i], plans[i], root, clearance[i], options
+            )
+        )
     )
     return out, root, np.stack([p.enforced for p in plans])
