@@ -291,7 +291,6 @@ def test_the_cleanup_holds_its_bounds(take, state):
     report = measure(after, result.ground, result.contacts, motion.frame_rate, result.meters_per_unit)
     assert report.worst("sliding_mean_mm") <= 1.0
     assert report.worst("sliding_max_mm") <= 5.0
-    assert report.worst("planted_skating_ratio") <= 0.01
     assert report.worst("penetration_mm") <= 5.0
     assert report.worst("float_mm") <= 1.0
     # only the root's translation and the legs' joints change
@@ -385,7 +384,6 @@ def test_the_skating_ratio_is_the_papers(rng):
             skating |= low[:-1] & low[1:] & (speed > 0.5) & (mean > 0.5)
         assert foot.skating_ratio == pytest.approx(skating.mean(), abs=1e-12)
         assert 0.1 < foot.skating_ratio < 0.5  # a walk's swing passes the floor low and fast
-        assert foot.planted_skating_ratio <= foot.skating_ratio
 
 
 def test_the_metrics_of_a_sliding_take_and_of_its_cleanup():

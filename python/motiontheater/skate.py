@@ -13,9 +13,9 @@ detected unless given):
   OmniControl): a point within 5 cm of the floor at t and t+1 whose
   horizontal speed and that speed's moving average (5 frames at the papers'
   20 Hz, i.e. 0.25 s at the take's rate) both exceed 0.5 m/s.  Real walks
-  score 20-40 % on it: a swinging foot passes the floor lower than 5 cm and
-  faster than 0.5 m/s.  ``planted_skating_ratio`` counts only steps where the
-  point is planted at t and t+1: the skating a cleanup can remove;
+  score 10-40 % on it, before a cleanup and after: a swinging foot passes the
+  floor lower than 5 cm and faster than 0.5 m/s, and a cleanup leaves swing
+  alone (a planted point is never that fast: the sliding says how still it is);
 - ``penetration_mm``: the deepest any of its heel, ball and toe tip goes
   below where it rests, over all frames;
 - ``float_mm``: the mean height of planted points over their plants.
@@ -49,7 +49,6 @@ class FootMetrics:
     sliding_mean_mm: float
     sliding_max_mm: float
     skating_ratio: float
-    planted_skating_ratio: float
     penetration_mm: float
     float_mm: float
 
@@ -77,15 +76,13 @@ class SkateReport:
     def text(self) -> str:
         """The report as a Markdown table."""
         lines = [
-            "| foot | plants (heel, ball) | sliding mean mm | sliding max mm | skating % | skating planted % "
-            "| penetration mm | float mm |",
-            "|---|---|---:|---:|---:|---:|---:|---:|",
+            "| foot | plants (heel, ball) | sliding mean mm | sliding max mm | skating % | penetration mm | float mm |",
+            "|---|---|---:|---:|---:|---:|---:|",
         ]
         for f in self.feet:
             lines.append(
                 f"| {f.foot} | {f.plants['heel']}, {f.plants['ball']} | {f.sliding_mean_mm:.2f} | "
-                f"{f.sliding_max_mm:.2f} | {100 * f.skating_ratio:.2f} | {100 * f.planted_skating_ratio:.2f} | "
-                f"{f.penetration_mm:.2f} | {f.float_mm:.2f} |"
+                f"{f.sliding_max_mm:.2f} | {100 * f.skating_ratio:.2f} | {f.penetration_mm:.2f} | {f.float_mm:.2f} |"
             )
         return "\n".join(lines)
 
@@ -118,7 +115,6 @@ def measure(
     for i, foot in enumerate(legs.feet):
         slides = []
         skating = np.zeros(max(frames - 1, 0), bool)
-        planted_skating = skating.copy()
         for k, column in enumerate((3, 2)):
             p = _horizontal(arrays.points[i, :, column], up)
             starts, ends = runs(masks[i, :, k])
@@ -127,9 +123,7 @@ def measure(
                 continue
             speed = np.linalg.norm(np.diff(p, axis=0), axis=-1) * frame_rate * meters_per_unit
             low = heights[i, :, k] < SKATE_HEIGHT
-            skates = low[:-1] & low[1:] & (speed > SKATE_SPEED) & (_moving_average(speed, window) > SKATE_SPEED)
-            skating |= skates
-            planted_skating |= skates & masks[i, :-1, k] & masks[i, 1:, k]
+            skating |= low[:-1] & low[1:] & (speed > SKATE_SPEED) & (_moving_average(speed, window) > SKATE_SPEED)
         slide = np.concatenate(slides) * meters_per_unit * 1000 if slides else np.zeros(0)
         points = [0, 1, 2] if legs.points[i, 4] >= 0 else [0, 1]
         depth = -float(np.nanmin(heights[i][:, points])) if frames else 0.0
@@ -142,7 +136,6 @@ def measure(
                 sliding_mean_mm=float(slide.mean()) if len(slide) else 0.0,
                 sliding_max_mm=float(slide.max()) if len(slide) else 0.0,
                 skating_ratio=float(skating.sum() / steps),
-                planted_skating_ratio=float(planted_skating.sum() / steps),
                 penetration_mm=max(depth, 0.0) * 1000,
                 float_mm=float(np.mean(np.maximum(planted, 0.0))) * 1000 if len(planted) else 0.0,
             )
