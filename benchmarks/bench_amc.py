@@ -5,36 +5,20 @@ The take cmu/01_01.amc is repeated to about 100 MB (125,000 frames at 120 Hz,
 17 minutes); plain Python, much slower, parses a tenth of it.
 """
 
-import os
-import re
 import subprocess
 import sys
 import textwrap
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import motiontheater as mt
-from conftest import NOTES
+from conftest import DATA, NOTES, repeated_take
 
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 FRAMES = 125_000
 SLOW = dict(rounds=3, iterations=1)
 FAST = dict(rounds=5, iterations=1, warmup_rounds=1)
 pd = pytest.importorskip("pandas")
-
-
-def _repeated_take(frames: int) -> bytes:
-    """01_01.amc with its frames repeated and renumbered up to ``frames`` frames."""
-    text = (DATA / "cmu" / "01_01.amc").read_bytes()
-    first = re.search(rb"(?m)^1\s*$", text).start()
-    blocks = re.split(rb"(?m)^\d+\s*\r?\n", text[first:])[1:]
-    out = [text[:first]]
-    for i in range(frames):
-        out.append(b"%d\r\n" % (i + 1))
-        out.append(blocks[i % len(blocks)])
-    return b"".join(out)
 
 
 @pytest.fixture(scope="module")
@@ -47,14 +31,14 @@ def skeleton():
 @pytest.fixture(scope="module")
 def big(tmp_path_factory, skeleton):
     path = tmp_path_factory.mktemp("amc") / "big.amc"
-    path.write_bytes(_repeated_take(FRAMES))
+    path.write_bytes(repeated_take(FRAMES))
     return path
 
 
 @pytest.fixture(scope="module")
 def tenth(tmp_path_factory, skeleton):
     path = tmp_path_factory.mktemp("amc") / "tenth.amc"
-    path.write_bytes(_repeated_take(FRAMES // 10))
+    path.write_bytes(repeated_take(FRAMES // 10))
     return path
 
 

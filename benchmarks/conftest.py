@@ -6,14 +6,31 @@ the issues set as targets.  Ratios use each benchmark's fastest round, the
 figure least disturbed by other load on a shared machine.
 """
 
+import os
+import re
 from collections import defaultdict
+from pathlib import Path
 
 import pytest
+
+DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 
 RESULTS: dict[str, dict[str, tuple[float, float, str]]] = defaultdict(dict)
 CEILING: dict[str, str] = {}  # case -> the case holding its memory-copy reference
 TARGETS: dict[str, str] = {}
 NOTES: list[str] = []  # measured facts that are not timings (peak memory)
+
+
+def repeated_take(frames: int) -> bytes:
+    """cmu/01_01.amc with its frames repeated and renumbered up to ``frames`` frames (125,000: about 100 MB)."""
+    text = (DATA / "cmu" / "01_01.amc").read_bytes()
+    first = re.search(rb"(?m)^1\s*$", text).start()
+    blocks = re.split(rb"(?m)^\d+\s*\r?\n", text[first:])[1:]
+    out = [text[:first]]
+    for i in range(frames):
+        out.append(b"%d\r\n" % (i + 1))
+        out.append(blocks[i % len(blocks)])
+    return b"".join(out)
 
 
 @pytest.fixture

@@ -36,7 +36,8 @@ enum mt_status {
     MT_EDUPLICATE = -7, /* a key appears twice in one frame */
     MT_EMISSING = -8,   /* a frame lacks a key that takes numbers */
     MT_EFRAME = -9,     /* a frame number out of sequence, or a key line before any frame */
-    MT_ERANGE = -10     /* more frames than the output holds, or an output buffer too small */
+    MT_ERANGE = -10,    /* more frames than the output holds, or an output buffer too small */
+    MT_EFRAMERANGE = -11 /* a frame number outside 0 .. MT_FRAME_MAX, read or to be written */
 };
 
 enum mt_dtype {
@@ -95,6 +96,24 @@ int mt_filter1d(int filter, int dtype, const void *in, void *out,
 size_t mt_filter1d_block(size_t size);
 
 /*
+ * Numbers in text, read and written (number.c, scan.c, format.c), one grammar everywhere:
+ *
+ *     number  = [sign] (decimal | "inf" | "infinity" | "nan")     words in any case
+ *     decimal = (digits ["." [digits]] | "." digits) [("e" | "E") [sign] digits]
+ *     sign    = "+" | "-"
+ *
+ * A number reads as the double nearest it (ties to even), for any count of digits: what
+ * Python's float() gives for the same token.  No hexadecimal, '_', "nan(...)" or blanks.
+ * Reading and writing never depend on the C locale (LC_NUMERIC).
+ */
+
+/* The token text[0 .. len-1] (no blanks around it) into *value; MT_ESYNTAX if it is not a number. */
+int mt_parse_number(const char *text, size_t len, double *value);
+
+/* Frame numbers, read and written, are 0 .. MT_FRAME_MAX (18 digits). */
+#define MT_FRAME_MAX 999999999999999999
+
+/*
  * Frame text: frames of key lines, each frame opened by a line holding only
  * its frame number (consecutive, from any start), e.g.
  *
@@ -107,7 +126,8 @@ size_t mt_filter1d_block(size_t size);
  * the frame's row of `channels` values.  Keys may come in any order within a
  * frame, each at most once; every key with counts[i] > 0 must be present.
  * Lines end in LF, CRLF or CR; blank lines and lines starting with '#' are
- * skipped; tokens are separated by spaces or tabs.
+ * skipped; tokens are separated by spaces or tabs.  A line of digits only is a
+ * frame number; above MT_FRAME_MAX it is MT_EFRAMERANGE.
  */
 struct mt_scan_report {
     size_t frames;         /* frames stored */
@@ -135,31 +155,63 @@ int mt_scan_frames(const char *text, size_t len, const char *const *keys, const 
 int mt_scan_table(const char *text, size_t len, size_t rows, size_t columns, double *values,
                   struct mt_scan_report *report);
 
-/* Writes values (rows x columns) as lines of numbers separated by a blank; see mt_format_frames. */
-int mt_format_table(const double *values, size_t rows, size_t columns, char *buf, size_t cap,
-                    size_t *written);
+enum mt_newline {
+    MT_NEWLINE_LF = 0,
+    MT_NEWLINE_CRLF = 1,
+    MT_NEWLINE_CR = 2
+};
 
 /*
- * Writes the shortest decimal text that reads back as exactly `value` into
- * buf (at least MT_NUMBER_MAX bytes, not NUL-terminated); returns its length.
- * Style of printf %g and Python repr: 17.8693, 1.23246e-13, 3, -0, -nan, inf;
- * a NaN keeps its sign but not its payload.
+ * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF}.
+ *
+ *   digits           0: the shortest text that reads back as exactly the value, of
+ *                    those the nearest to it (the digits of Python's repr); exponent
+ *                    form below 1e-4 and from 1e16 up, as repr.  1 .. 17: the value
+ *                    correctly rounded to that many significant digits (ties to even),
+ *                    as C's %.<digits>g: exponent form below 1e-4 and from 10^digits up.
+ *                    Trailing zeros and a trailing point are dropped: 17.8693, 3, -0,
+ *                    1.23246e-13, -nan, inf (a NaN keeps its sign, not its payload).
+ *   exponent_digits  the fewest digits of an exponent, 1 .. 3: 2 gives 1e-05 (Python,
+ *                    C on Linux), 3 gives 1e-005 (HDM05 files, C on Windows).
+ *   newline          the line ending of mt_format_frames and mt_format_table.
+ *   frame_newline    the ending of the lines that hold only a frame number
+ *                    (mt_format_frames): HDM05 ends those in LF, every other in CRLF.
  */
-size_t mt_format_double(double value, char *buf);
+struct mt_format_style {
+    int digits;
+    int exponent_digits;
+    int newline;
+    int frame_newline;
+};
+
+/* Bytes a number can take: -1.2345678901234567e-308. */
+enum { MT_NUMBER_MAX = 24 };
+
+/* Writes the text of value into buf (MT_NUMBER_MAX bytes, not NUL-terminated); its length to *written. */
+int mt_format_double(double value, const struct mt_format_style *style, char *buf, size_t *written);
 
 /*
  * Writes frames first .. first+frames-1 of values (frames x channels) as
  * frame text, the keys in the order given, into buf of cap bytes; *written
- * receives the length.  MT_ERANGE if cap is below mt_format_bound().
+ * receives the length.  MT_ERANGE if cap is below mt_format_bound();
+ * MT_EFRAMERANGE if a frame number would be outside 0 .. MT_FRAME_MAX.
  */
 int mt_format_frames(const double *values, size_t frames, size_t channels, long long first_frame,
                      const char *const *keys, const size_t *key_lens, const size_t *offsets,
-                     const size_t *counts, size_t nkeys, char *buf, size_t cap, size_t *written);
+                     const size_t *counts, size_t nkeys, const struct mt_format_style *style, char *buf,
+                     size_t cap, size_t *written);
 
-/* Bytes that mt_format_frames may need for `frames` frames of these keys. */
-size_t mt_format_bound(size_t frames, const size_t *key_lens, const size_t *counts, size_t nkeys);
+/* Bytes that mt_format_frames may need for `frames` frames of these keys (SIZE_MAX past size_t). */
+size_t mt_format_bound(size_t frames, const size_t *key_lens, const size_t *counts, size_t nkeys,
+                       const struct mt_format_style *style);
 
-enum { MT_NUMBER_MAX = 32 };
+/* Writes values (rows x columns) as lines of numbers separated by a blank; MT_ERANGE if cap is
+   below mt_format_table_bound(). */
+int mt_format_table(const double *values, size_t rows, size_t columns, const struct mt_format_style *style,
+                    char *buf, size_t cap, size_t *written);
+
+/* Bytes that mt_format_table may need (SIZE_MAX past size_t). */
+size_t mt_format_table_bound(size_t rows, size_t columns, const struct mt_format_style *style);
 
 /* Channels of a joint: rotations about, and translations along, its x, y, z; and stretch. */
 enum mt_dof {
@@ -289,6 +341,94 @@ int mt_combine(const double *old_values, size_t old_frames, const double *new_va
                const double *weight, const unsigned char *selected, const long long *offset_row,
                const double *offsets, size_t offset_rows, const size_t *offset_channel,
                size_t noffsets, size_t begin, size_t end, double *out);
+/*
+ * Signal kernels (bands.c, iir.c, resample.c, gaps.c), float64.  Unless said
+ * otherwise an array is n rows (frames) of `channels` values, consecutive
+ * rows `stride` values apart (stride >= channels): a call may process a slab
+ * of the columns of a wider (n, stride) array, so that threads can share the
+ * channels of one array.  Outputs have the input's layout and never alias it.
+ */
+
+/*
+ * The band equaliser of Bruderlin and Williams (1995).  Level G_0 is the
+ * input; G_{k+1} is G_k correlated with (1 4 6 4 1) / 16, its taps 2^k frames
+ * apart (no decimation: every level has all n frames), the level extended
+ * past its ends by `mode` (fill value cval); band k is G_k - G_{k+1}.  Writes
+ *
+ *     out = in + sum_{k < levels} (gains[k] - 1) (G_k - G_{k+1}),
+ *
+ * which is G_levels + sum gains[k] band_k, summed so that gains of 1 give the
+ * input exactly.  Requires 2^levels <= n (for n >= 1).
+ */
+int mt_equalize(const double *in, double *out, size_t n, size_t channels, size_t stride, size_t levels,
+                const double *gains, int mode, double cval);
+
+/*
+ * How mt_sosfiltfilt extends a line a b c d by padlen samples (scipy's padtype):
+ *
+ *   odd       2a-d 2a-c 2a-b | a b c d | 2d-c 2d-b 2d-a
+ *   even         d    c    b | a b c d | c b a
+ *   constant     a    a    a | a b c d | d d d
+ *   none         (no extension)
+ */
+enum mt_pad {
+    MT_PAD_NONE = 0,
+    MT_PAD_ODD = 1,
+    MT_PAD_EVEN = 2,
+    MT_PAD_CONSTANT = 3
+};
+
+/*
+ * Forward-backward filtering by `sections` second-order sections (sos,
+ * sections x 6: b0 b1 b2 a0 a1 a2, a0 = 1), as scipy.signal.sosfiltfilt: the
+ * line extended by padlen samples (padtype), filtered forward from the state
+ * zi[s] * (first sample), then backward from zi[s] * (last forward output),
+ * the extension cut off.  zi (sections x 2) is the steady state of a unit
+ * step (scipy.signal.sosfilt_zi).  Requires padlen < n (padlen is ignored
+ * for MT_PAD_NONE, then n >= 1).
+ *
+ * Computed as scipy computes it, bit for bit, with the input read twice and
+ * the output written once (see iir.c).
+ */
+int mt_sosfiltfilt(const double *sos, size_t sections, const double *zi, const double *in, double *out, size_t n,
+                   size_t channels, size_t stride, size_t padlen, int padtype);
+
+/*
+ * Upsample by up, filter by the FIR h (taps), downsample by down, as
+ * scipy.signal.upfirdn, on (n, channels) rows (stride = channels): output row
+ * j (begin <= j < end, at out + j * channels) is
+ *
+ *     sum over i of v[i] h[(skip + j) down - i up],  0 <= (skip + j) down - i up < taps,
+ *
+ * v[i] = in row i for 0 <= i < n, before row nbefore + i for -nbefore <= i < 0,
+ * after row i - n for n <= i < n + nafter (both (rows, channels)), 0 elsewhere.
+ */
+int mt_upfirdn(const double *h, size_t taps, size_t up, size_t down, const double *in, size_t n, size_t channels,
+               const double *before, size_t nbefore, const double *after, size_t nafter, size_t skip, size_t begin,
+               size_t end, double *out);
+
+enum mt_fill {
+    MT_FILL_LINEAR = 0, /* the line between the samples around the gap (numpy.interp) */
+    MT_FILL_CUBIC = 1   /* the not-a-knot cubic spline of scipy.interpolate.CubicSpline */
+};
+
+/*
+ * Copies in to out and fills each run of NaN in a channel that is at most
+ * max_gap frames long and has a sample on both sides.  MT_FILL_CUBIC takes
+ * the spline through every sample of the stretch between the runs left
+ * unfilled (or the ends of the line).  Other runs stay NaN.
+ */
+int mt_fill_gaps(const double *in, double *out, size_t n, size_t channels, size_t stride, size_t max_gap,
+                 int method);
+
+/*
+ * The runs of NaN: (channel, first frame, frame after the last) triples, in
+ * the order they end, the first `capacity` of them into runs (capacity x 3);
+ * *count receives how many there are (runs may be NULL when capacity is 0).
+ */
+int mt_nan_runs(const double *in, size_t n, size_t channels, size_t stride, size_t *runs, size_t capacity,
+                size_t *count);
+
 /*
  * Footskate cleanup (footskate.c; Kovar, Schreiner & Gleicher, SCA 2002).
  *

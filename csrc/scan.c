@@ -1,15 +1,15 @@
 /*
  * scan.c - frame text (AMC-style) into a values array, in one pass.
  *
- * Numbers take an exact fast path: a decimal with at most 19 significant
- * digits whose mantissa is below 2^53 and whose power of ten is at most 22
- * in magnitude is the mantissa times or divided by an exactly representable
- * power of ten, one correctly rounded operation (Clinger 1990).  Anything
- * else (more digits, large exponents, inf, nan) goes through strtod, so every
- * value equals what Python's float() gives for the same text.
+ * Numbers (the grammar of mtcore.h) take an exact fast path: a decimal with at most 19
+ * significant digits whose mantissa is at most 2^53 and whose power of ten is at most 22 in
+ * magnitude is the mantissa times or divided by an exactly representable power of ten, one
+ * correctly rounded operation (Clinger 1990).  Every other token goes to number_parse
+ * (number.c), exact for any length, so that every value equals what Python's float() gives
+ * for the same text.
  */
-#include "decimal.h"
 #include "mtcore.h"
+#include "number.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -38,20 +38,6 @@ static const char *token_end(const char *p, const char *end)
     return p;
 }
 
-/* The token [p, end) through strtod; 0 if it is not a number. */
-static int parse_slow(const char *p, const char *end, double *out)
-{
-    char buf[64];
-    size_t n = (size_t)(end - p);
-    if (n >= sizeof buf)
-        return 0;
-    memcpy(buf, p, n);
-    buf[n] = '\0';
-    char *stop;
-    *out = strtod(buf, &stop);
-    return n > 0 && stop == buf + n;
-}
-
 /* Appends the digits at p to *mantissa, two per step to halve the multiply chain. */
 static const char *take_digits(const char *p, const char *end, uint64_t *mantissa)
 {
@@ -69,7 +55,7 @@ static const char *take_digits(const char *p, const char *end, uint64_t *mantiss
 /*
  * Parses the number that starts at p, before end; returns the end of its
  * token, or NULL if the token is not a number.  One pass for the usual
- * decimals; other tokens are measured and handed to strtod.
+ * decimals; other tokens are measured and handed to number_parse.
  */
 static const char *parse_number(const char *p, const char *end, double *out)
 {
@@ -78,7 +64,7 @@ static const char *parse_number(const char *p, const char *end, double *out)
     if (p < end && (*p == '-' || *p == '+'))
         negative = *p++ == '-';
     /* Digits go into the mantissa unchecked; more than 19 of them (leading
-       zeros included, which is rare) take the slow path below. */
+       zeros included, which is rare) take the general path below. */
     uint64_t mantissa = 0;
     const char *first = p;
     p = take_digits(p, end, &mantissa);
@@ -103,14 +89,28 @@ static const char *parse_number(const char *p, const char *end, double *out)
             p = e;
         }
     }
-    if (digits > 0 && exact && (p == end || is_blank(*p) || is_eol(*p)) &&
-        mantissa <= ((uint64_t)1 << 53) && exp10 >= -22 && exp10 <= 22) {
-        const double v = exact_decimal(mantissa, exp10);
-        *out = negative ? -v : v;
-        return p;
+    if (digits > 0 && exact && (p == end || is_blank(*p) || is_eol(*p))) {
+        if (mantissa <= ((uint64_t)1 << 53) && exp10 >= -22 && exp10 <= 22) {
+            const double v = exact_decimal(mantissa, exp10);
+            *out = negative ? -v : v;
+            return p;
+        }
+        uint64_t bits; /* 16 to 19 digits, or large exponents */
+        if (number_decimal(mantissa, exp10, &bits)) {
+            bits |= (uint64_t)negative << 63;
+            memcpy(out, &bits, sizeof bits);
+            return p;
+        }
     }
-    const char *stop = token_end(start, end); /* inf, nan, long or odd forms */
-    return parse_slow(start, stop, out) ? stop : NULL;
+    const char *stop = token_end(start, end); /* inf, nan, long or odd forms, ties */
+    return number_parse(start, stop, out) ? stop : NULL;
+}
+
+int mt_parse_number(const char *text, size_t len, double *value)
+{
+    if ((text == NULL && len > 0) || value == NULL)
+        return MT_EINVAL;
+    return len > 0 && number_parse(text, text + len, value) ? MT_OK : MT_ESYNTAX;
 }
 
 /*
@@ -148,22 +148,25 @@ static int line_numbers(const char **p, const char *end, double *dst, size_t cou
     return MT_OK;
 }
 
-/* A line holding one token of digits only: the frame number, or -1. */
-static long long frame_number(const char *tok, const char *tok_end, const char *line_rest,
-                              const char *end)
+/*
+ * Whether the line holding the token [tok, tok_end) and then [line_rest, end) is a frame
+ * number line (one token of digits); its number to *number, or -1 above MT_FRAME_MAX.
+ */
+static int frame_line(const char *tok, const char *tok_end, const char *line_rest, const char *end,
+                      long long *number)
 {
-    if (tok_end - tok > 18)
-        return -1;
-    long long number = 0;
+    long long n = 0;
     for (const char *q = tok; q < tok_end; q++) {
         if (!is_digit(*q))
-            return -1;
-        number = number * 10 + (*q - '0');
+            return 0;
+        if (n >= 0)
+            n = n > (MT_FRAME_MAX - (*q - '0')) / 10 ? -1 : n * 10 + (*q - '0');
     }
     for (const char *q = line_rest; q < end && !is_eol(*q); q++)
         if (!is_blank(*q))
-            return -1;
-    return number;
+            return 0;
+    *number = n;
+    return 1;
 }
 
 struct scan {
@@ -219,8 +222,10 @@ static int scan_text(const char *text, const char *end, struct scan *s, double *
             p++;
         if (p < end && !is_eol(*p) && *p != '#') {
             const char *tok = p, *tok_stop = token_end(p, end);
-            long long number = frame_number(tok, tok_stop, tok_stop, end);
-            if (number >= 0) {
+            long long number;
+            if (frame_line(tok, tok_stop, tok_stop, end, &number)) {
+                if (number < 0)
+                    return MT_EFRAMERANGE;
                 if (frames > 0 && (r->key = missing_key(s, frames)) >= 0)
                     return MT_EMISSING;
                 if (frames > 0 && number != previous + 1) {

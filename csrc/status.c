@@ -25,6 +25,8 @@ const char *mt_strerror(int status)
         return "frame number out of sequence";
     case MT_ERANGE:
         return "output too small";
+    case MT_EFRAMERANGE:
+        return "frame number outside 0 .. MT_FRAME_MAX";
     default:
         return "unknown status code";
     }

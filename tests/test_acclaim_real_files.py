@@ -9,6 +9,7 @@ import pytest
 import motiontheater as mt
 from amc_twin import parse_amc
 from conftest import ids, real_files
+from motiontheater._io import PLAIN
 
 ASFS = real_files("*/*.asf")
 AMCS = real_files("*/*.amc")
@@ -66,22 +67,26 @@ def test_hdm05_root_translation_is_amc_root_over_length_unit(ref):
     np.testing.assert_allclose(root / 0.45, expected, rtol=1e-15, atol=0)
 
 
-def test_number_text_is_kept_short(data_dir):
-    """A value read as 1.23246e-013 is written as 1.23246e-13, not with 17 digits."""
+def test_number_text_is_kept_short_and_in_the_files_style(data_dir):
+    """A value read as 3.64024e-015 is written in the shortest form, not with 17 digits, with the
+    file's exponent digits and line endings, or in the plain style when asked."""
     amc = data_dir / "cmu" / "01_01.amc"
     motion = load(amc)
+    assert b"rclavicle 3.64024e-015 -6.75868e-015\r\n" in amc.read_bytes()
     out = io.BytesIO()
-    mt.write_amc(motion, out)
-    assert b"rclavicle 3.64024e-15 -6.75868e-15\n" in out.getvalue()
-    assert b"3.64024e-015" in amc.read_bytes()
+    mt.write_amc(motion, out)  # a file object: written through the formatter, not copied
+    assert b"rclavicle 3.64024e-015 -6.75868e-015\r\n" in out.getvalue()
+    plain = io.BytesIO()
+    mt.write_amc(motion.replace(style=PLAIN), plain)
+    assert b"rclavicle 3.64024e-15 -6.75868e-15\n" in plain.getvalue()
 
 
 def test_latin1_header_survives_a_round_trip(data_dir, tmp_path):
     amc = data_dir / "hdm05" / "HDM_bd_squat1Reps_003_120.amc"
     motion = load(amc)
     assert "Bonn" in motion.header[0]
-    mt.write_amc(motion, tmp_path / "out.amc")
-    first_line = (tmp_path / "out.amc").read_bytes().split(b"\n")[0]
+    mt.write_amc(motion.replace(values=motion.values.copy()), tmp_path / "out.amc")  # through the formatter
+    first_line = (tmp_path / "out.amc").read_bytes().split(b"\r\n")[0]
     assert first_line == amc.read_bytes().split(b"\r\n")[0]  # the latin-1 byte unchanged
 
 

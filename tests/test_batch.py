@@ -113,12 +113,14 @@ def test_killing_a_run_leaves_no_partial_outputs_and_resume_completes_it(data_di
         str(out),
         "--quiet",
     ]
-    run = subprocess.Popen(command)
+    run = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
     deadline = time.time() + 60
     while time.time() < deadline and len(list(out.rglob("*.amc"))) < 20:
         time.sleep(0.01)
     run.send_signal(signal.SIGTERM)
-    run.wait(timeout=60)
+    _, stopped = run.communicate(timeout=60)
+    assert run.returncode == 130
+    assert "INTERRUPTED" in stopped and "--resume" in stopped
     done = list(out.rglob("*.amc"))
     assert 0 < len(done) < 12 * 33, "the run was not caught midway"
     assert not list(out.rglob(".mt-partial-*"))
@@ -129,7 +131,11 @@ def test_killing_a_run_leaves_no_partial_outputs_and_resume_completes_it(data_di
         assert take.read_bytes() == expected[relative], relative
     finished = subprocess.run(command[:-1] + ["--resume"], check=False, capture_output=True, text=True)
     assert finished.returncode == 0, finished.stderr
-    assert f"{len(done)} skipped (already done)" in finished.stdout
+    # the manifest holds every take the parent saw finish: at most those on disk (a worker may finish
+    # one in the moment the parent stops listening; resume does that one again)
+    skipped = int(re.search(r"(\d+) skipped \(already done\)", finished.stdout).group(1))
+    assert 0 < skipped <= len(done)
+    assert "Traceback" not in stopped + finished.stderr
     assert len(list(out.rglob("*.amc"))) == 12 * 33
     sample = out / "copy07" / "HDM_bd_squat1Reps_003_120.amc"
     assert sample.read_bytes() == expected_bytes(src / "copy07" / "HDM_bd_squat1Reps_003_120.amc")
@@ -186,42 +192,31 @@ def long_take(data_dir: Path, path: Path, frames: int) -> Path:
 
 
 def test_streaming_memory_does_not_grow_with_the_take(data_dir, tmp_path):
-    """One hour and two hours (432,000 and 864,000 frames) stream with the same peak memory (a whole
-    hour more held in memory would be 200 MB of values), and to the same bytes as in memory."""
+    """Fifteen and thirty minutes (108,000 and 216,000 frames) stream with the same peak memory: the
+    take in memory would add at least its values, 54 MB for the quarter hour more (the bytes equal
+    processing whole: test_streaming_equals_whole)."""
     script = textwrap.dedent(f"""
         import re, sys, motiontheater as mt
         from motiontheater import streaming
-        def peak():
-            return int(re.search(r"VmHWM:\\s+(\\d+)", open("/proc/self/status").read()).group(1)) * 1024
         skeleton = mt.read_asf({str(data_dir / "cmu" / "01.asf")!r})
-        take, target = sys.argv[2], sys.argv[3]
-        if sys.argv[1] == "stream":
-            streaming.stream(take, target, skeleton, mt.Pipeline.of("median", size=5))
-        else:
-            mt.write_amc(mt.read_amc(take, skeleton).filter("median", 5), target)
-        print(peak())
+        streaming.stream(sys.argv[1], sys.argv[2], skeleton, mt.Pipeline.of("median", size=5))
+        print(int(re.search(r"VmHWM:\\s+(\\d+)", open("/proc/self/status").read()).group(1)) * 1024)
     """)
 
-    def run(*args) -> int:
+    def peak(frames: int) -> int:
+        take = long_take(data_dir, tmp_path / f"{frames}.amc", frames)
         done = subprocess.run(
-            [sys.executable, "-c", script, *map(str, args)], check=False, capture_output=True, text=True
+            [sys.executable, "-c", script, str(take), str(tmp_path / "out.amc")],
+            check=False,
+            capture_output=True,
+            text=True,
         )
         assert done.returncode == 0, done.stderr
+        take.unlink()
         return int(done.stdout)
 
-    hour = long_take(data_dir, tmp_path / "hour.amc", 432_000)
-    one = run("stream", hour, tmp_path / "hour-out.amc")
-    hour.unlink()
-    two_hours = long_take(data_dir, tmp_path / "long.amc", 864_000)
-    two = run("stream", two_hours, tmp_path / "streamed.amc")
-    assert two - one < 50e6, f"peak {one / 1e6:.0f} MB for one hour, {two / 1e6:.0f} MB for two"
-    run("whole", two_hours, tmp_path / "whole.amc")
-    with open(tmp_path / "streamed.amc", "rb") as a, open(tmp_path / "whole.amc", "rb") as b:
-        while True:
-            x, y = a.read(1 << 24), b.read(1 << 24)
-            assert x == y
-            if not x:
-                break
+    quarter, half = peak(108_000), peak(216_000)
+    assert half - quarter < 30e6, f"peak {quarter / 1e6:.0f} MB for 15 minutes, {half / 1e6:.0f} MB for 30"
 
 
 def test_batch_streams_takes_above_the_threshold(data_dir, tmp_path, capsys):
@@ -272,7 +267,8 @@ def test_progress_bar(capsys):
     progress.advance(batch.Result("a", "b", bytes=1_000_000))
     progress.close()
     err = capsys.readouterr().err
-    assert "1/2 files, 1.0/2.0 MB" in err and "MB/s, ETA" in err
+    pytest.importorskip("tqdm")
+    assert "1/2 takes" in err and "50%" in err and "1.00M/2.00M" in err
     silent = batch.Progress(2, 10, enabled=False)
     silent.advance(batch.Result("a", "b", bytes=5))
     assert capsys.readouterr().err == ""

@@ -3,14 +3,19 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import io
 import mmap
 import os
 import re
+import shutil
 import tempfile
 import typing
 from collections.abc import Iterator
-from typing import IO
+from dataclasses import dataclass
+from typing import IO, Any
+
+from mtcore.text import frame_line, text_style
 
 Source = str | os.PathLike | IO[bytes] | IO[str]
 Text = bytes | mmap.mmap  # a file's bytes, read or mapped
@@ -41,6 +46,78 @@ def mapped_source(source: Source) -> Iterator[tuple[bytes | mmap.mmap, str | Non
         yield mapped, os.fspath(source)
 
 
+@dataclass(frozen=True)
+class TextStyle:
+    """How a file's text is laid out, so that what is written from it looks the same: its line
+    endings (``frame_newline`` for the lines that hold only a frame number, which HDM05 ends in LF
+    while every other line ends in CRLF), the fewest digits of an exponent (HDM05: 3, ``e-013``),
+    and whether the last line ends in a line break."""
+
+    newline: bytes = b"\n"
+    frame_newline: bytes = b"\n"
+    exponent_digits: int = 2
+    final_newline: bool = True
+
+    @classmethod
+    def of(cls, data: bytes | mmap.mmap) -> TextStyle:
+        """The style of a file's text."""
+        newline, exponent_digits = text_style(data)
+        frame = frame_line(data, 0, min(len(data), 1 << 20))
+        frame_newline = newline
+        if frame != -1:
+            match = _LINE_END.search(data, frame)
+            frame_newline = match.group() if match else newline
+        return cls(newline, frame_newline, exponent_digits, not data or data[-1:] in (b"\n", b"\r"))
+
+    def lines(self, lines: list[str]) -> bytes:
+        """Header lines as bytes, each ended as the file ends its lines."""
+        return encode("".join(line + self.newline.decode() for line in lines))
+
+    def numbers(self) -> dict[str, Any]:
+        """The options of mtcore.text's writers for this style (format_frames also takes frame_newline)."""
+        return {"exponent_digits": self.exponent_digits, "newline": self.newline}
+
+
+PLAIN = TextStyle()  # what this package writes when no file says otherwise
+_LINE_END = re.compile(rb"\r\n|\r|\n")
+
+
+@dataclass(frozen=True)
+class Origin:
+    """The file an object was read from, and the file's size and time then: while they hold, the
+    file still says exactly what was read, and writing the unchanged object back can copy it."""
+
+    path: str
+    stamp: tuple[int, int]
+
+    @classmethod
+    def of(cls, source: Source) -> Origin | None:
+        """The origin of a source named by path; None for a file object (it cannot be read again)."""
+        if not isinstance(source, (str, os.PathLike)):
+            return None
+        status = os.stat(source)
+        return cls(os.path.abspath(source), (status.st_size, status.st_mtime_ns))
+
+    def intact(self) -> bool:
+        """Whether the file is still as it was read."""
+        try:
+            status = os.stat(self.path)
+        except OSError:
+            return False
+        return (status.st_size, status.st_mtime_ns) == self.stamp
+
+    def copy_to(self, target: Source) -> bool:
+        """Write the file's bytes to ``target`` (atomically, as :func:`output`) if it is intact and
+        is not the target itself; returns whether it did."""
+        if not self.intact():
+            return False
+        if isinstance(target, (str, os.PathLike)) and os.path.abspath(target) == self.path:
+            return True  # writing the file over itself, unchanged: nothing to do
+        with open(self.path, "rb") as src, output(target) as dst:
+            shutil.copyfileobj(src, dst)
+        return True
+
+
 def decode(data: bytes) -> str:
     """Text of a file whose comments may hold any bytes: undecodable bytes survive
     as surrogates and are written back unchanged by :func:`encode`."""
@@ -48,6 +125,7 @@ def decode(data: bytes) -> str:
 
 
 def encode(text: str) -> bytes:
+    """The bytes of :func:`decode`'s text, undecodable bytes restored."""
     return text.encode("utf-8", "surrogateescape")
 
 
@@ -55,16 +133,85 @@ def encode(text: str) -> bytes:
 def output(target: Source) -> Iterator[IO[bytes]]:
     """A binary stream to write to.  For a path, the text goes to a temporary file
     beside it that replaces the path only when complete, so that a failure
-    leaves no partial file."""
+    leaves no partial file; the file gets the permissions any new file gets
+    (the umask's).  An OSError names the target, never the temporary file."""
     if not isinstance(target, (str, os.PathLike)):
         yield typing.cast(IO[bytes], target.buffer if isinstance(target, io.TextIOWrapper) else target)
         return
-    directory = os.path.dirname(os.path.abspath(target))
-    fd, tmp = tempfile.mkstemp(prefix=PARTIAL_PREFIX, suffix="-" + os.path.basename(target), dir=directory)
+    path = os.fspath(target)
+    directory = os.path.dirname(os.path.abspath(path))
+    remove_stale_partials(directory)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f"{PARTIAL_PREFIX}{os.getpid()}-", suffix=".tmp", dir=directory)
+    except OSError as e:
+        raise OutputError(e.errno, f"cannot write {path}: {e.strerror}") from None
     try:
         with os.fdopen(fd, "wb") as f:
             yield f
-        os.replace(tmp, target)
-    except BaseException:
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, path)
+    except BaseException as e:
         os.unlink(tmp)
+        if isinstance(e, OSError) and e.filename in (None, tmp) and e.errno in WRITE_ERRORS:
+            raise OutputError(e.errno, f"cannot write {path}: {e.strerror}") from None
         raise
+
+
+WRITE_ERRORS = (errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+
+
+class OutputError(OSError):
+    """A file could not be written (no permission, read-only, disk full): the message names the
+    file the user asked for, never the temporary file."""
+
+    def __str__(self) -> str:
+        return str(self.strerror)
+
+
+def _umask() -> int:
+    """The process's umask (read without changing it where /proc tells it)."""
+    try:
+        with open("/proc/self/status") as f:
+            return int(next(line for line in f if line.startswith("Umask:")).split()[1], 8)
+    except (OSError, StopIteration, ValueError):
+        mask = os.umask(0o022)
+        os.umask(mask)
+        return mask
+
+
+_CLEANED: set[str] = set()
+
+
+def remove_stale_partials(directory: str | os.PathLike, *, recursive: bool = False) -> int:
+    """Remove the temporary files that killed processes left in ``directory`` (and below it,
+    ``recursive``); a file being written by a live process is left alone.  A folder is looked
+    at once per process unless ``recursive``.  Returns how many were removed."""
+    folder = os.fspath(directory)
+    if not recursive:
+        if folder in _CLEANED:
+            return 0
+        _CLEANED.add(folder)
+    removed = 0
+    with contextlib.suppress(OSError), os.scandir(folder) as entries:
+        for entry in entries:
+            if recursive and entry.is_dir(follow_symlinks=False):
+                removed += remove_stale_partials(entry.path, recursive=True)
+            elif entry.name.startswith(PARTIAL_PREFIX) and not _alive(entry.name[len(PARTIAL_PREFIX) :]):
+                with contextlib.suppress(OSError):
+                    os.unlink(entry.path)
+                    removed += 1
+    return removed
+
+
+def _alive(rest: str) -> bool:
+    """Whether the process whose id starts ``rest`` ("<pid>-...") still runs."""
+    pid = rest.split("-", 1)[0]
+    if not pid.isdigit():
+        return False
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True

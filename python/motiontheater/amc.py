@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -13,7 +14,7 @@ import numpy as np
 from mtcore import format_frames, format_number, scan_frames
 from mtcore.text import frame_line, line_breaks
 
-from ._io import LINE_BREAK, Source, Text, decode, encode, mapped_source, output
+from ._io import LINE_BREAK, Source, Text, TextStyle, decode, encode, mapped_source, output
 from .errors import FormatError, SequenceError
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Skeleton
@@ -39,7 +40,10 @@ def skeleton_path_for(amc_path: str | os.PathLike) -> Path:
         if matches and (best is None or len(stem) > len(best.stem.split("-")[0])):
             best = asf
     if best is None:
-        raise FileNotFoundError(f"no skeleton (.asf) for {amc} in {amc.parent}")
+        raise FileNotFoundError(
+            f"no skeleton for {amc}: no .asf in {amc.parent} matches its name (CMU 01_02.amc -> 01.asf, "
+            "HDM05 HDM_bd_squat_003_120.amc -> HDM_bd.asf, take.amc -> take.asf); give it with --asf"
+        )
     return best
 
 
@@ -65,7 +69,7 @@ def _split_header(data: Text) -> tuple[list[tuple[int, str]], int, int]:
         lines += 1
         if line:
             header.append((lines, decode(line)))
-        pos = end + (2 if data[end : end + 2] == b"\r\n" else 1)
+        pos = min(len(data), end + (2 if data[end : end + 2] == b"\r\n" else 1))
     return header, pos, lines
 
 
@@ -98,7 +102,7 @@ def read_amc(
     ``workers=1`` keeps to the calling thread (as batch jobs in processes should).
     """
     with mapped_source(source) as (data, name):
-        return _read(data, name, skeleton, frame_rate, workers)
+        return _read(data, name, skeleton, frame_rate, workers).read_from(source)
 
 
 def _read_header(
@@ -136,6 +140,7 @@ def _read(data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | 
         first_frame=first if len(values) else 1,
         header=tuple(text for _, text in header),
         line_order=_first_frame_order(data, body, set(joints)),
+        style=TextStyle.of(data),
     )
 
 
@@ -167,8 +172,12 @@ def write_amc(motion: Motion, target: Source) -> None:
     The header is the motion's (its rate line updated, or added when the rate
     is not the default); bone lines follow the motion's ``line_order`` when it
     has one, else the root and the bones with dofs in skeleton order.  Every
-    number is the shortest text that reads back to exactly the same float64.
+    number is the shortest text that reads back to exactly the same float64,
+    lines and exponents laid out as the file read was (``motion.style``); a
+    motion written back unchanged is its file's very bytes.
     """
+    if motion.unchanged() and motion.origin is not None and motion.origin.file.copy_to(target):
+        return
     with amc_writer(motion, target) as write:
         write(motion.values, motion.first_frame)
 
@@ -179,9 +188,21 @@ def amc_writer(motion: Motion, target: Source) -> Iterator[Callable[[np.ndarray,
     line order and skeleton of ``motion`` (its values are not written): :func:`write_amc` a
     piece at a time.  A path is replaced only when the block ends without an error."""
     keys, offsets, counts = _layout(motion.skeleton, _write_order(motion.skeleton, motion.line_order))
+    style = motion.style
+    frames = 0
+
+    def write(values: np.ndarray, first: int) -> None:
+        nonlocal frames
+        format_frames(
+            values, first, keys, offsets, counts, f.write, frame_newline=style.frame_newline, **style.numbers()
+        )
+        frames += len(values)
+
     with output(target) as f:
-        f.write(encode("".join(line + "\n" for line in _header_lines(motion))))
-        yield lambda values, first: format_frames(values, first, keys, offsets, counts, f.write)
+        f.write(style.lines(_header_lines(motion)))
+        yield write
+        if not style.final_newline and f.seekable() and f.tell():  # the file read ended without a break
+            f.truncate(f.tell() - len(style.frame_newline if frames and not keys else style.newline))
 
 
 @dataclass(frozen=True)
@@ -244,6 +265,9 @@ def open_amc(
     header, body, header_lines, rate = _read_header(head, name, skeleton, frame_rate)
     start = frame_line(head, body)
     first = int(LINE_BREAK.split(decode(head[start:]), 1)[0]) if start != -1 else 1
+    with open(path, "rb") as f:
+        f.seek(max(0, os.fstat(f.fileno()).st_size - 1))
+        ends_in_a_break = f.read(1) in (b"", b"\n", b"\r")
     motion = Motion(
         skeleton,
         np.zeros((0, len(skeleton.channels))),
@@ -251,6 +275,7 @@ def open_amc(
         first,
         tuple(text for _, text in header),
         _first_frame_order(head, body, set(skeleton.joint_names)),
+        dataclasses.replace(TextStyle.of(head), final_newline=ends_in_a_break),
     )
     return AmcStream(name, motion, body, header_lines, read_bytes)
 

@@ -3,22 +3,24 @@
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 from mtcore import format_number
 from mtcore.errors import CountError, DuplicateError, FormatError, MissingError, NumberError, TruncatedError
+from mtcore.text import parse_number
 
-from ._io import LINE_BREAK, Source, decode, encode, output, read_source
+from ._io import LINE_BREAK, Origin, Source, TextStyle, decode, output, read_source
 from ._version import __version__
 from .skeleton import BONE_DOFS, ROOT_DOFS, Bone, Root, Skeleton, canonical_hierarchy, name_problem
 
-_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|infinity|nan)", re.IGNORECASE)
 _LIMIT = re.compile(r"\(\s*(\S+)\s+(\S+)\s*\)")
 
 
 def _number(token: str, line: int, what: str) -> float:
-    if not _NUMBER.fullmatch(token):
-        raise NumberError(f"expected a number for {what}, found '{token}'", line)
-    return float(token)
+    try:
+        return parse_number(token)  # the grammar of every format's numbers
+    except NumberError:
+        raise NumberError(f"expected a number for {what}, found '{token}'", line) from None
 
 
 def _numbers(tokens: list[str], count: int, line: int, what: str) -> tuple[float, ...]:
@@ -64,9 +66,10 @@ def read_asf(source: Source) -> Skeleton:
     """
     data, name = read_source(source)
     try:
-        return _parse(_Lines(decode(data)))
+        skeleton = _parse(_Lines(decode(data)))
     except FormatError as e:
         raise e.at(name) from None
+    return replace(skeleton, style=TextStyle.of(data), origin=Origin.of(source))
 
 
 def _parse(lines: _Lines) -> Skeleton:
@@ -242,11 +245,15 @@ def write_asf(skeleton: Skeleton, target: Source) -> None:
     """Write a skeleton as ASF text to a path (atomically) or a binary file object.
 
     Numbers are written in the shortest form that reads back to the same
-    float64, so reading the result gives an identical skeleton.
+    float64, so reading the result gives an identical skeleton; lines end as
+    the file read ended them.  A skeleton equal to its file's is written as
+    the file's very bytes.
     """
-    text = "\n".join(_asf_lines(skeleton)) + "\n"
+    origin = skeleton.origin
+    if origin is not None and origin.intact() and read_asf(origin.path) == skeleton and origin.copy_to(target):
+        return
     with output(target) as f:
-        f.write(encode(text))
+        f.write(skeleton.style.lines(list(_asf_lines(skeleton))))
 
 
 def _num(*values: float) -> str:
@@ -267,18 +274,20 @@ def _asf_lines(s: Skeleton):
     yield f"   position {_num(*s.root.position)}"
     yield f"   orientation {_num(*s.root.orientation)}"
     yield ":bonedata"
-    for i, bone in enumerate(s.bones, start=1):
+    for bone in s.bones:
         yield "  begin"
-        yield f"     id {bone.id if bone.id is not None else i}"
+        if bone.id is not None:  # an id the file did not give is not made up
+            yield f"     id {bone.id}"
         yield f"     name {bone.name}"
         yield f"     direction {_num(*bone.direction)}"
         yield f"     length {_num(bone.length)}"
         yield f"     axis {_num(*bone.axis)} {bone.axis_order}"
         if bone.dofs:
             yield f"     dof {' '.join(bone.dofs)}"
+        # other keys before the limits: a key line that looks like "(lo hi)" must not follow them
+        yield from (f"     {key} {value}".rstrip() for key, value in bone.extra)
         for j, (lo, hi) in enumerate(bone.limits):
             yield f"     {'limits' if j == 0 else '      '} ({_num(lo)} {_num(hi)})"
-        yield from (f"     {key} {value}".rstrip() for key, value in bone.extra)
         yield "  end"
     yield ":hierarchy"
     yield "  begin"

@@ -6,37 +6,47 @@ searched recursively, globs); results go to an output folder that mirrors
 the input tree, each written to a temporary name and renamed when complete.
 A take larger than a threshold is streamed in chunks of frames when its
 pipeline allows (:mod:`motiontheater.streaming`), so memory does not grow
-with its length, to the same bytes as processing it whole.  This module
-keeps jobs, pools, progress and reports; formats and steps live elsewhere.
+with its length, to the same bytes as processing it whole.  A manifest in
+the output folder records what made each output, so that ``--resume`` skips
+exactly the takes already done by the same recipe from the same inputs.
+This module keeps jobs, pools, progress and reports; formats and steps live
+elsewhere.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import glob
+import hashlib
 import json
 import os
 import shutil
 import signal
 import sys
+import tempfile
+import threading
 import time
-from collections.abc import Iterable
+from collections.abc import Generator, Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ._io import PARTIAL_PREFIX, output
+from mtcore import cpu_count
+
+from ._io import WRITE_ERRORS, OutputError, output, remove_stale_partials
 from .amc import read_amc
 from .asf import read_asf, write_asf
 from .bvh import read_bvh
 from .errors import FormatError
-from .formats import TAKE_SUFFIXES, skeleton_for, write_take
+from .formats import TAKE_SUFFIXES, require_frames, skeleton_for, write_take
 from .motion import Motion
 from .pipeline import Pipeline
 from .streaming import CHUNK_FRAMES, stream, streamable
 
 STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed (when its pipeline allows)
 SUFFIXES = {"asf": ".amc", "bvh": ".bvh"}  # what a motion of each skeleton convention is written as
+MANIFEST = ".motiontheater-batch.json"
 
 
 @dataclass(frozen=True)
@@ -50,6 +60,7 @@ class Job:
     frame_rate: float | None = None
     stream_above: int = STREAM_ABOVE
     chunk_frames: int = CHUNK_FRAMES
+    bytes: int = 0  # the take's size when planned
 
 
 @dataclass
@@ -65,6 +76,7 @@ class Result:
     bytes: int = 0
     frames: int = 0
     seconds: float = 0.0
+    stop: str = ""  # an output problem that every take would meet: the run stops
 
 
 def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
@@ -90,6 +102,59 @@ def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
     return list(found.items())
 
 
+class Manifest:
+    """What made each output of a folder: the recipe, and the stamps of the take and its skeleton.
+
+    Kept as JSON beside the outputs; ``--resume`` trusts an output only when the
+    manifest says the same recipe made it from inputs that have not changed since.
+    """
+
+    def __init__(self, folder: str | os.PathLike, recipe: str):
+        self.path = Path(folder) / MANIFEST
+        self.recipe = hashlib.sha256(recipe.encode()).hexdigest()
+        self.entries: dict[str, dict[str, Any]] = {}
+        self.saved = time.monotonic()
+        with contextlib.suppress(OSError, ValueError):
+            self.entries = dict(json.loads(self.path.read_text()).get("outputs", {}))
+
+    def _key(self, job: Job) -> str:
+        return os.path.relpath(job.output, self.path.parent)
+
+    def _stamps(self, job: Job) -> dict[str, Any]:
+        return {
+            "recipe": self.recipe,
+            "input": os.path.abspath(job.input),
+            "stamps": [
+                list(_stamp(job.input)),
+                list(_stamp(job.skeleton)) if job.skeleton else None,
+            ],  # as JSON has them
+        }
+
+    def done(self, job: Job) -> bool:
+        """Whether the job's output exists, made by this recipe from these very inputs."""
+        entry = self.entries.get(self._key(job))
+        if entry is None or {k: entry.get(k) for k in ("recipe", "input", "stamps")} != self._stamps(job):
+            return False
+        written = Path(self.path.parent, entry["written"])
+        return written.exists() and written.stat().st_size == entry["size"]
+
+    def record(self, job: Job, result: Result) -> None:
+        """Note a finished job (saved now and then, and by :meth:`save`)."""
+        self.entries[self._key(job)] = {
+            **self._stamps(job),
+            "written": os.path.relpath(result.output, self.path.parent),
+            "size": os.path.getsize(result.output),
+        }
+        if time.monotonic() - self.saved > 2:
+            self.save()
+
+    def save(self) -> None:
+        """Write the manifest (atomically, like every output)."""
+        self.saved = time.monotonic()
+        with output(self.path) as f:
+            f.write(json.dumps({"version": 1, "outputs": self.entries}, indent=1).encode())
+
+
 def plan_jobs(
     inputs: Iterable[str],
     out: str | os.PathLike,
@@ -98,34 +163,48 @@ def plan_jobs(
     skeleton: str | None = None,
     frame_rate: float | None = None,
     resume: bool = False,
+    in_place: bool = False,
     stream_above: int = STREAM_ABOVE,
     chunk_frames: int = CHUNK_FRAMES,
 ) -> tuple[list[Job], list[Result]]:
-    """The jobs to run, and the takes skipped or failed before running (no skeleton, already done)."""
+    """The jobs to run, and the takes settled before running (no skeleton, or already done by this
+    recipe when resuming).  An output that would replace its own input is refused (ValueError)
+    unless ``in_place``."""
     jobs, settled = [], []
+    manifest = Manifest(out, pipeline.to_toml())
     for take, relative in find_takes(inputs):
         target = Path(out) / relative
+        if not in_place and target.exists() and os.path.samefile(take, target):
+            raise ValueError(
+                f"{take} would be overwritten by its own output: choose another output folder, "
+                "or pass --in-place to replace the takes"
+            )
         try:
             asf = None if take.suffix.lower() == ".bvh" else skeleton_for(take, skeleton)
+            size = take.stat().st_size
         except FileNotFoundError as e:
             settled.append(Result(str(take), str(target), ok=False, error=str(e)))
             continue
-        inputs_time = max(take.stat().st_mtime, asf.stat().st_mtime if asf else 0)
-        if resume and target.exists() and target.stat().st_mtime >= inputs_time:
-            settled.append(Result(str(take), str(target), skipped=True, bytes=take.stat().st_size))
-            continue
-        job = Job(str(take), str(target), str(asf) if asf else "", pipeline, frame_rate, stream_above, chunk_frames)
-        jobs.append(job)
+        job = Job(
+            str(take), str(target), str(asf) if asf else "", pipeline, frame_rate, stream_above, chunk_frames, size
+        )
+        if resume and manifest.done(job):
+            settled.append(Result(str(take), str(target), skipped=True, bytes=size))
+        else:
+            jobs.append(job)
     return jobs, settled
 
 
 def run_job(job: Job) -> Result:
     """Process one take; every failure becomes a Result naming the file, line and reason."""
     start = time.perf_counter()
-    result = Result(job.input, job.output, bytes=os.path.getsize(job.input))
+    result = Result(job.input, job.output, bytes=job.bytes)
     try:
-        os.makedirs(os.path.dirname(job.output) or ".", exist_ok=True)
-        if job.skeleton and result.bytes > job.stream_above and streamable(job.pipeline):
+        try:
+            os.makedirs(os.path.dirname(job.output) or ".", exist_ok=True)
+        except OSError as e:
+            raise OutputError(e.errno, f"cannot write {os.path.dirname(job.output)}: {e.strerror}") from None
+        if job.skeleton and job.bytes > job.stream_above and streamable(job.pipeline):
             skeleton = _skeleton(job.skeleton, *_stamp(job.skeleton))
             _copy_skeleton(job.skeleton, os.path.dirname(job.output))
             result.frames = stream(
@@ -133,11 +212,16 @@ def run_job(job: Job) -> Result:
             )
             result.streamed = True
         else:
-            motion = _read(job)
+            motion = require_frames(_read(job), job.input)
             result.output = _write(job, job.pipeline.apply(motion), motion)
             result.frames = motion.frames
+    except OutputError as e:
+        result.ok, result.error = False, str(e)
+        result.stop = str(e) if e.errno in WRITE_ERRORS else ""
     except (FormatError, ValueError, OSError) as e:
         result.ok, result.error = False, str(e)
+    except MemoryError:
+        result.ok, result.error = False, f"{job.input}: not enough memory for this take ({job.bytes / 1e6:.0f} MB)"
     result.seconds = time.perf_counter() - start
     return result
 
@@ -189,36 +273,33 @@ def _copy_skeleton(asf: str, folder: str) -> None:
 
 
 class Progress:
-    """A one-line progress bar on stderr (files and MB, rate, ETA); silent unless stderr is a terminal."""
+    """A progress bar on stderr (takes and MB, rate, time left), fitting the terminal: tqdm's, where
+    it is installed (``pip install "motiontheater[progress]"``); off when stderr is not a terminal."""
 
     def __init__(self, files: int, total_bytes: int, enabled: bool | None = None):
-        self.files, self.total = files, total_bytes
-        self.done_files, self.done_bytes = 0, 0
-        self.start = time.perf_counter()
-        self.enabled = sys.stderr.isatty() if enabled is None else enabled
+        enabled = sys.stderr.isatty() if enabled is None else enabled
+        self.bar = None
+        if enabled:
+            with contextlib.suppress(ImportError):
+                from tqdm import tqdm
+
+                self.bar = tqdm(
+                    total=total_bytes, unit="B", unit_scale=True, unit_divisor=1000, file=sys.stderr,
+                    desc=f"0/{files} takes", dynamic_ncols=True, smoothing=0.1,
+                )  # fmt: skip
+        self.files, self.done = files, 0
 
     def advance(self, result: Result) -> None:
-        """Count a finished take and redraw the bar."""
-        self.done_files += 1
-        self.done_bytes += result.bytes
-        if not self.enabled:
-            return
-        elapsed = max(time.perf_counter() - self.start, 1e-9)
-        rate = self.done_bytes / elapsed
-        eta = (self.total - self.done_bytes) / rate if rate else 0
-        width = 24
-        filled = int(width * self.done_bytes / max(self.total, 1))
-        sys.stderr.write(
-            f"\r[{'=' * filled}{' ' * (width - filled)}] {self.done_files}/{self.files} files, "
-            f"{self.done_bytes / 1e6:.1f}/{self.total / 1e6:.1f} MB, {rate / 1e6:.1f} MB/s, "
-            f"ETA {eta:.0f} s "
-        )
-        sys.stderr.flush()
+        """Count a finished take."""
+        self.done += 1
+        if self.bar is not None:
+            self.bar.set_description(f"{self.done}/{self.files} takes", refresh=False)
+            self.bar.update(result.bytes)
 
     def close(self) -> None:
-        """End the bar's line."""
-        if self.enabled:
-            sys.stderr.write("\n")
+        """Take the bar off the screen's last line."""
+        if self.bar is not None:
+            self.bar.close()
 
 
 @dataclass
@@ -227,6 +308,9 @@ class Summary:
 
     results: list[Result] = field(default_factory=list)
     seconds: float = 0.0
+    planned: int = 0  # takes found
+    stopped: str = ""  # why the run stopped early, if it did
+    interrupted: bool = False
 
     @property
     def failed(self) -> list[Result]:
@@ -238,19 +322,22 @@ class Summary:
         done = [r for r in self.results if r.ok and not r.skipped]
         processed = sum(r.bytes for r in done)
         return {
-            "files": len(self.results),
+            "files": self.planned or len(self.results),
             "processed": len(done),
             "skipped": sum(r.skipped for r in self.results),
             "failed": len(self.failed),
+            "not_run": max(0, self.planned - len(self.results)),
             "streamed": sum(r.streamed for r in self.results),
             "megabytes": processed / 1e6,
             "seconds": self.seconds,
             "megabytes_per_second": processed / 1e6 / self.seconds if self.seconds else 0.0,
-            "failures": [{"file": r.input, "error": r.error} for r in self.failed],
+            "stopped": self.stopped,
+            "interrupted": self.interrupted,
+            "failures": [{"file": r.input, "error": r.error} for r in self.failed if not r.stop],
         }
 
     def text(self) -> str:
-        """The totals in a line, then a line per failure."""
+        """The totals in a line, then a line per failure, and why the run ended early if it did."""
         d = self.as_dict()
         lines = [
             f"{d['processed']} processed, {d['skipped']} skipped (already done), {d['failed']} failed "
@@ -261,16 +348,11 @@ class Summary:
             f"FAILED {f['error']}" if f["file"] in f["error"] else f"FAILED {f['file']}: {f['error']}"
             for f in d["failures"]
         ]
+        if self.stopped:
+            lines.append(f"STOPPED: {self.stopped}; {d['not_run']} takes were not processed")
+        if self.interrupted:
+            lines.append(f"INTERRUPTED: {d['not_run']} takes not processed; run the same command with --resume")
         return "\n".join(lines)
-
-
-def remove_partials(folder: str | os.PathLike) -> int:
-    """Delete the temporary files a killed run left in the output folder; returns how many."""
-    removed = 0
-    for path in Path(folder).rglob(PARTIAL_PREFIX + "*") if Path(folder).is_dir() else ():
-        path.unlink(missing_ok=True)
-        removed += 1
-    return removed
 
 
 def run(
@@ -284,53 +366,89 @@ def run(
     out: str | os.PathLike = ".",
 ) -> Summary:
     """Run the jobs on local processes (``workers``, 0 for every core), a Dask cluster at
-    ``scheduler``, or a local Dask cluster; the summary lists every take's result."""
-    summary = Summary(list(settled))
-    progress = progress or Progress(len(jobs), sum(os.path.getsize(j.input) for j in jobs), enabled=False)
+    ``scheduler``, or a local Dask cluster; the summary lists every take's result.
+
+    The output folder is checked first (one clear OutputError if it cannot be written), a
+    problem that every take would meet (no permission, disk full) stops the run once, and an
+    interruption (Ctrl-C, SIGTERM) ends it cleanly: no partial file is left, the manifest keeps
+    what was done, and the summary says so (``interrupted``)."""
+    summary = Summary(list(settled), planned=len(settled) + len(jobs))
+    progress = progress or Progress(len(jobs), sum(j.bytes for j in jobs), enabled=False)
+    manifest = Manifest(out, jobs[0].pipeline.to_toml()) if jobs else None
+    _check_writable(out)
     start = time.perf_counter()
-    remove_partials(out)
+    remove_stale_partials(out, recursive=True)
+    results = _run_dask(jobs, workers, scheduler) if scheduler or dask_local else _run_local(jobs, workers)
     try:
-        if scheduler or dask_local:
-            results = _run_dask(jobs, workers, scheduler)
-        else:
-            results = _run_local(jobs, workers)
-        for result in results:
+        for job, result in results:
             summary.results.append(result)
             progress.advance(result)
+            if result.ok and manifest is not None:
+                manifest.record(job, result)
+            if result.stop:
+                summary.stopped = result.stop
+                break
+    except KeyboardInterrupt:
+        summary.interrupted = True
     finally:
+        results.close()
         progress.close()
-        remove_partials(out)
+        if manifest is not None and manifest.entries:
+            manifest.save()
+        remove_stale_partials(out, recursive=True)
     summary.seconds = time.perf_counter() - start
     return summary
 
 
-def _run_local(jobs: list[Job], workers: int):
-    count = workers or os.cpu_count() or 1
+def _check_writable(out: str | os.PathLike) -> None:
+    """OutputError now, once, if the output folder cannot be made or written to."""
+    try:
+        os.makedirs(out, exist_ok=True)
+        tempfile.TemporaryFile(dir=os.fspath(out)).close()
+    except OSError as e:
+        raise OutputError(e.errno, f"cannot write to the output folder {os.fspath(out)}: {e.strerror}") from None
+
+
+def _run_local(jobs: list[Job], workers: int) -> Generator[tuple[Job, Result]]:
+    count = workers or cpu_count()
     if count == 1 or len(jobs) <= 1:
-        yield from (run_job(job) for job in jobs)
+        for job in jobs:
+            yield job, run_job(job)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     previous = signal.signal(signal.SIGTERM, _interrupt)
-    pool = ProcessPoolExecutor(max_workers=count)
+    pool = ProcessPoolExecutor(max_workers=count, initializer=_worker_start, initargs=(os.getpid(),))
     try:
-        futures = [pool.submit(run_job, job) for job in jobs]
+        futures = {pool.submit(run_job, job): job for job in jobs}
         for future in as_completed(futures):
-            yield future.result()
-    except BaseException:
+            yield futures[future], future.result()
+    finally:
         for process in list(getattr(pool, "_processes", {}).values()):
             process.terminate()  # a half-written take dies with its worker; its partial file is removed
-        raise
-    finally:
         pool.shutdown(wait=True, cancel_futures=True)
         signal.signal(signal.SIGTERM, previous)
 
 
-def _interrupt(signum, frame):
+def _worker_start(parent: int) -> None:
+    """In each worker: Ctrl-C is the parent's to handle (it stops the workers), and a worker
+    whose parent is gone (killed outright) ends instead of running on alone."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's handler, which a fork copies
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def _interrupt(signum: int, frame: Any) -> None:
     raise KeyboardInterrupt(f"signal {signum}")
 
 
-def _run_dask(jobs: list[Job], workers: int, scheduler: str | None):
+def _run_dask(jobs: list[Job], workers: int, scheduler: str | None) -> Generator[tuple[Job, Result]]:
     try:
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError:
@@ -339,14 +457,15 @@ def _run_dask(jobs: list[Job], workers: int, scheduler: str | None):
         None
         if scheduler
         else LocalCluster(
-            n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True, dashboard_address=None
+            n_workers=workers or cpu_count(), threads_per_worker=1, processes=True, dashboard_address=None
         )
     )
     client = Client(scheduler or cluster)
     try:
         futures = client.map(run_job, jobs, pure=False)
+        job_of = {future.key: job for future, job in zip(futures, jobs)}
         for future in as_completed(futures):
-            yield future.result()
+            yield job_of[future.key], future.result()
     finally:
         client.close()
         if cluster is not None:

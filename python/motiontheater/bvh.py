@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from mtcore.errors import CountError, FormatError, MissingError, TruncatedError
-from mtcore.text import format_table, scan_table
+from mtcore.text import format_number, format_table, parse_number, scan_table
 
-from ._io import LINE_BREAK, Source, decode, encode, output, read_source
+from ._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
 from .motion import Motion
 from .skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem
 
@@ -46,7 +46,7 @@ def read_bvh(source: Source) -> Motion:
     """
     data, name = read_source(source)
     try:
-        return _read(data)
+        return _read(data).read_from(source)
     except FormatError as e:
         raise e.at(name) from None
 
@@ -64,8 +64,10 @@ def _read(data) -> Motion:
     if frames_match is None or time_match is None:
         raise MissingError("the MOTION section needs 'Frames: N' and 'Frame Time: T'", motion_line)
     try:
+        if not frames_match.group(1).isdigit():  # int() would take '_', signs and other scripts' digits
+            raise ValueError
         frames = int(frames_match.group(1))
-        frame_time = float(time_match.group(1))
+        frame_time = parse_number(time_match.group(1))
     except ValueError:
         raise FormatError("expected a whole number of frames and a frame time in seconds", motion_line + 1) from None
     if frames < 0 or not frame_time > 0:
@@ -75,8 +77,15 @@ def _read(data) -> Motion:
     start = max(frames_match.end(), time_match.end())
     start = data.find(b"\n", start) + 1 if data.find(b"\n", start) != -1 else len(data)
     lines_before = data.count(b"\n", 0, start)
+    columns = len(skeleton.channels)
+    room = (len(data) - start + 1) // max(1, 2 * columns)  # a frame takes a digit and a blank per channel
+    if frames > room and frames * columns * 8 > 1 << 24:  # a header's claim is no reason to allocate much
+        raise TruncatedError(
+            f"the header says {frames} frames but the {len(data) - start} bytes after it hold at most {room}",
+            motion_line + 1,
+        )
     try:
-        values = scan_table(data, frames, len(skeleton.channels), start=start)
+        values = scan_table(data, frames, columns, start=start)
     except FormatError as e:
         raise e.at(None, lines_before) from None
     values.flags.writeable = False
@@ -87,6 +96,7 @@ def _read(data) -> Motion:
         first_frame=1,
         header=(f"Frame Time: {decode(time_match.group(1))}",),
         line_order=None,
+        style=TextStyle.of(data),
     )
 
 
@@ -206,18 +216,21 @@ def _numbers(words: list[str], count: int, number: int, what: str) -> tuple[floa
     if len(words) != count:
         raise CountError(f"{what} takes {count} numbers, found {len(words)}", number)
     try:
-        return tuple(float(w) for w in words)
+        return tuple(parse_number(w) for w in words)
     except ValueError:
         raise FormatError(f"expected numbers after {what}, found '{' '.join(words)}'", number) from None
 
 
 def write_bvh(motion: Motion, target: Source) -> None:
     """Write a motion of a BVH skeleton as BVH, to a path (atomically) or a binary file object;
-    every number the shortest text that reads back exactly, the frame time as it was read."""
+    every number the shortest text that reads back exactly, the frame time as it was read, lines
+    and exponents laid out as the file read was (``motion.style``).  A motion written back
+    unchanged is its file's very bytes."""
     skeleton = motion.skeleton
     if skeleton.convention != "bvh":
         raise ValueError("write_bvh needs a motion of a BVH skeleton (read_bvh, or convert an ASF/AMC first)")
-    from mtcore import format_number
+    if motion.unchanged() and motion.origin is not None and motion.origin.file.copy_to(target):
+        return
 
     lines = ["HIERARCHY"]
     written: list[str] = []  # joints in the order the file declares them: its columns' order
@@ -246,10 +259,13 @@ def write_bvh(motion: Motion, target: Source) -> None:
 
     joint("root", 0)
     frame_time = next((h.split(":", 1)[1].strip() for h in motion.header if h.lower().startswith("frame time")), None)
-    if frame_time is None or 1.0 / float(frame_time) != motion.frame_rate:
+    if frame_time is None or 1.0 / parse_number(frame_time) != motion.frame_rate:
         frame_time = format_number(1.0 / motion.frame_rate)
     lines += ["MOTION", f"Frames: {motion.frames}", f"Frame Time: {frame_time}"]
     columns = [c for name in written for c in motion.columns(name)] if motion.values.shape[1] else []
+    style = motion.style
     with output(target) as f:
-        f.write(encode("\n".join(lines) + "\n"))
-        format_table(motion.values[:, columns], f.write)
+        f.write(style.lines(lines))
+        format_table(motion.values[:, columns], f.write, **style.numbers())
+        if not style.final_newline and f.seekable():  # the file read ended without a line break
+            f.truncate(f.tell() - len(style.newline))

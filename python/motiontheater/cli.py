@@ -8,8 +8,13 @@ apply, batch, combine, bench) are written out below.
 from __future__ import annotations
 
 import argparse
+import logging
 import os
+import shutil
+import signal
 import sys
+import textwrap
+import threading
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -26,6 +31,8 @@ from .formats import read_take, take_suffix, write_take
 from .motion import Motion
 from .pipeline import Pipeline
 from .registry import Option, Step, lookup, steps
+from .scene import RECIPE_HELP as SCENE_HELP
+from .scene import read_recipe
 
 RECIPE_HELP = """\
 A recipe is a TOML file of [[step]] tables, applied in order; each names a step
@@ -81,6 +88,7 @@ def _take_options(parser: argparse.ArgumentParser) -> None:
 def _output_options(parser: argparse.ArgumentParser, what: str) -> None:
     parser.add_argument("output_file", nargs="?", metavar="OUT", help=f"{what} (or give it with -o)")
     parser.add_argument("-o", "--output", help=f"{what}")
+    parser.add_argument("--in-place", action="store_true", help="allow the output to replace the input")
 
 
 def _inputs(args: argparse.Namespace) -> tuple[str, str | None]:
@@ -91,18 +99,22 @@ def _inputs(args: argparse.Namespace) -> tuple[str, str | None]:
     return take, asf
 
 
-def _output(args: argparse.Namespace) -> str:
+def _output(args: argparse.Namespace, source: str) -> str:
     chosen = [o for o in (args.output_file, args.output) if o]
     if len(chosen) != 1:
         raise ValueError("give the output file once: as the second argument or with -o OUT")
+    _refuse_overwriting(source, chosen[0], args.in_place)
     return chosen[0]
+
+
+def _refuse_overwriting(source: str, target: str, in_place: bool) -> None:
+    if not in_place and os.path.exists(target) and os.path.samefile(source, target):
+        raise ValueError(f"{target} is the input: write the result to another file, or pass --in-place")
 
 
 def _write(motion: Motion, result: Motion, source: str, target: str) -> str:
     """Write a step's result as its suffix says; an AMC of a new skeleton gets its ASF beside it.
     Returns what was written, in words."""
-    if os.path.exists(target) and os.path.samefile(source, target):
-        raise ValueError(f"{target} is the input: write the result to another file")
     write_take(result, target)
     if result.skeleton.convention == "asf" and result.skeleton is not motion.skeleton:
         skeleton = os.path.splitext(target)[0] + ".asf"
@@ -115,7 +127,7 @@ def _run_step(args: argparse.Namespace) -> int:
     step = lookup(args.step)
     options = {o.name: getattr(args, o.name) for o in step.all_options if getattr(args, o.name) is not None}
     source, asf = _inputs(args)
-    target = _output(args)
+    target = _output(args, source)
     if not step.is_exporter:
         take_suffix(target)
     motion = read_take(source, asf, args.frame_rate)
@@ -132,7 +144,7 @@ def _run_step(args: argparse.Namespace) -> int:
 def _apply(args: argparse.Namespace) -> int:
     pipeline = Pipeline.read(args.recipe)
     source, asf = _inputs(args)
-    target = _output(args)
+    target = _output(args, source)
     if pipeline.exporter is None:
         take_suffix(target)
     motion = read_take(source, asf, args.frame_rate)
@@ -150,7 +162,7 @@ def _apply(args: argparse.Namespace) -> int:
 def _filter(args: argparse.Namespace) -> int:
     pipeline = _filter_pipeline(args)
     source, asf = _inputs(args)
-    target = _output(args)
+    target = _output(args, source)
     take_suffix(target)
     motion = read_take(source, asf, args.frame_rate)
     written = _write(motion, pipeline.apply(motion), source, target)
@@ -173,7 +185,9 @@ def _filter_options(parser: argparse.ArgumentParser) -> None:
     for kind in FILTERS:
         parser.add_argument(f"--{kind}", type=int, metavar="N", help=f"{lookup(kind).summary} over N frames")
     names = Option("joints", "names", None, "")
-    parser.add_argument("--joints", type=names.parse, help="comma-separated joints to smooth (default: all)")
+    parser.add_argument(
+        "--joints", type=names.parse, metavar="A,B,...", help="comma-separated joints to smooth (default: all)"
+    )
     parser.add_argument("--no-translation", action="store_true", help="leave the root's translation alone")
     parser.add_argument(
         "--mode",
@@ -208,11 +222,10 @@ def _batch(args: argparse.Namespace) -> int:
         skeleton=args.asf,
         frame_rate=args.frame_rate,
         resume=args.resume,
+        in_place=args.in_place,
         stream_above=int(args.stream_above * 1e6),
     )
-    progress = Progress(
-        len(jobs), sum(os.path.getsize(j.input) for j in jobs), enabled=False if args.quiet or args.json else None
-    )
+    progress = Progress(len(jobs), sum(j.bytes for j in jobs), enabled=False if args.quiet or args.json else None)
     summary = run(
         jobs,
         settled,
@@ -224,9 +237,12 @@ def _batch(args: argparse.Namespace) -> int:
     )
     if args.json:
         print(report_json(summary))
-    elif not args.quiet or summary.failed:
-        print(summary.text(), file=sys.stderr if summary.failed else sys.stdout)
-    return 1 if summary.failed else 0
+    elif not args.quiet or summary.failed or summary.stopped or summary.interrupted:
+        trouble = summary.failed or summary.stopped or summary.interrupted
+        print(summary.text(), file=sys.stderr if trouble else sys.stdout)
+    if summary.interrupted:
+        return 130
+    return 1 if summary.failed or summary.stopped else 0
 
 
 def _bench(args: argparse.Namespace) -> int:
@@ -243,8 +259,6 @@ def _bench(args: argparse.Namespace) -> int:
 
 
 def _combine(args: argparse.Namespace) -> int:
-    from .scene import read_recipe
-
     scene = read_recipe(args.recipe)
     if args.dry_run:
         for track, plan in scene.plans():
@@ -312,7 +326,7 @@ def _step_verb(verbs: Any, step: Step) -> None:
         step.name,
         aliases=list(step.aliases),
         help=step.summary,
-        description=f"{step.summary[:1].upper()}{step.summary[1:]}. {step.description}".strip(),
+        description=_prose(f"{step.summary[:1].upper()}{step.summary[1:]}.", *step.description.split("\n\n")),
         epilog=example,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -338,6 +352,12 @@ def _step_verb(verbs: Any, step: Step) -> None:
                 help=help_text,
             )
     parser.set_defaults(run=_run_step, step=step.name)
+
+
+def _prose(*paragraphs: str) -> str:
+    """Paragraphs filled to the terminal's width, for --help texts that also hold examples."""
+    width = min(shutil.get_terminal_size().columns, 100) - 2
+    return "".join(textwrap.fill(" ".join(p.split()), width) + "\n\n" for p in paragraphs if p.strip())
 
 
 def _shown(value: Any) -> str:
@@ -394,7 +414,7 @@ def build_parser() -> argparse.ArgumentParser:
     recipe_run = verbs.add_parser(
         "apply",
         help="apply a recipe of steps (a TOML file) to a take",
-        description="Apply the steps of a recipe, in order, to a take and write the result.\n\n" + RECIPE_HELP,
+        description=_prose("Apply the steps of a recipe, in order, to a take and write the result.") + RECIPE_HELP,
         epilog="Example: motiontheater apply 01_01.amc --recipe steps.toml -o cleaned.amc",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -410,7 +430,7 @@ def build_parser() -> argparse.ArgumentParser:
     many = verbs.add_parser(
         "batch",
         help="apply a filter or a recipe to whole capture databases: folders, globs, all cores or a Dask cluster",
-        description=(
+        description=_prose(
             "Apply a filter (--median N, --mean N, --binomial N) or a recipe of steps (--recipe FILE) to "
             "every AMC and BVH take under the inputs (files, folders searched recursively, globs), writing "
             "into an output folder that mirrors the input tree, with each take's skeleton found by the "
@@ -418,8 +438,9 @@ def build_parser() -> argparse.ArgumentParser:
             "local one, --scheduler tcp://HOST:PORT). Each output is written under a temporary name and "
             "renamed when complete; --resume skips takes already done; a bad take is reported and the "
             "others go on; the exit status is 1 when any take failed. Takes above --stream-above MB are "
-            "streamed in chunks when the recipe is a single filter.\n\n" + RECIPE_HELP
-        ),
+            "streamed in chunks when the recipe is a single filter."
+        )
+        + RECIPE_HELP,
         epilog="Example: motiontheater batch --median 5 --jobs 2 captures/ -o smoothed/",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -429,7 +450,12 @@ def build_parser() -> argparse.ArgumentParser:
     many.add_argument("-o", "--output", required=True, help="the output folder")
     _take_options(many)
     many.add_argument("--jobs", type=int, default=0, help="processes (default: every core)")
-    many.add_argument("--resume", action="store_true", help="skip takes whose output is newer than the input")
+    many.add_argument(
+        "--resume",
+        action="store_true",
+        help="skip takes already done by this recipe from inputs unchanged since (the output folder's manifest says)",
+    )
+    many.add_argument("--in-place", action="store_true", help="allow outputs to replace their inputs")
     many.add_argument("--quiet", action="store_true", help="no progress bar or summary (failures still reported)")
     many.add_argument("--json", action="store_true", help="print a JSON summary")
     many.add_argument("--dask", action="store_true", help="run on a local Dask cluster of --jobs workers")
@@ -445,13 +471,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     recipe = verbs.add_parser(
         "combine",
-        help="lay motion tracks over a base motion, as a TOML recipe says, and write an AMC",
-        description=(
+        help="lay motion tracks over a base motion, as a TOML recipe says, and write the result",
+        description=_prose(
             "Combine motions as the MotionTheater thesis's MotionCombiner does: each track of the "
             "recipe is cut, time-scaled, blended or root-preserved and applied to chosen joints over "
-            "the scene so far. --dry-run prints every track's frame map and borders instead. See "
-            "motiontheater.scene.read_recipe for the recipe's keys."
-        ),
+            "the scene so far. --dry-run prints every track's frame map and borders instead."
+        )
+        + SCENE_HELP,
+        epilog="Example: motiontheater combine scene.toml --dry-run; motiontheater combine scene.toml -o out.amc",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     recipe.add_argument("recipe", help="the TOML recipe")
     recipe.add_argument("-o", "--output", help="the take to write (.amc or .bvh, as the motions)")
@@ -511,18 +539,54 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _notes() -> logging.Handler:
+    """A handler that prints what steps note on the package's logger (a cut-off chosen, gaps left) to stderr."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    handler.setLevel(logging.INFO)
+    return handler
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit status (2 with a one-line reason on failure)."""
+    """Run the command line; returns the exit status: 0 done, 1 some takes failed (batch), 2 a
+    one-line reason on failure, 130 interrupted (Ctrl-C or SIGTERM: nothing partial is left)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.verb is None:
         parser.print_help()
         return 0
+    logger, notes = logging.getLogger("motiontheater"), _notes()
+    logger.addHandler(notes)
+    level = logger.level
+    logger.setLevel(logging.INFO)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminated) if main_thread else None
     try:
-        return int(args.run(args))
+        status = int(args.run(args))
+        sys.stdout.flush()  # here, where a closed pipe is caught, not at exit
+        return status
+    except KeyboardInterrupt:
+        print(f"motiontheater {args.verb}: interrupted; nothing was left half-written", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # the reader of our output went away (| head): say nothing more, to no one
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except MemoryError:
+        print(f"motiontheater {args.verb}: not enough memory for this take", file=sys.stderr)
+        return 2
     except (ValueError, TypeError, OSError, RuntimeError) as exc:
         print(f"motiontheater {args.verb}: {exc}", file=sys.stderr)
         return 2
+    finally:
+        logger.removeHandler(notes)
+        logger.setLevel(level)
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _terminated(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
 
 
 if __name__ == "__main__":

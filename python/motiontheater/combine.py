@@ -53,7 +53,7 @@ class Border:
 class Plan:
     """Which frames of the old and new motions every output frame takes, and how.
 
-    ``frames`` are the output frame numbers; ``old_row``/``new_row`` the rows
+    ``frames`` are the output frame numbers; ``cut`` the new motion's frames the piece shows; ``old_row``/``new_row`` the rows
     of ``old.values``/``new.values`` they read (-1 for none), ``weight`` the
     new motion's share, ``next_row``/``ramp`` the re-interpolation of repeated
     frames.  ``piece`` is the output range the cut lands on, ``source`` the
@@ -68,6 +68,7 @@ class Plan:
     ramp: np.ndarray | None
     weight: np.ndarray
     piece: tuple[int, int]
+    cut: tuple[int, int]
     source: tuple[int, int]
     borders: tuple[Border, ...]
     gap: tuple[int, int] | None
@@ -79,7 +80,12 @@ class Plan:
         """The frame map and borders in words (``motiontheater combine --dry-run``)."""
         lines = [
             f"output frames {self.frames[0]}..{self.frames[-1]}" if len(self.frames) else "no output frames",
-            f"piece {self.piece[0]}..{self.piece[1]} from source frames {self.source[0]}..{self.source[1]}",
+            f"piece {self.piece[0]}..{self.piece[1]} from source frames {self.cut[0]}..{self.cut[1]}"
+            + (
+                f" (the blends also read source frames {self.source[0]}..{self.source[1]})"
+                if self.source != self.cut
+                else ""
+            ),
         ]
         for b in self.borders:
             window = b.window
@@ -245,6 +251,7 @@ def plan(
         ramp=ramp,
         weight=weight,
         piece=(sf, st),
+        cut=(cf, ct),
         source=(int(x.min()), int(x.max())),
         borders=tuple(borders),
         gap=gap,

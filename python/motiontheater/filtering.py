@@ -32,7 +32,8 @@ FILTERS = {
 
 @dataclass
 class TakeStats:
-    """What smoothing needs to know about a whole take: each channel's range and its first frame."""
+    """What smoothing needs to know about a whole take: each channel's range and its first value,
+    of its finite samples only (NaN where a channel has none yet)."""
 
     low: np.ndarray
     high: np.ndarray
@@ -41,12 +42,33 @@ class TakeStats:
     @classmethod
     def of(cls, values: np.ndarray) -> TakeStats:
         """The statistics of the first frames of a take."""
-        return cls(values.min(axis=0), values.max(axis=0), values[0].copy())
+        stats = cls(
+            np.full(values.shape[1], np.inf), np.full(values.shape[1], -np.inf), np.full(values.shape[1], np.nan)
+        )
+        stats.update(values)
+        return stats
 
     def update(self, values: np.ndarray) -> None:
         """Widen the ranges by more frames of the same take."""
-        np.minimum(self.low, values.min(axis=0), out=self.low)
-        np.maximum(self.high, values.max(axis=0), out=self.high)
+        finite = np.isfinite(values)
+        np.minimum(self.low, np.where(finite, values, np.inf).min(axis=0, initial=np.inf), out=self.low)
+        np.maximum(self.high, np.where(finite, values, -np.inf).max(axis=0, initial=-np.inf), out=self.high)
+        missing = np.isnan(self.first) & finite.any(axis=0)
+        self.first[missing] = values[finite[:, missing].argmax(axis=0), np.flatnonzero(missing)]
+
+    @property
+    def base(self) -> np.ndarray:
+        """What the means are taken relative to: each channel's first finite value (0 for none)."""
+        return np.nan_to_num(self.first, nan=0.0)
+
+
+@dataclass
+class Unwrapping:
+    """Where unwrapping stands after some frames: each rotation channel's last finite sample and
+    the whole turns counted for it."""
+
+    last: np.ndarray
+    turns: np.ndarray
 
 
 class Smoother:
@@ -76,13 +98,11 @@ class Smoother:
         self.kind, self.size, self.mode, self.workers = kind, int(size), mode, workers
         self.rotations: list[int] = []
         self.others: list[int] = []
-        for joint in skeleton.joint_names if joints is None else tuple(joints):
-            start = skeleton.first_column(joint)
-            for i, dof in enumerate(skeleton.dofs(joint)):
-                if dof in ROTATIONS:
-                    self.rotations.append(start + i)
-                elif translation:
-                    self.others.append(start + i)
+        for column in skeleton.columns_of(joints):
+            if skeleton.channels[column][1] in ROTATIONS:
+                self.rotations.append(column)
+            elif translation:
+                self.others.append(column)
         self.period = skeleton.period
 
     @property
@@ -95,25 +115,14 @@ class Smoother:
         """Stretches that start at multiples of this frame count smooth exactly as the whole take."""
         return mtcore.filters.lib.mt_filter1d_block(self.size)
 
-    def unwrap(self, values: np.ndarray, previous: np.ndarray | None, turns: np.ndarray | None):
-        """(values with rotation channels unwrapped, turns at the last frame).
-
-        A jump of more than half a period between frames counts whole turns,
-        and the angle gets turns times the period added: exact multiples, so
-        that every chunking of a take unwraps to the same values.  ``previous``
-        is the raw row before these frames and ``turns`` its count (None at
-        the take's start).
-        """
+    def unwrap(self, values: np.ndarray, state: Unwrapping | None) -> tuple[np.ndarray, Unwrapping | None]:
+        """(values with rotation channels unwrapped by :func:`unwrap_angles`, the state after the last
+        frame).  ``state`` is what the frames before these left (None at the take's start)."""
         out = values.copy()
-        if not self.rotations:
-            return out, turns
-        raw = values[:, self.rotations]
-        before = raw[:1] if previous is None else previous[None, self.rotations]
-        steps = np.diff(raw, axis=0, prepend=before)
-        jumps = np.where(np.abs(steps) > self.period / 2, -np.round(steps / self.period), 0.0)
-        counted = np.cumsum(jumps, axis=0) + (0.0 if turns is None else turns)
-        out[:, self.rotations] = raw + counted * self.period
-        return out, counted[-1].copy() if len(counted) else turns
+        if not self.rotations or not len(values):
+            return out, state
+        out[:, self.rotations], state = unwrap_angles(values[:, self.rotations], self.period, state)
+        return out, state
 
     def smooth(self, unwrapped: np.ndarray, stats: TakeStats) -> np.ndarray:
         """Smoothed frames (all channels; the chosen ones changed), rotations wrapped back."""
@@ -126,7 +135,7 @@ class Smoother:
             if self.kind == "median":
                 values[:, columns] = smooth(block, self.size, axis=0, mode=self.mode, workers=self.workers)
             else:  # relative to the take's first frame: exact for constants, no loss far from zero
-                base = stats.first[columns]
+                base = stats.base[columns]
                 values[:, columns] = (
                     smooth(block - base, self.size, axis=0, mode=self.mode, workers=self.workers) + base
                 )
@@ -135,6 +144,30 @@ class Smoother:
                 values[:, self.rotations], stats.low[self.rotations], stats.high[self.rotations], self.period
             )
         return values
+
+
+def unwrap_angles(raw: np.ndarray, period: float, state: Unwrapping | None = None) -> tuple[np.ndarray, Unwrapping]:
+    """Angle columns (frames, columns, at least one frame) unwrapped, and the state after the last frame.
+
+    A jump of more than half a period between frames counts whole turns,
+    and the angle gets turns times the period added: exact multiples, so
+    that every chunking of a take unwraps to the same values.  A sample
+    that is not finite (inf, NaN) stays as it is and is stepped over: the
+    next finite one is compared with the last finite one before it, so a
+    bad sample spoils only the windows that hold it.  ``state`` is what
+    the frames before these left (None at the take's start).
+    """
+    finite = np.isfinite(raw)
+    # each sample's last finite value so far, its own where it is finite (a forward fill)
+    last = np.where(finite, np.arange(len(raw))[:, None], -1)
+    np.maximum.accumulate(last, axis=0, out=last)
+    before = raw[:1] if state is None else state.last[None]
+    filled = np.where(last >= 0, np.take_along_axis(raw, np.maximum(last, 0), axis=0), before)
+    steps = np.diff(filled, axis=0, prepend=before)
+    with np.errstate(invalid="ignore"):  # NaN steps (nothing finite yet) count no turn
+        jumps = np.where(np.abs(steps) > period / 2, -np.round(steps / period), 0.0)
+    counted = np.cumsum(jumps, axis=0) + (0.0 if state is None else state.turns)
+    return raw + counted * period, Unwrapping(filled[-1].copy(), counted[-1].copy())
 
 
 def filter_motion(
@@ -164,7 +197,7 @@ def filter_motion(
     chosen = smoother.rotations + smoother.others
     if not motion.frames or not chosen:
         return motion.replace(values=motion.values)
-    unwrapped, _ = smoother.unwrap(motion.values, None, None)
+    unwrapped, _ = smoother.unwrap(motion.values, None)
     values = smoother.smooth(unwrapped, TakeStats.of(motion.values))
     values.flags.writeable = False
     return motion.replace(values=values)
@@ -177,9 +210,10 @@ def _wrap_into(filtered: np.ndarray, low: np.ndarray, high: np.ndarray, period: 
     positive = ~centred & (low >= 0) & (high <= period)
     out = filtered.copy()
     c = filtered[:, centred]
-    out[:, centred] = np.where(np.abs(c) <= half, c, c - period * np.floor((c + half) / period))
-    p = filtered[:, positive]
-    out[:, positive] = np.where((p >= 0) & (p <= period), p, p - period * np.floor(p / period))
+    with np.errstate(invalid="ignore"):  # inf and NaN stay as they are
+        out[:, centred] = np.where(~np.isfinite(c) | (np.abs(c) <= half), c, c - period * np.floor((c + half) / period))
+        p = filtered[:, positive]
+        out[:, positive] = np.where(~np.isfinite(p) | ((p >= 0) & (p <= period)), p, p - period * np.floor(p / period))
     return out
 
 

@@ -30,13 +30,21 @@ def skeleton_for(path: str | os.PathLike, asf: str | os.PathLike | None = None) 
 
 
 def read_take(path: str | os.PathLike, asf: str | os.PathLike | None = None, frame_rate: float | None = None) -> Motion:
-    """The motion of an AMC (with its skeleton: ``asf``, or the ASF found beside it) or a BVH file."""
+    """The motion of an AMC (with its skeleton: ``asf``, or the ASF found beside it) or a BVH file,
+    which must hold at least one frame."""
     suffix = take_suffix(path)
     if not os.path.exists(path):
         raise FileNotFoundError(f"{os.fspath(path)}: no such file")
     if suffix == ".bvh":
-        return read_bvh(path)
-    return read_amc(path, read_asf(skeleton_for(path, asf)), frame_rate=frame_rate)
+        return require_frames(read_bvh(path), path)
+    return require_frames(read_amc(path, read_asf(skeleton_for(path, asf)), frame_rate=frame_rate), path)
+
+
+def require_frames(motion: Motion, path: str | os.PathLike) -> Motion:
+    """The motion; ValueError naming the file when it has no frame to work on."""
+    if not motion.frames:
+        raise ValueError(f"{os.fspath(path)}: the take holds no frames")
+    return motion
 
 
 def write_take(motion: Motion, path: str | os.PathLike) -> None:

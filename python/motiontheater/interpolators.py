@@ -36,12 +36,12 @@ def interpolate(
     frames: Annotated[tuple[int, int], "the key frames A:B; the frames between them are replaced"],
     joints: Annotated[Joints, "joints to interpolate, comma-separated (default: all)"] = None,
 ) -> Motion:
-    """A new motion whose frames strictly between the keys interpolate them.
+    """A new motion whose frames strictly between the key frames A and B interpolate the keys.
 
-    ``method`` is "slerp" (quaternions, the short arc), "euler" (linear on
-    the stored angles), "expmap" (linear on exponential maps) or
-    "aligned_expmap" (the first key flipped to the second key's hemisphere,
-    so that it too takes the short way).  Joints with other than three
+    The interpolators (``method``): slerp (quaternions, the short arc),
+    euler (linear on the stored angles), expmap (linear on exponential
+    maps) and aligned_expmap (the first key flipped to the second key's
+    hemisphere, so that it too takes the short way).  Joints with other than three
     rotation channels, and every translation, interpolate linearly.  The
     Euler angles written continue from the first key (no 360-degree jumps).
     """
@@ -49,9 +49,8 @@ def interpolate(
         raise ValueError(f"method must be one of {', '.join(INTERPOLATORS)}, got {method!r}")
     a, b = _keys(motion, frames)
     skeleton = motion.skeleton
-    chosen = skeleton.joint_names if joints is None else tuple(joints)
-    columns = [c for joint in chosen for c in motion.columns(joint)]
-    groups = [] if method == "euler" else skeleton.euler_groups(chosen)
+    columns = skeleton.columns_of(joints)
+    groups = [] if method == "euler" else skeleton.euler_groups(joints)
     turned = {int(c) for _, _, cols in groups for c in cols.ravel()}
     linear = [c for c in columns if c not in turned]
     values = motion.values.copy()
@@ -86,8 +85,7 @@ def median3(
     editor's quick fix for single-frame glitches, on the numbers as stored.
     Give ``frames`` to filter a range only.
     """
-    chosen = motion.skeleton.joint_names if joints is None else tuple(joints)
-    columns = [c for joint in chosen for c in motion.columns(joint)]
+    columns = motion.skeleton.columns_of(joints)
     values = motion.values.copy()
     values[:, columns] = median_filter1d(values[:, columns], 3, axis=0, mode="nearest")
     values.flags.writeable = False

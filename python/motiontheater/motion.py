@@ -11,9 +11,25 @@ import numpy as np
 from mtcore.kinematics import forward_kinematics
 from mtcore.rotations import matrices_to_quaternions
 
+from ._io import PLAIN, Origin, Source, TextStyle
 from .errors import UnknownNameError
 from .registry import is_step, lookup
 from .skeleton import ROTATIONS, TRANSLATIONS, Skeleton, angle_factor
+
+
+@dataclass(frozen=True, eq=False)
+class Read:
+    """What a motion held when it was read from ``file``: :meth:`Motion.unchanged` compares."""
+
+    file: Origin
+    values: np.ndarray
+    skeleton: Skeleton
+    frame_rate: float
+    first_frame: int
+    header: tuple[str, ...]
+    line_order: tuple[str, ...] | None
+    style: TextStyle
+
 
 DEFAULT_FRAME_RATE = 120.0
 """Frames per second assumed for an AMC without a rate (CMU and HDM05 record at 120 Hz)."""
@@ -29,7 +45,10 @@ class Motion:
     new motions (a writeable array given here is copied first).  Frames are
     numbered from ``first_frame`` at ``frame_rate`` per second.  ``header``
     and ``line_order`` are what the AMC file had (its header lines, and the
-    order of the bone lines in a frame), so that it is written back as found.
+    order of the bone lines in a frame), ``style`` how its text was laid out
+    (line endings, exponents), so that it is written back as found; ``origin``
+    is the file it was read from, with what was read, so that a motion written
+    back unchanged is the file's very bytes.
     """
 
     skeleton: Skeleton
@@ -38,6 +57,8 @@ class Motion:
     first_frame: int = 1
     header: tuple[str, ...] = (":FULLY-SPECIFIED", ":DEGREES")
     line_order: tuple[str, ...] | None = None
+    style: TextStyle = PLAIN
+    origin: Read | None = None
 
     def __post_init__(self) -> None:
         values = self.values
@@ -50,6 +71,35 @@ class Motion:
         if not self.frame_rate > 0:
             raise ValueError(f"frame_rate must be positive, got {self.frame_rate}")
         object.__setattr__(self, "values", values)
+
+    def unchanged(self) -> bool:
+        """Whether this motion is exactly what was read from its file, and the file is as it was."""
+        o = self.origin
+        return (
+            o is not None
+            and o.values is self.values
+            and o.skeleton is self.skeleton
+            and (o.frame_rate, o.first_frame, o.header, o.line_order, o.style)
+            == (self.frame_rate, self.first_frame, self.header, self.line_order, self.style)
+            and o.file.intact()
+        )
+
+    def read_from(self, source: Source) -> Motion:
+        """This motion (just read) marked as read from ``source``: see :attr:`origin`."""
+        file = Origin.of(source)
+        if file is None:
+            return self
+        origin = Read(
+            file,
+            self.values,
+            self.skeleton,
+            self.frame_rate,
+            self.first_frame,
+            self.header,
+            self.line_order,
+            self.style,
+        )
+        return replace(self, origin=origin)
 
     def __repr__(self) -> str:
         return (

@@ -71,7 +71,9 @@ class Pipeline:
             raise StepError(f"nothing can follow the exporter '{self.exporter.name}'")
         step = lookup(name)
         bound = step.bind(options)
-        given = tuple((key, bound[key]) for key in options)
+        defaults = {o.name: o.default for o in step.all_options}
+        # an option given as None where None is its default says nothing (and TOML has no None)
+        given = tuple((key, bound[key]) for key in options if not (bound[key] is None and defaults[key] is None))
         return Pipeline((*self.entries, Entry(name, given)))
 
     @property

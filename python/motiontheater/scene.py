@@ -70,23 +70,33 @@ class Scene:
         return steps
 
 
-def read_recipe(path: str | os.PathLike) -> Scene:
-    """A scene from a TOML recipe; paths in it are relative to the recipe's folder::
+RECIPE_HELP = """\
+A scene recipe is a TOML file: a [base] motion, then [[track]] tables laid over it in
+order, each with its motion and the combiner's options (cut, scale, blend, preserve,
+joints, discard_old, interpolate, rotation_blend, up).  Paths are relative to the
+recipe; takes may be AMC (with the skeleton given, or found beside the base) or BVH.
 
-    skeleton = "02.asf"            # optional: else the ASF beside the base motion
-    frame_rate = 120               # optional: for AMCs that do not say
-    [base]
-    motion = "02_01.amc"
-    [[track]]
-    motion = "02_02.amc"
-    joints = ["lowerback", "upperback", "thorax"]
-    cut = [1, 55]
-    scale = [1, 66]
-    [[track]]
-    motion = "02_01.amc"
-    joints = ["lowerback", "upperback", "thorax"]
-    cut = [67, 113]
-    blend = 10
+  skeleton = "02.asf"            # optional: else the ASF beside the base motion
+  frame_rate = 120               # optional: for AMCs that do not say
+  [base]
+  motion = "02_01.amc"
+  [[track]]                      # the upper body of another take, slowed to 66 frames
+  motion = "02_02.amc"
+  joints = ["lowerback", "upperback", "thorax"]
+  cut = [1, 55]
+  scale = [1, 66]
+  [[track]]                      # back to the base's own upper body, blended over 10 frames
+  motion = "02_01.amc"
+  joints = ["lowerback", "upperback", "thorax"]
+  cut = [67, 113]
+  blend = 10
+"""
+
+
+def read_recipe(path: str | os.PathLike) -> Scene:
+    """A scene from a TOML recipe (see :data:`RECIPE_HELP` for its keys and an example).
+
+    Errors name the recipe and the track at fault.
     """
     path = Path(path)
     with open(path, "rb") as f:

@@ -23,6 +23,7 @@ import numpy as np
 from mtcore import rotations
 from mtcore.kinematics import DOFS, JointTree, forward_kinematics
 
+from ._io import PLAIN, Origin, TextStyle
 from .errors import DuplicateError, HierarchyError, UnknownNameError
 
 Vec3 = tuple[float, float, float]
@@ -122,6 +123,8 @@ class Skeleton:
     documentation: tuple[str, ...] = ()
     sections: tuple[tuple[str, tuple[str, ...]], ...] = ()
     convention: str = "asf"  # "asf", or "bvh": a joint's offset turns with its parent, see kinematics
+    style: TextStyle = field(default=PLAIN, compare=False, repr=False)  # how its ASF file was laid out
+    origin: Origin | None = field(default=None, compare=False, repr=False)  # the ASF file it was read from
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
     _parents: dict[str, str] = field(init=False, repr=False, compare=False)
     _children: dict[str, tuple[str, ...]] = field(init=False, repr=False, compare=False)
@@ -210,6 +213,20 @@ class Skeleton:
             return self._first_column[joint]
         except KeyError:
             raise UnknownNameError(f"no bone '{joint}' in skeleton '{self.name}'") from None
+
+    def columns_of(self, joints: Iterable[str] | None = None) -> list[int]:
+        """The columns of the joints' channels (every joint's when None), in the order given.
+        UnknownNameError for a name the skeleton lacks, ValueError for a joint without channels
+        (an end site, a bone without dofs): asking to change it is a mistake worth saying."""
+        if joints is None:
+            return list(range(len(self.channels)))
+        columns: list[int] = []
+        for joint in joints:
+            start, count = self.first_column(joint), len(self.dofs(joint))
+            if not count:
+                raise ValueError(f"joint '{joint}' has no channels (it only follows its parent)")
+            columns.extend(range(start, start + count))
+        return columns
 
     def euler_groups(self, joints: Iterable[str] | None = None) -> list[tuple[str, bool, np.ndarray]]:
         """The joints (all by default) with three rotation channels, grouped by Euler convention

@@ -91,11 +91,10 @@ def stream(
 
 def _unwrapped_chunks(take: AmcStream, smoother: Smoother, chunk: int) -> Iterator[np.ndarray]:
     """The take's frames, unwrapped, in chunks of exactly ``chunk`` frames (the last shorter)."""
-    previous, turns, pending = None, None, []
+    state, pending = None, []
     held = 0
     for values in take.pieces():
-        unwrapped, turns = smoother.unwrap(values, previous, turns)
-        previous = values[-1]
+        unwrapped, state = smoother.unwrap(values, state)
         pending.append(unwrapped)
         held += len(unwrapped)
         while held >= chunk:

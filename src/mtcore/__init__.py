@@ -7,21 +7,27 @@ scipy.ndimage counterparts (same signatures, defaults and results)::
 
 and frame text (AMC bodies) scanned into arrays and written back exactly
 (:func:`scan_frames`, :func:`format_frames`); rotations of whole arrays (Euler
-angles, matrices, quaternions, rotation vectors) in :mod:`mtcore.rotations`.
+angles, matrices, quaternions, rotation vectors) in :mod:`mtcore.rotations`;
+signal processing (a band equaliser, zero-phase Butterworth filtering,
+polyphase resampling, gap filling; scipy.signal's signatures) in
+:mod:`mtcore.signal`.
 """
 
-from . import errors
+from . import errors, signal
+from ._parallel import cpu_count
 from .filters import MODES, binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
 from .text import format_frames, format_number, scan_frames
 
 __all__ = [
     "MODES",
     "binomial_filter1d",
+    "cpu_count",
     "errors",
     "format_frames",
     "format_number",
     "median_filter1d",
     "pascal_weights",
     "scan_frames",
+    "signal",
     "uniform_filter1d",
 ]

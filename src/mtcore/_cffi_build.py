@@ -17,6 +17,8 @@ import cffi
 from pycparser import c_ast, c_parser
 
 BEGIN, END = "/* MT_CDEF_BEGIN */", "/* MT_CDEF_END */"
+# integer constants too large for an enum (an int), which cffi reads and pycparser does not
+DEFINE = re.compile(r"^[ \t]*#define[ \t]+(\w+)[ \t]+\d+[ \t]*$", re.MULTILINE)
 
 
 def cdef_region(header_text: str) -> str:
@@ -41,8 +43,10 @@ def _python_type(node: c_ast.Node) -> str:
 def stub(declarations: str) -> str:
     """The text of ``_mtcore.pyi`` for the declarations of the cdef region."""
     # cffi knows the standard integer types; plain pycparser needs them declared
-    tree = c_parser.CParser().parse("typedef unsigned long size_t; typedef long ptrdiff_t;\n" + declarations)
-    constants, functions = [], []
+    tree = c_parser.CParser().parse(
+        "typedef unsigned long size_t; typedef long ptrdiff_t;\n" + DEFINE.sub("", declarations)
+    )
+    constants, functions = [f"    {name}: int" for name in DEFINE.findall(declarations)], []
     for node in tree.ext:
         kind = node.type
         if isinstance(node, c_ast.Typedef):

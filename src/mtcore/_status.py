@@ -18,6 +18,7 @@ _EXCEPTIONS: dict[int, type[Exception]] = {
     lib.MT_EDUPLICATE: errors.DuplicateError,
     lib.MT_EMISSING: errors.MissingError,
     lib.MT_EFRAME: errors.SequenceError,
+    lib.MT_EFRAMERANGE: errors.SequenceError,
 }
 
 

@@ -1,15 +1,23 @@
-"""Frame text (the body of an AMC file) to and from arrays, in C.
+"""Numbers and frame text (the body of an AMC file) to and from arrays, in C.
 
 Frame text is a sequence of frames, each a line holding its frame number
 followed by key lines ``key v1 v2 ...``; see ``mtcore.h``.  Keys are opaque
 byte strings here: the caller (motiontheater's AMC reader) maps bones to keys
 and columns.
+
+Every number, in every format, follows one grammar: an optional sign, digits
+with an optional '.', an optional exponent (``e``/``E``, optional sign,
+digits); or ``inf``, ``infinity``, ``nan`` in any case with an optional sign.
+It reads as the float64 nearest to it, exactly what ``float()`` gives, for any
+count of digits; no hexadecimal, ``_`` or ``nan(...)``.  Reading and writing
+never depend on the C locale.
 """
 
 from __future__ import annotations
 
 import itertools
 import mmap
+import operator
 import re
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -20,13 +28,53 @@ from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._parallel import run_all, thread_count
 from ._status import check
-from .errors import SequenceError
+from .errors import NumberError, SequenceError
 
 Text = bytes | mmap.mmap  # text to scan: read into memory, or mapped from its file
 
-__all__ = ["format_frames", "format_number", "format_table", "frame_line", "line_breaks", "scan_frames", "scan_table"]
+__all__ = [
+    "FRAME_MAX",
+    "format_frames",
+    "format_number",
+    "format_table",
+    "frame_line",
+    "line_breaks",
+    "parse_number",
+    "scan_frames",
+    "scan_table",
+    "text_style",
+]
+
+FRAME_MAX: int = lib.MT_FRAME_MAX
+"""The largest frame number that frame text can hold (18 digits); the smallest is 0."""
 
 _FORMAT_CHUNK = 2048  # frames per C call when writing: bounds the text buffer
+_NEWLINES = {b"\n": lib.MT_NEWLINE_LF, b"\r\n": lib.MT_NEWLINE_CRLF, b"\r": lib.MT_NEWLINE_CR}
+_GRAMMAR = "a number (optional sign, digits with an optional '.' and exponent, as 17.8693 or -1.2e-05; or inf, nan)"
+
+
+def _style(digits: int | None, exponent_digits: int, newline: bytes = b"\n", frame_newline: bytes | None = None):
+    """The C style of numbers and lines, checked: see format_frames."""
+    if digits is not None:
+        try:
+            digits = operator.index(digits)
+        except TypeError:
+            raise TypeError(f"digits must be None or an integer, got {type(digits).__name__}") from None
+        if not 1 <= digits <= 17:
+            raise ValueError(f"digits must be None (the shortest exact text) or 1 to 17, got {digits}")
+    try:
+        exponent_digits = operator.index(exponent_digits)
+    except TypeError:
+        raise TypeError(f"exponent_digits must be an integer, got {type(exponent_digits).__name__}") from None
+    if not 1 <= exponent_digits <= 3:
+        raise ValueError(f"exponent_digits must be 1, 2 or 3, got {exponent_digits}")
+    frame_newline = newline if frame_newline is None else frame_newline
+    for name, ending in (("newline", newline), ("frame_newline", frame_newline)):
+        if ending not in _NEWLINES:
+            raise ValueError(f"{name} must be one of {sorted(_NEWLINES)}, got {ending!r}")
+    return ffi.new(
+        "struct mt_format_style *", [digits or 0, exponent_digits, _NEWLINES[newline], _NEWLINES[frame_newline]]
+    )
 
 
 class _KeyTable:
@@ -207,6 +255,8 @@ def _describer(
             reason = f"{noun} '{key}' appears twice in frame {frame}"
         elif status == lib.MT_EMISSING:
             reason = f"frame {frame} has no line for {noun} '{key}'"
+        elif status == lib.MT_EFRAMERANGE:
+            reason = f"frame number '{line.split()[0]}' is past the largest, {FRAME_MAX}"
         elif report.expected == -1:
             reason = f"expected a frame number, found '{line[:80]}'"
         else:
@@ -225,19 +275,37 @@ def format_frames(
     offsets: Sequence[int],
     counts: Sequence[int],
     write: Callable[[bytes], object],
+    *,
+    digits: int | None = None,
+    exponent_digits: int = 2,
+    newline: bytes = b"\n",
+    frame_newline: bytes | None = None,
 ) -> None:
     """Write (frames, channels) values as frame text through ``write``, in chunks.
 
-    Key lines come in the order of ``keys``; every number is the shortest text
-    that reads back to exactly the same float64.
+    Key lines come in the order of ``keys``; frames are numbered from
+    ``first_frame`` (all numbers must lie in 0 .. FRAME_MAX, to be read back).
+    Every number is the shortest text that reads back to exactly the same
+    float64 (the digits of ``repr``), or with ``digits=N`` (1 to 17) the value
+    correctly rounded to N significant digits, as C's ``%.Ng``: smaller files,
+    inexact.  ``exponent_digits`` is the fewest digits of an exponent (2:
+    ``1e-05``; 3: ``1e-005`` as HDM05 writes), ``newline`` the line ending
+    (``b"\\n"``, ``b"\\r\\n"`` or ``b"\\r"``); :func:`text_style` finds both in a file.
     """
+    style = _style(digits, exponent_digits, newline, frame_newline)
     values = np.ascontiguousarray(values, dtype=np.float64)
     if values.ndim != 2:
         raise ValueError(f"values must be (frames, channels), got shape {values.shape}")
     frames, channels = values.shape
+    first_frame = operator.index(first_frame)
+    if not 0 <= first_frame <= FRAME_MAX - max(frames - 1, 0):
+        raise ValueError(
+            f"frame numbers {first_frame} .. {first_frame + frames - 1} cannot be written: frame text "
+            f"holds 0 .. {FRAME_MAX}"
+        )
     table = _KeyTable(keys, offsets, counts, channels)
     chunk = max(1, min(frames, _FORMAT_CHUNK))
-    buf = bytearray(lib.mt_format_bound(chunk, table.c_lens, table.c_counts, table.n))
+    buf = bytearray(lib.mt_format_bound(chunk, table.c_lens, table.c_counts, table.n, style))
     written = ffi.new("size_t *")
     with c_array(values) as c_values, ffi.from_buffer(buf) as c_buf:
         for f0 in range(0, frames, chunk):
@@ -252,6 +320,7 @@ def format_frames(
                 table.c_offsets,
                 table.c_counts,
                 table.n,
+                style,
                 c_buf,
                 len(buf),
                 written,
@@ -281,7 +350,7 @@ def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers:
             )
 
         statuses = run_all([piece(i) for i in range(len(pieces))])
-    for (begin, _, _, count), report, status in zip(pieces, reports, statuses):
+    for (begin, _, _, _), report, status in zip(pieces, reports, statuses):
         if status == lib.MT_OK:
             continue
         lines_before = line_breaks(text, start, begin)
@@ -298,12 +367,8 @@ def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers:
                     at,
                     False,
                 )
-            return (
-                f"the header says {rows} frames but the data holds "
-                f"{report.frames + sum(p[3] for p in pieces if p[0] < begin)} (truncated?)",
-                at,
-                True,
-            )
+            held = report.frames + sum(p[3] for p in pieces if p[0] < begin)
+            return f"the header says {rows} frames but the data holds {held} (truncated?)", at, True
 
         if status == lib.MT_ERANGE:
             raise SequenceError(f"the header says {rows} frames but the data holds more", lines_before + report.line)
@@ -340,24 +405,88 @@ def _table_pieces(text: bytes, start: int, rows: int, count: int) -> list[tuple[
     return [(bounds[i], bounds[i + 1], first[i], first[i + 1] - first[i]) for i in range(len(bounds) - 1)]
 
 
-def format_table(values: np.ndarray, write: Callable[[bytes], object]) -> None:
-    """Write (rows, columns) values as lines of numbers through ``write``, in chunks; every
-    number the shortest text that reads back to exactly the same float64."""
+def format_table(
+    values: np.ndarray,
+    write: Callable[[bytes], object],
+    *,
+    digits: int | None = None,
+    exponent_digits: int = 2,
+    newline: bytes = b"\n",
+) -> None:
+    """Write (rows, columns) values as lines of numbers separated by a blank through ``write``,
+    in chunks; numbers and lines as for :func:`format_frames`."""
+    style = _style(digits, exponent_digits, newline)
     values = np.ascontiguousarray(values, dtype=np.float64)
     if values.ndim != 2:
         raise ValueError(f"values must be (rows, columns), got shape {values.shape}")
     rows, columns = values.shape
     chunk = max(1, min(rows, _FORMAT_CHUNK))
-    buf = bytearray(chunk * (columns * (lib.MT_NUMBER_MAX + 1) + 1))
+    buf = bytearray(lib.mt_format_table_bound(chunk, columns, style))
     written = ffi.new("size_t *")
     with c_array(values) as c_values, ffi.from_buffer(buf) as c_buf:
         for r0 in range(0, rows, chunk):
             n = min(chunk, rows - r0)
-            check(lib.mt_format_table(c_values + r0 * columns, n, columns, c_buf, len(buf), written), "mt_format_table")
+            status = lib.mt_format_table(c_values + r0 * columns, n, columns, style, c_buf, len(buf), written)
+            check(status, "mt_format_table")
             write(bytes(memoryview(buf)[: written[0]]))
 
 
-def format_number(value: float) -> str:
-    """The shortest text that reads back as exactly ``value`` (``%g`` style: 17.8693, 1e-05, 3)."""
+def format_number(value: float, *, digits: int | None = None, exponent_digits: int = 2) -> str:
+    """The text of one number, as :func:`format_frames` writes it: by default the shortest
+    that reads back as exactly ``value`` (17.8693, 1e-05, 3, -0, inf, nan)."""
     buf = ffi.new("char[]", lib.MT_NUMBER_MAX)
-    return bytes(ffi.buffer(buf, lib.mt_format_double(float(value), buf))).decode("ascii")
+    written = ffi.new("size_t *")
+    check(lib.mt_format_double(float(value), _style(digits, exponent_digits), buf, written), "mt_format_double")
+    return bytes(ffi.buffer(buf, written[0])).decode("ascii")
+
+
+def parse_number(token: str | bytes) -> float:
+    """The float64 of one number token (no blanks around it), by the grammar of every format:
+    equal to ``float(token)`` wherever this accepts the token.
+
+    Raises :class:`~mtcore.errors.NumberError` (a ValueError) saying what was expected, for
+    anything else: hexadecimal, ``1_0``, ``nan(...)``, blanks, the empty string.
+    """
+    data = token.encode("ascii", "replace") if isinstance(token, str) else bytes(token)
+    value = ffi.new("double *")
+    with ffi.from_buffer(data) as c_data:
+        status = lib.mt_parse_number(c_data, len(data), value)
+    if status != lib.MT_OK:
+        shown = token if isinstance(token, str) else data.decode("ascii", "replace")
+        raise NumberError(f"expected {_GRAMMAR}, found '{shown}'")
+    return value[0]
+
+
+_STYLE_SAMPLE = 1 << 22  # bytes of a file that text_style looks at
+_EXPONENTS = (b"e-", b"e+", b"E-", b"E+")
+
+
+def text_style(data: Text) -> tuple[bytes, int]:
+    """The line ending and the fewest exponent digits of the numbers of a file's text, for
+    writing it back alike: ``(newline, exponent_digits)`` for :func:`format_frames`.
+
+    The newline is the one most lines of the first 4 MB end in (``b"\\r\\n"``, ``b"\\n"``
+    or ``b"\\r"``; ``b"\\n"`` when there is none).  Exponent digits: 3 where an exponent
+    there is written with a leading zero in three digits (``1.23246e-013``), 1 where one
+    has a single digit (``1e-5``), else 2 (Python and C on Linux: ``1e-05``).
+    """
+    head = bytes(memoryview(data)[:_STYLE_SAMPLE])
+    crlf = head.count(b"\r\n")
+    endings = {b"\n": head.count(b"\n") - crlf, b"\r\n": crlf, b"\r": head.count(b"\r") - crlf}
+    newline = max(endings, key=endings.__getitem__)  # the first, LF, of equal counts
+    single = False
+    for marker in _EXPONENTS:
+        at = head.find(marker, 1)
+        for _ in range(64):  # enough to see a file's style, few enough to stay cheap
+            if at == -1:
+                break
+            end = at + 2
+            while end < len(head) and 48 <= head[end] <= 57:
+                end += 1
+            exponent = head[at + 2 : end]
+            if exponent and (48 <= head[at - 1] <= 57 or head[at - 1] == 46):  # after a digit or '.'
+                if len(exponent) > 1 and exponent[0] == 48:
+                    return newline, len(exponent)
+                single |= len(exponent) == 1
+            at = head.find(marker, at + 2)
+    return newline, 1 if single else 2
