@@ -305,7 +305,7 @@ def _skate(args: argparse.Namespace) -> int:
 def _contacts(args: argparse.Namespace) -> int:
     from .footskate import contacts_of, prepare
 
-    target = _output(args)
+    target = _output(args, args.input)
     motion = read_take(args.input, args.asf, args.frame_rate)
     arrays, ground, mpu = prepare(
         motion, legs=args.legs, up=args.up, floor=args.floor, meters_per_unit=args.meters_per_unit
