@@ -6,7 +6,7 @@ cut 1,000..400,000 scaled onto 5,000..420,000, with blend depth 10, or
 with the root preserved by the thesis's rule or on the ground plane (the
 thesis makes blend and preserve exclusive).  Every peer includes working
 out the frame map.  The numpy peer is the same rules in whole-array numpy
-(tests/combine_twins.py, with numpy Euler conversions); the Python peer is
+(tests/twins/combine.py, with numpy Euler conversions); the Python peer is
 the thesis's structure, a loop over frames and channels that works out each
 frame's source and weight as it goes, run on 1/400 of the frames.
 """
@@ -24,8 +24,8 @@ import motiontheater as mt
 from motiontheater.combine import _root_offsets, combine, plan
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-import euler_twin
-from combine_twins import numpy_combine, python_thesis
+from twins import combine as twin
+from twins import rotations as euler_twin
 
 DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 FRAMES = 432_000
@@ -72,7 +72,10 @@ def _numpy_rules(old, new, options):
         with mock.patch.object(importlib.import_module("motiontheater.combine"), "rot", euler_twin):
             rows, offsets, channels = _root_offsets(old, new, p, "y")
         extra = dict(offset_row=rows, offsets=offsets, offset_channels=channels)
-    return numpy_combine(old.values, new.values, p, selected, **extra)
+    rows = (p.old_row, p.new_row, p.weight)
+    return twin.combine_frames(
+        old.values, new.values, *rows, next_row=p.next_row, ramp=p.ramp, selected=selected, **extra
+    )
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -104,7 +107,7 @@ def test_combine_python_loop(benchmark, record, hours, case):
     lists = small_old.values.tolist(), small_new.values.tolist()
     selected = [1] * 62
     result = benchmark.pedantic(
-        lambda: python_thesis(*lists, 1, 1, options["cut"], options["scale"], windows, selected, offsets),
+        lambda: twin.python_thesis(*lists, 1, 1, options["cut"], options["scale"], windows, selected, offsets),
         rounds=3,
         iterations=1,
     )

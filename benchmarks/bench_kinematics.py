@@ -16,7 +16,7 @@ import motiontheater as mt
 from mtcore.kinematics import forward_kinematics
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from fk_twin import forward_kinematics as numpy_fk
+from twins.kinematics import motion_kinematics as numpy_fk
 
 DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 FAST = dict(rounds=30, iterations=1, warmup_rounds=2)

@@ -13,6 +13,14 @@
  * When the filtered axis is (nearly) the last one, rows are only a few
  * values wide; the driver then gathers TILE_LINES lines side by side into a
  * small tile, so that they become the channels, and scatters the results back.
+ *
+ * A window longer than the line (size > n) would need a table of size rows
+ * however short the line.  The median and the mean then take another path
+ * (filter_long in filter_kernels.inc): each line keeps how many times each
+ * of its samples occurs in the window (window_counts), which the window
+ * changes by two counts per step; time and memory grow with n, never with
+ * size.  Every size computation is checked for overflow: a product that
+ * does not fit is MT_ENOMEM, never a short buffer.
  */
 #include "clones.h"
 #include "mtcore.h"
@@ -36,6 +44,14 @@ enum {
 #else
 #define MT_IVDEP
 #endif
+
+/* malloc of count elements of size bytes, NULL when the product does not fit in size_t. */
+static void *alloc_array(size_t count, size_t size)
+{
+    if (size != 0 && count > SIZE_MAX / size)
+        return NULL;
+    return malloc(count * size > 0 ? count * size : 1);
+}
 
 /* Index into 0..n-1 of position r of the extended line, or -1 for the fill value. */
 static ptrdiff_t extend_index(ptrdiff_t r, ptrdiff_t n, int mode)
@@ -77,6 +93,92 @@ static size_t chunk_length(size_t t0, size_t end, size_t chunk)
 {
     size_t next = (t0 / chunk + 1) * chunk;
     return (next < end ? next : end) - t0;
+}
+
+/*
+ * How many times each sample of a line of n occurs among the extended
+ * positions lo .. lo+size-1: counts[i] for sample i, counts[n] for the fill
+ * value (constant mode).  The periodic modes repeat a pattern of `period`
+ * positions that holds every sample once (wrap) or twice (reflect; mirror
+ * but for its two end samples): the window holds size / period whole
+ * patterns and size % period positions more.  nearest and constant hold the
+ * line (or a part) between runs of the edge or fill value.  O(n) time.
+ */
+static void window_counts(ptrdiff_t lo, size_t size, size_t n, int mode, size_t *counts)
+{
+    const ptrdiff_t len = (ptrdiff_t)n, hi = lo + (ptrdiff_t)size - 1;
+    memset(counts, 0, (n + 1) * sizeof *counts);
+    if (mode == MT_MODE_NEAREST || mode == MT_MODE_CONSTANT) {
+        const size_t below = lo < 0 ? (size_t)((hi < -1 ? hi : -1) - lo + 1) : 0;
+        const size_t above = hi >= len ? (size_t)(hi - (lo > len ? lo : len) + 1) : 0;
+        for (ptrdiff_t i = lo > 0 ? lo : 0; i <= hi && i < len; i++)
+            counts[i]++;
+        counts[mode == MT_MODE_NEAREST ? 0 : n] += below;
+        counts[mode == MT_MODE_NEAREST ? n - 1 : n] += above;
+        return;
+    }
+    const size_t period = mode == MT_MODE_WRAP      ? n
+                          : mode == MT_MODE_REFLECT ? 2 * n
+                          : n == 1                  ? 1
+                                                    : 2 * n - 2;
+    const size_t whole = size / period, rest = size % period;
+    for (size_t p = 0; p < period; p++)
+        counts[extend_index((ptrdiff_t)p, len, mode)] += whole;
+    for (size_t j = 0; j < rest; j++)
+        counts[extend_index(lo + (ptrdiff_t)j, len, mode)]++;
+}
+
+/* Sample (or n for the fill value) at position r of the extended line. */
+static size_t sample_at(ptrdiff_t r, size_t n, int mode)
+{
+    const ptrdiff_t i = extend_index(r, (ptrdiff_t)n, mode);
+    return i < 0 ? n : (size_t)i;
+}
+
+/* The place p (1-based) in sorted order of the element of rank `target` (0-based): the first p
+   whose prefix count exceeds target (Fenwick 1994). */
+static size_t fenwick_find(const size_t *tree, size_t len, size_t target)
+{
+    size_t step = 1, at = 0;
+    while (step <= len / 2)
+        step *= 2;
+    for (; step > 0; step /= 2)
+        if (at + step <= len && tree[at + step] <= target) {
+            at += step;
+            target -= tree[at];
+        }
+    return at + 1;
+}
+
+static void fenwick_add(size_t *tree, size_t len, size_t at, size_t delta)
+{
+    for (; at <= len; at += at & (~at + 1))
+        tree[at] += delta; /* delta SIZE_MAX subtracts one: unsigned arithmetic wraps */
+}
+
+/* Copies of non-finite samples in a window: the mean is NaN, +inf or -inf by these. */
+struct nonfinite {
+    size_t nan, pos, neg;
+};
+
+/* Adds (delta 1) or removes (delta SIZE_MAX) copies of the value v: to the sum, or to the count of its kind. */
+static void nonfinite_add(struct nonfinite *bad, double v, size_t delta)
+{
+    if (v != v)
+        bad->nan += delta;
+    else if (v > 0)
+        bad->pos += delta;
+    else
+        bad->neg += delta;
+}
+
+/* Whether every a[0 .. n-1] is finite. */
+static int all_finite(const double *a, size_t n)
+{
+    int bad = 0;
+    for (size_t k = 0; k < n; k++)
+        bad |= a[k] - a[k] != 0; /* x - x is 0 for every finite x */
+    return !bad;
 }
 
 /* Median sizes with a fixed selection network (Paeth; Devillard 1998). */
@@ -225,8 +327,10 @@ int mt_filter1d(int filter, int dtype, const void *in, void *out, size_t outer, 
         return MT_EINVAL;
     if (outer == 0 || begin == end || inner == 0)
         return MT_OK;
-    if (in == NULL || out == NULL || n > PTRDIFF_MAX / 4 || inner > SIZE_MAX / n ||
-        outer > SIZE_MAX / (n * inner))
+    /* No array holds more than PTRDIFF_MAX bytes: larger dimensions are a caller's error. */
+    const size_t item = dtype == MT_FLOAT64 ? sizeof(double) : sizeof(float);
+    if (in == NULL || out == NULL || n > PTRDIFF_MAX / 4 || inner > (size_t)PTRDIFF_MAX / item / n ||
+        outer > (size_t)PTRDIFF_MAX / item / (n * inner))
         return MT_EINVAL;
 
     struct job job = {.filter = filter, .mode = mode, .outer = outer, .n = n, .inner = inner,

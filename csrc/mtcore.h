@@ -82,10 +82,16 @@ const char *mt_strerror(int status);
  * a multiple of mt_filter1d_block(size) gives, bit for bit, what one call
  * over all frames gives there (the running sums of the uniform filter
  * restart at those multiples).  Requires
- * begin <= end <= n, size >= 1 and
+ * begin <= end <= n, 1 <= size <= PTRDIFF_MAX / 4 and
  * -(size/2) <= origin <= (size-1)/2; `weights` (size doubles) is read only by
- * MT_FILTER_CORRELATE and may be NULL otherwise.  Means and weighted sums are
- * accumulated in double for float32 data.
+ * MT_FILTER_CORRELATE and may be NULL otherwise; an array of more than
+ * PTRDIFF_MAX bytes is MT_EINVAL.  Means and weighted sums are
+ * accumulated in double for float32 data; a NaN or an infinity reaches only
+ * the outputs whose windows hold it.  The median and the mean of a window
+ * longer than the line (size > n) take time and scratch memory in
+ * proportion to n, whatever the size; MT_FILTER_CORRELATE reads all size
+ * weights for each output and needs scratch for 2 size row pointers
+ * (MT_ENOMEM when that cannot be allocated, never a short buffer).
  */
 int mt_filter1d(int filter, int dtype, const void *in, void *out,
                 size_t outer, size_t n, size_t inner, size_t begin, size_t end,

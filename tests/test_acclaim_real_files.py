@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from amc_twin import parse_amc
 from conftest import ids, real_files
 from motiontheater._io import PLAIN
+from twins.text import parse_amc
 
 ASFS = real_files("*/*.asf")
 AMCS = real_files("*/*.amc")
@@ -35,10 +35,10 @@ def test_every_asf_reads_and_writes_back_identically(asf, tmp_path):
 @pytest.mark.parametrize("amc", AMCS, ids=ids(AMCS))
 def test_every_amc_equals_a_python_reading_of_its_text(amc):
     motion = load(amc)
-    rows, first = parse_amc(amc.read_bytes(), motion.skeleton)
-    assert motion.frames == len(rows) == len(re.findall(rb"^\s*\d+\s*$", amc.read_bytes(), re.MULTILINE))
+    values, first = parse_amc(amc.read_bytes(), motion.skeleton)
+    assert motion.frames == len(values) == len(re.findall(rb"^\s*\d+\s*$", amc.read_bytes(), re.MULTILINE))
     assert motion.first_frame == first
-    np.testing.assert_array_equal(motion.values, np.array(rows).reshape(len(rows), -1))
+    np.testing.assert_array_equal(motion.values, values)
     assert motion.frame_rate == 120.0
     assert not motion.values.flags.writeable
 

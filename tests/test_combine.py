@@ -5,10 +5,10 @@ import warnings
 import numpy as np
 import pytest
 
-import euler_twin
 import motiontheater as mt
-from combine_twins import numpy_combine, python_combine
 from motiontheater.combine import combine, plan
+from twins import combine as twin
+from twins import rotations as euler_twin
 
 
 @pytest.fixture(scope="module")
@@ -109,8 +109,14 @@ def test_c_loop_equals_numpy_and_python_twins(take):
     got = combine_frames(
         old.values, new.values, p.old_row, p.new_row, p.weight, next_row=p.next_row, ramp=p.ramp, selected=selected
     )
-    np.testing.assert_array_equal(got, numpy_combine(old.values, new.values, p, selected))
-    np.testing.assert_array_equal(got, np.array(python_combine(old.values.tolist(), new.values.tolist(), p, selected)))
+    rows = (p.old_row, p.new_row, p.weight)
+    ramps = dict(next_row=p.next_row, ramp=p.ramp, selected=selected)
+    np.testing.assert_array_equal(got, twin.combine_frames(old.values, new.values, *rows, **ramps))
+    lists = [a.tolist() for a in rows]
+    ramps = {k: None if v is None else v.tolist() for k, v in ramps.items()}
+    np.testing.assert_array_equal(
+        got, np.array(twin.python_combine(old.values.tolist(), new.values.tolist(), *lists, **ramps))
+    )
 
 
 def test_unselected_joints_are_bit_identical(take):
@@ -225,17 +231,80 @@ def test_inputs_untouched(take):
     np.testing.assert_array_equal(new.values, before[1])
 
 
+class NoC:
+    """Stands in for the C library: any use fails the test."""
+
+    def __getattr__(self, name):
+        raise AssertionError(f"{name} called before the arguments were checked")
+
+
+OLD, NEW = np.zeros((5, 3)), np.ones((4, 3))
+BAD_COMBINE = [
+    (dict(old=None, new=None), ValueError, "needs an old or a new motion"),
+    (dict(old=np.zeros(5)), ValueError, r"old must be two-dimensional of shape \(any, any\), got shape \(5,\)"),
+    (dict(new=np.ones((4, 2))), ValueError, r"new must have the 3 channels of old, got shape \(4, 2\)"),
+    (dict(new=np.ones((4, 3), complex)), TypeError, "new must hold real numbers, got dtype complex128"),
+    (dict(weight=None), TypeError, "weight must be an array, got None"),
+    (dict(weight=[[0.0, 1.0]]), ValueError, "weight must be one-dimensional"),
+    (dict(weight=[0.0, 1.5]), ValueError, r"weight must lie in \[0, 1\], got weight\[1\] = 1.5"),
+    (dict(weight=[0.0, np.nan]), ValueError, r"got weight\[1\] = nan"),
+    (dict(old_row=[0]), ValueError, r"old_row must be one-dimensional of shape \(2,\), got shape \(1,\)"),
+    (dict(old_row=[0.0, 1.0]), TypeError, "old_row must hold integers, got dtype float64"),
+    (dict(new_row=[0, 9]), ValueError, r"new_row must lie in -1 .. 3, got new_row\[1\] = 9"),
+    (dict(old_row=[0, -2]), ValueError, r"old_row must lie in -1 .. 4, got old_row\[1\] = -2"),
+    (dict(old_row=[0, -1], weight=[0.0, 0.5]), ValueError, r"output frame 1 \(weight 0.5\) needs a row of old"),
+    (dict(new_row=[-1, -1]), ValueError, r"output frame 1 \(weight 1.0\) needs a row of new, but new_row\[1\] is -1"),
+    (dict(next_row=[0, 1]), ValueError, "next_row is the row a ramp leads to: pass ramp too"),
+    (dict(ramp=[0.0, 2.0]), ValueError, r"ramp must lie in \[0, 1\], got ramp\[1\] = 2.0"),
+    (dict(ramp=[0.0, 0.5], next_row=[0, -1]), ValueError, "needs the next row of new"),
+    (dict(selected=[1, 0]), ValueError, r"selected must be one-dimensional of shape \(3,\), got shape \(2,\)"),
+    (dict(selected=[1, 0, 2]), ValueError, r"selected must lie in 0 .. 1, got selected\[2\] = 2"),
+    (dict(selected=None, old_row=None, weight=[1.0, 0.0]), ValueError, "output frame 1 .* needs a row of old"),
+    (dict(offset_channels=[0, 3]), ValueError, r"offset_channels must lie in 0 .. 2, got offset_channels\[1\] = 3"),
+    (
+        dict(offset_channels=[0], offsets=np.zeros((2, 2))),
+        ValueError,
+        r"offsets must be two-dimensional of shape \(any, 1\)",
+    ),
+    (
+        dict(offset_channels=[0], offsets=np.zeros((2, 1)), offset_row=[0, 2]),
+        ValueError,
+        r"offset_row must lie in -1 .. 1",
+    ),
+    (dict(workers=0), ValueError, "workers must be"),
+]
+
+
+@pytest.mark.parametrize("change, exc, message", BAD_COMBINE)
+def test_combine_frames_checks_every_argument_before_any_c_call(monkeypatch, change, exc, message):
+    import mtcore.combine
+
+    args = {**dict(old=OLD, new=NEW, old_row=[0, 1], new_row=[0, 0], weight=[0.0, 1.0]), **change}
+    monkeypatch.setattr(mtcore.combine, "lib", NoC())
+    with pytest.raises(exc, match=message):
+        mtcore.combine.combine_frames(**args)
+
+
 def test_c_loop_checks_every_row_it_reads():
+    """The C loop does not trust its caller either: rows out of range and weights out of [0, 1]."""
+    from mtcore._cdata import c_array
+    from mtcore._mtcore import ffi, lib
     from mtcore.combine import combine_frames
 
-    old, new = np.zeros((5, 3)), np.ones((4, 3))
-    with pytest.raises(ValueError, match="mt_combine: an argument is outside its documented range"):
-        combine_frames(old, new, [0, 1], [0, 9], [1.0, 1.0])  # new row 9 of 4
-    with pytest.raises(ValueError, match="mt_combine"):
-        combine_frames(old, new, [0, -1], [0, 0], [0.0, 0.5])  # a blend without an old row
-    with pytest.raises(ValueError, match="mt_combine"):
-        combine_frames(old, new, [0, 1], [0, 0], [0.0, 1.5])  # a weight above 1
-    np.testing.assert_array_equal(combine_frames(old, new, [0, 1], [0, 0], [0.0, 1.0]), [[0, 0, 0], [1, 1, 1]])
+    def status(new_row, weight, old_row=(0, 1)):
+        out = np.empty((2, 3))
+        rows = [np.array(r, np.int64) for r in (old_row, new_row)]
+        return lib.mt_combine(
+            c_array(OLD), 5, c_array(NEW), 4, 3, 2, c_array(rows[0], "long long[]"), c_array(rows[1], "long long[]"),
+            ffi.NULL, ffi.NULL, c_array(np.array(weight)), c_array(np.ones(3, np.uint8), "unsigned char[]"),
+            c_array(np.full(2, -1, np.int64), "long long[]"), ffi.NULL, 0, ffi.NULL, 0, 0, 2, c_array(out),
+        )  # fmt: skip
+
+    assert status([0, 9], [1.0, 1.0]) == lib.MT_EINVAL  # new row 9 of 4
+    assert status([0, 0], [0.0, 0.5], old_row=(0, -1)) == lib.MT_EINVAL  # a blend without an old row
+    assert status([0, 0], [0.0, 1.5]) == lib.MT_EINVAL  # a weight above 1
+    assert status([0, 0], [0.0, 1.0]) == lib.MT_OK
+    np.testing.assert_array_equal(combine_frames(OLD, NEW, [0, 1], [0, 0], [0.0, 1.0]), [[0, 0, 0], [1, 1, 1]])
 
 
 def test_offset_channels_without_offsets():

@@ -149,3 +149,19 @@ def test_filter_command_on_bvh(data_dir, tmp_path, capsys):
     assert main(["filter", "--median", "3", str(data_dir / "bvh" / "walk01.bvh"), "-o", str(out)]) == 0
     expected = mt.read_bvh(data_dir / "bvh" / "walk01.bvh").filter("median", 3)
     assert mt.read_bvh(out).values.tobytes() == expected.values.tobytes()
+
+
+@pytest.mark.parametrize("kind", ["median", "mean", "binomial"])
+@pytest.mark.parametrize("bad", [np.inf, -np.inf, np.nan])
+def test_a_bad_sample_spoils_only_the_windows_that_hold_it(take, kind, bad):
+    """One inf or NaN in a rotation channel: every frame whose window does not reach it smooths as
+    it would without it (the unwrap steps over it, the ranges and the means' base ignore it)."""
+    size, frame, column = 7, 1000, take.columns("lfemur", "rz")[0]
+    values = take.values.copy()
+    values[frame, column] = bad
+    spoiled = take.replace(values=values).filter(kind, size)
+    clean = take.filter(kind, size)
+    outside = np.r_[0 : frame - size // 2, frame + size // 2 + 1 : take.frames]
+    np.testing.assert_array_equal(spoiled.values[outside], clean.values[outside])
+    others = [c for c in range(values.shape[1]) if c != column]
+    np.testing.assert_array_equal(spoiled.values[:, others], clean.values[:, others])

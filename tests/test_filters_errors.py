@@ -34,7 +34,11 @@ def filt(request):
         ),
         (dict(size=3, output=np.complex128), TypeError, "got dtype complex128"),
         (dict(size=3, output="not a dtype"), TypeError, "output must be None, an ndarray or a dtype"),
-        (dict(size=3, cval="a"), ValueError, "could not convert"),
+        (dict(size=3, cval="a"), TypeError, "cval must be a real number, got 'a'"),
+        (dict(size=3, cval=None), TypeError, "cval must be a real number, got None"),
+        (dict(size=3, axis=0.0), TypeError, "axis must be an integer, got float"),
+        (dict(size=3, origin="1"), TypeError, "origin must be an integer, got str"),
+        (dict(size=3, axis=None), TypeError, "axis must be an integer, got NoneType"),
     ],
 )
 def test_bad_arguments(filt, kwargs, exc, message):

@@ -1,4 +1,4 @@
-"""Every filter against scipy.ndimage and against the slow twins in reference.py."""
+"""Every filter against scipy.ndimage and against the slow twins in twins/filters.py."""
 
 import itertools
 
@@ -7,7 +7,7 @@ import pytest
 import scipy.ndimage as ndi
 
 import mtcore
-from reference import MODES, along_axis, correlate_line, mean_line, median_line
+from twins.filters import MODES, along_axis, correlate_line, mean_line, median_line
 
 SHAPES = [(0,), (1,), (2,), (7,), (10,), (0, 3), (3, 1), (5, 4), (4, 9), (2, 3, 5), (3, 1, 4, 2), (2, 2, 3, 3)]
 SIZES = list(range(1, 16)) + [40]

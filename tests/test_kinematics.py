@@ -8,9 +8,9 @@ from scipy.spatial.transform import Rotation
 
 import motiontheater as mt
 from conftest import ids, real_files
-from fk_twin import forward_kinematics as twin
 from mtcore import rotations as rot
 from mtcore.kinematics import JointTree, forward_kinematics
+from twins.kinematics import motion_kinematics as twin
 
 REFS = real_files("hdm05/*.ref.npz")
 AMCS = real_files("*/*.amc")
@@ -166,37 +166,71 @@ def test_quaternions_equal_scipy(rng):
 
 
 def test_bad_tables_are_refused():
-    with pytest.raises(ValueError, match=r"order must have shape \(2,\), got \(1,\)"):
-        JointTree(
-            parent=[-1, 0],
-            order=[0],
-            axis=[np.eye(3)] * 2,
-            direction=np.zeros((2, 3)),
-            segment=np.zeros((2, 3)),
-            dof_start=[0, 0, 0],
-            dof_kind=[],
-            dof_column=[],
-        )
-    tree = JointTree(
-        parent=[1, -1],
+    """In Python, before any C call, with the argument named; the C kernel checks them again."""
+    good = dict(
+        parent=[-1, 0],
         order=[0, 1],
         axis=[np.eye(3)] * 2,
         direction=np.zeros((2, 3)),
         segment=np.zeros((2, 3)),
-        dof_start=[0, 0, 0],
-        dof_kind=[],
-        dof_column=[],
+        dof_start=[0, 1, 2],
+        dof_kind=[0, 3],
+        dof_column=[0, 1],
     )
-    with pytest.raises(ValueError, match="mt_forward_kinematics: an argument is outside its documented range"):
-        forward_kinematics(np.zeros((3, 1)), tree)  # a child before its parent
+    bad = [
+        (dict(order=[0]), ValueError, r"order must be one-dimensional of shape \(2,\), got shape \(1,\)"),
+        (
+            dict(parent=[1, -1], order=[0, 1]),
+            ValueError,
+            r"each joint after its parent: joint 0 at order\[0\] before 1",
+        ),
+        (dict(order=[0, 0]), ValueError, r"every joint once, got joint 0 twice \(order\[1\]\)"),
+        (dict(parent=[-1, 2]), ValueError, r"parent must lie in -1 .. 1, got parent\[1\] = 2"),
+        (dict(parent=[-1.0, 0.5]), TypeError, "parent must hold integers, got dtype float64"),
+        (dict(dof_kind=[0, 7]), ValueError, r"dof_kind must lie in 0 .. 6, got dof_kind\[1\] = 7"),
+        (dict(dof_column=[0, -1]), ValueError, r"dof_column must lie in 0 .. \d+, got dof_column\[1\] = -1"),
+        (dict(dof_start=[0, 2, 1]), ValueError, r"dof_start must rise from 0 to the length of dof_kind \(2\)"),
+        (dict(dof_start=[0, 1, 3]), ValueError, r"dof_start must lie in 0 .. 2"),
+        (dict(axis=np.eye(3)), ValueError, r"axis must be three-dimensional of shape \(2, 3, 3\), got shape \(3, 3\)"),
+        (dict(segment=None), TypeError, "segment must be an array, got None"),
+        (dict(direction=[["a"] * 3] * 2), TypeError, "direction must hold real numbers, got dtype <U1"),
+        (dict(parent_frame=[0, 2]), ValueError, r"parent_frame must lie in 0 .. 1"),
+        (dict(angle_scale=np.nan), ValueError, "angle_scale must be finite, got nan"),
+    ]
+    for change, exc, message in bad:
+        with pytest.raises(exc, match=message):
+            JointTree(**{**good, **change})
+    tree = JointTree(**good)
+    with pytest.raises(ValueError, match="reads column 1 but values have 1 channels"):
+        forward_kinematics(np.zeros((3, 1)), tree)
+    with pytest.raises(ValueError, match=r"values must be two-dimensional of shape \(any, any\), got shape \(3,\)"):
+        forward_kinematics(np.zeros(3), tree)
+    with pytest.raises(TypeError, match="tree must be a JointTree, got dict"):
+        forward_kinematics(np.zeros((3, 2)), good)
     with pytest.raises(ValueError, match="reads column 0 but values have 0 channels"):
         forward_kinematics(np.zeros((3, 0)), single_joint(0))
+
+
+def test_the_c_kernel_checks_the_tree_again():
+    """A table that skips the Python checks (a child before its parent) is refused in C."""
+    from mtcore._cdata import c_array
+    from mtcore._mtcore import ffi, lib
+
+    parent, order = np.array([1, -1]), np.array([0, 1])
+    start = np.zeros(3, np.uintp)
+    positions = np.empty((1, 2, 3))
+    status = lib.mt_forward_kinematics(
+        c_array(np.zeros((1, 1))), 1, 1, 2, c_array(parent, "long long[]"), c_array(order, "long long[]"),
+        c_array(np.tile(np.eye(3), (2, 1))), c_array(np.zeros(6)), c_array(np.zeros(6)), c_array(start, "size_t[]"),
+        ffi.NULL, ffi.NULL, ffi.NULL, 1.0, 0, 1, c_array(positions), ffi.NULL, ffi.NULL,
+    )  # fmt: skip
+    assert status == lib.MT_EINVAL
 
 
 @pytest.mark.parametrize("order", ["xyz", "xzy", "yxz", "yzx", "zxy", "zyx"])
 @pytest.mark.parametrize("extrinsic", [True, False])
 def test_euler_conversions_equal_the_numpy_twin(rng, order, extrinsic):
-    import euler_twin
+    from twins import rotations as euler_twin
 
     angles = rng.uniform(-np.pi, np.pi, (997, 3))
     angles[:, 1] /= 2  # the middle angle's range, where the triple is the one the conversion returns

@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation, Slerp
 
-import euler_twin
 from mtcore import rotations as rot
+from twins import rotations as twin
 
 ORDERS = rot.ORDERS
 KINDS = [pytest.param(True, id="extrinsic"), pytest.param(False, id="intrinsic")]
@@ -33,11 +33,6 @@ def euler_samples(rng, order: str, n: int = 2000) -> np.ndarray:
     return np.concatenate([angles, lock])
 
 
-def twin_matrices(angles, order, extrinsic):
-    """Products of single-axis matrices; intrinsic angles are extrinsic ones in reverse."""
-    return euler_twin.matrices(angles, order) if extrinsic else euler_twin.matrices(angles[..., ::-1], order[::-1])
-
-
 def total_turn(q):
     """Sum of the angles turned between consecutive frames of quaternions (frames, 4)."""
     r = Rotation.from_quat(q, scalar_first=True)
@@ -55,7 +50,7 @@ def test_euler_to_matrices_equals_scipy_and_the_twin(rng, order, extrinsic):
     np.testing.assert_allclose(
         m, Rotation.from_euler(scipy_seq(order, extrinsic), angles).as_matrix(), rtol=0, atol=1e-12
     )
-    np.testing.assert_allclose(m, twin_matrices(angles, order, extrinsic), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(m, twin.euler_to_matrices(angles, order, extrinsic), rtol=0, atol=1e-14)
     degrees = rot.euler_to_matrices(np.degrees(angles), order, extrinsic=extrinsic, degrees=True)
     np.testing.assert_allclose(degrees, m, rtol=0, atol=1e-14)
 
@@ -258,34 +253,6 @@ def test_nan_and_zero_quaternions_give_nan():
 # --- continuity ---------------------------------------------------------------------------
 
 
-def unroll_quaternions_twin(q):
-    out = q.copy()
-    for t in range(1, len(q)):
-        if np.dot(out[t - 1], q[t]) < 0:
-            out[t] = -q[t]
-    return out
-
-
-def unroll_euler_twin(angles, proper, half):
-    """Every equivalent triple within a turn of the rounded shift, the nearest kept."""
-    out = angles.copy()
-    shifts = 2 * half * np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)])
-    for t in range(1, len(angles)):
-        a = angles[t]
-        if np.isnan(out[t - 1]).any():
-            continue
-        other = np.array([a[0] + half, (0 if proper else half) - a[1], a[2] + half])
-        best = None
-        for candidate in (a, other):
-            base = candidate + 2 * half * np.round((out[t - 1] - candidate) / (2 * half))
-            for s in shifts:
-                d = np.sum((base + s - out[t - 1]) ** 2)
-                if best is None or d < best[0]:
-                    best = (d, base + s)
-        out[t] = best[1]
-    return out
-
-
 @pytest.mark.parametrize("frames", [0, 1, 2, 7, 500])
 def test_unroll_quaternions_equals_the_twin(rng, frames):
     q = rng.normal(size=(3, frames, 5, 4))
@@ -293,7 +260,7 @@ def test_unroll_quaternions_equals_the_twin(rng, frames):
     assert out.shape == q.shape
     for i in range(3):
         for j in range(5):
-            np.testing.assert_array_equal(out[i, :, j], unroll_quaternions_twin(q[i, :, j]))
+            np.testing.assert_array_equal(out[i, :, j], twin.unroll_quaternions(q[i, :, j]))
     np.testing.assert_array_equal(rot.unroll_quaternions(np.moveaxis(q, 1, 0)), np.moveaxis(out, 1, 0))
     np.testing.assert_array_equal(rot.unroll_quaternions(q, axis=-3), out)
 
@@ -309,7 +276,7 @@ def test_unroll_quaternions_makes_a_canonical_path_continuous():
     q[500] = np.nan  # a restart after the gap, from the raw sign
     out = rot.unroll_quaternions(q)
     np.testing.assert_array_equal(out[501], q[501])
-    np.testing.assert_array_equal(out, unroll_quaternions_twin(q))
+    np.testing.assert_array_equal(out, twin.unroll_quaternions(q))
 
 
 @pytest.mark.parametrize("degrees", [False, True])
@@ -321,7 +288,9 @@ def test_unroll_euler_equals_the_twin(rng, order, degrees):
     raw[1, 100] = np.nan
     out = rot.unroll_euler(raw, order, axis=1, degrees=degrees)
     for i in range(2):
-        np.testing.assert_allclose(out[i], unroll_euler_twin(raw[i], order[0] == order[2], half), rtol=0, atol=1e-9)
+        np.testing.assert_allclose(
+            out[i], twin.unroll_euler_line(raw[i], order[0] == order[2], half), rtol=0, atol=1e-9
+        )
     m = rot.euler_to_matrices(raw, order, extrinsic=True, degrees=degrees)
     np.testing.assert_allclose(
         rot.euler_to_matrices(out, order, extrinsic=True, degrees=degrees), m, rtol=0, atol=1e-12
@@ -386,25 +355,12 @@ def test_slerp_broadcasts_keys_against_fractions(rng):
     np.testing.assert_array_equal(out[4, 2], rot.slerp(q0[2], q1, t[4]))
 
 
-def aligned_twin(v0, v1, t):
-    """Quaternions of the keys; where their dot product is negative the first is negated and taken
-    back to a rotation vector without canonicalising (angle in (pi, 2 pi])."""
-    q0 = Rotation.from_rotvec(v0).as_quat(scalar_first=True, canonical=False)
-    q1 = Rotation.from_rotvec(v1).as_quat(scalar_first=True, canonical=False)
-    flip = np.sum(q0 * q1, axis=-1) < 0
-    n = -q0[flip]
-    norm = np.linalg.norm(n[:, 1:], axis=-1, keepdims=True)
-    v0 = v0.copy()
-    v0[flip] = 2 * np.arctan2(norm, n[:, :1]) * n[:, 1:] / norm
-    return v0 + t[..., None] * (v1 - v0)
-
-
 def test_rotvec_interpolation_equals_the_twins(rng):
     v0, v1 = rng.uniform(-4, 4, (2, 3000, 3))
     t = rng.uniform(0, 1, 3000)
     np.testing.assert_allclose(rot.interpolate_rotvecs(v0, v1, t), v0 + t[:, None] * (v1 - v0), rtol=0, atol=1e-15)
     aligned = rot.interpolate_rotvecs(v0, v1, t, aligned=True)
-    np.testing.assert_allclose(aligned, aligned_twin(v0, v1, t), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(aligned, twin.interpolate_rotvecs(v0, v1, t, aligned=True), rtol=0, atol=1e-13)
     ends = rot.interpolate_rotvecs(v0, v1, np.array([[0.0], [1.0]]), aligned=True)
     for end, key in zip(ends, (v0, v1)):
         np.testing.assert_allclose(rot.rotvecs_to_matrices(end), rot.rotvecs_to_matrices(key), rtol=0, atol=1e-14)

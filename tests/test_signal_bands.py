@@ -8,7 +8,7 @@ import scipy.ndimage as ndi
 import motiontheater as mt
 from conftest import real_files
 from mtcore import signal as sg
-from signal_twins import equalize_twin, levels_twin
+from twins.signal import equalize_twin, levels_twin
 
 MODES = ["nearest", "reflect", "mirror", "constant", "wrap"]
 SIZES = [1, 2, 3, 4, 5, 7, 8, 9, 16, 17, 31, 100, 513, 1000, 2049, 5000]

@@ -9,7 +9,7 @@ import scipy.signal as ss
 
 import motiontheater as mt
 from mtcore import signal as sg
-from signal_twins import sosfilt_zi_twin, sosfiltfilt_twin
+from twins.signal import sosfilt_zi_twin, sosfiltfilt_twin
 
 KINDS = [("low", 0.1), ("low", 0.004), ("low", 0.9), ("high", 0.05), ("high", 0.8), ("band", (0.02, 0.2))]
 KINDS += [("band", (0.4, 0.45)), ("band", (0.005, 0.99))]

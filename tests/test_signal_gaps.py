@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 import motiontheater as mt
 from mtcore import signal as sg
-from signal_twins import fill_gaps_twin, nan_runs_twin
+from twins.signal import fill_gaps_twin, nan_runs_twin
 
 
 def holes(rng, frames, channels, share):

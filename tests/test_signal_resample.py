@@ -11,7 +11,7 @@ from mtcore import rotations as rot
 from mtcore import signal as sg
 from mtcore._cdata import c_array
 from mtcore._mtcore import lib
-from signal_twins import resample_poly_twin, upfirdn_twin
+from twins.signal import resample_poly_twin, upfirdn_twin
 
 RATIOS = [(1, 4), (1, 2), (4, 1), (2, 1), (1, 5), (5, 24), (3, 7), (960, 959), (2, 2)]
 PADTYPES = ["constant", "line", "edge", "smooth", "symmetric", "reflect", "wrap", "antisymmetric", "antireflect"]

@@ -19,6 +19,9 @@ _EXCEPTIONS: dict[int, type[Exception]] = {
     lib.MT_EMISSING: errors.MissingError,
     lib.MT_EFRAME: errors.SequenceError,
     lib.MT_EFRAMERANGE: errors.SequenceError,
+    # a table with more rows than its header declares (mt_scan_table); elsewhere an output
+    # buffer below its bound, which Python sizes, so a broken invariant
+    lib.MT_ERANGE: errors.SequenceError,
 }
 
 

@@ -3,7 +3,10 @@
 Each filter runs along one axis of an n-d array, in C.  float32 and float64
 are computed natively (float32 stays float32; means are accumulated in
 double); float16 is computed in float32; bool and integer input in float64,
-the result cast to the output type as scipy does (truncation toward zero).
+the result cast to the output type as scipy does (truncation toward zero),
+but for the median of 64-bit integers beyond 2**53, which float64 would
+round: it is exact (computed on the values' ranks).  A NaN or an infinity
+affects only the outputs whose windows hold it.
 The input is never modified.  ``output`` may be an array of the input's shape
 (any dtype, any layout, even the input itself) or a dtype.
 
@@ -26,6 +29,15 @@ An extension longer than the line repeats the pattern; scipy's aliases
 ``grid-mirror``, ``grid-constant`` and ``grid-wrap`` are accepted.  Output
 sample ``i`` reads input samples ``i + j - size // 2 - origin`` for
 ``j = 0 .. size - 1``.
+
+Sizes: any from 1 to :data:`MAX_SIZE` (2**31 - 1) for the median and the
+mean; a window longer than the line costs time and memory in proportion to
+the line, not to the window.  The binomial filter takes sizes up to
+:data:`MAX_BINOMIAL_SIZE` (65537, a Gaussian of standard deviation 128
+samples): its weights are exact fractions of integers of ``size`` bits, and
+beyond that size they would take seconds to compute while all but the
+central ``39 * sqrt(size)`` of them round to 0.  For wider smoothing apply
+:func:`uniform_filter1d` three times (a close approximation of a Gaussian).
 """
 
 from __future__ import annotations
@@ -40,7 +52,15 @@ from numpy.typing import ArrayLike, DTypeLike
 from ._mtcore import ffi, lib
 from ._parallel import run_ranges, thread_count
 
-__all__ = ["MODES", "binomial_filter1d", "median_filter1d", "pascal_weights", "uniform_filter1d"]
+__all__ = [
+    "MAX_BINOMIAL_SIZE",
+    "MAX_SIZE",
+    "MODES",
+    "binomial_filter1d",
+    "median_filter1d",
+    "pascal_weights",
+    "uniform_filter1d",
+]
 
 MODES = {
     "reflect": lib.MT_MODE_REFLECT,
@@ -53,6 +73,9 @@ MODES = {
     "grid-wrap": lib.MT_MODE_WRAP,
 }
 
+MAX_SIZE = 2**31 - 1  # samples: a window no capture comes near (20 days at 1200 Hz)
+MAX_BINOMIAL_SIZE = 2**16 + 1  # see the module's docstring
+
 # Below this, handing work to another thread costs more than it saves.
 _PARALLEL_MIN_VALUES = 1 << 20
 
@@ -63,8 +86,18 @@ _F32, _F64 = np.dtype(np.float32), np.dtype(np.float64)
 @functools.lru_cache(maxsize=64)
 def _pascal(size: int) -> np.ndarray:
     n = size - 1
-    # Python integers are exact, and int / int rounds correctly even for huge rows.
-    w = np.array([math.comb(n, k) / 2**n for k in range(size)])
+    top = 1 << n
+    w = np.zeros(size)
+    # From the middle outwards, C(n, k - 1) = C(n, k) k / (n - k + 1) exactly, by symmetry
+    # both halves at once, until the weights round to 0: a few thousand steps on integers of
+    # n bits.  Python integers are exact, and int / int rounds correctly even for huge rows.
+    c = math.comb(n, n // 2)
+    for k in range(n // 2, -1, -1):
+        weight = c / top
+        if weight == 0.0:
+            break
+        w[k] = w[n - k] = weight
+        c = c * k // (n - k + 1)
     w.flags.writeable = False
     return w
 
@@ -73,10 +106,12 @@ def pascal_weights(size: int) -> np.ndarray:
     """Row ``size - 1`` of Pascal's triangle divided by its sum ``2**(size - 1)``.
 
     size 3: ``[1, 2, 1] / 4``; size 5: ``[1, 4, 6, 4, 1] / 16``.  Every weight
-    is the correctly rounded float64 of the exact fraction.  Returns a new
-    float64 array of length ``size``.
+    is the correctly rounded float64 of the exact fraction (0.0 where that is
+    below the smallest subnormal, the outer weights of sizes above 1075).
+    Returns a new float64 array of length ``size``, 1 to
+    :data:`MAX_BINOMIAL_SIZE`.
     """
-    return _pascal(_check_size(size)).copy()
+    return _pascal(_check_size(size, MAX_BINOMIAL_SIZE, "binomial ")).copy()
 
 
 def median_filter1d(
@@ -95,8 +130,8 @@ def median_filter1d(
     Gives the same result as ``scipy.ndimage.median_filter(input, size=size,
     axes=(axis,), mode=mode, cval=cval, origin=origin)``: for an even size the
     upper of the two middle values (rank ``size // 2``), never an average, so
-    the median never invents values.  A window that contains NaN gives NaN
-    (scipy's result is undefined there).
+    the median never invents values, 64-bit integers included.  A window
+    that contains NaN gives NaN (scipy's result is undefined there).
     """
     return _filter1d(lib.MT_FILTER_MEDIAN, input, size, axis, output, mode, cval, origin, workers)
 
@@ -142,13 +177,20 @@ def binomial_filter1d(
     return _filter1d(lib.MT_FILTER_CORRELATE, input, size, axis, output, mode, cval, origin, workers)
 
 
-def _check_size(size: int) -> int:
+def _integer(value, name: str) -> int:
     try:
-        size = operator.index(size)
+        return operator.index(value)
     except TypeError:
-        raise TypeError(f"size must be an integer, got {type(size).__name__}") from None
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__}") from None
+
+
+def _check_size(size: int, most: int = MAX_SIZE, what: str = "") -> int:
+    size = _integer(size, "size")
     if size < 1:
         raise ValueError(f"size must be at least 1, got {size}")
+    if size > most:
+        hint = " (see mtcore.filters: wider smoothing by uniform_filter1d three times)" if what else ""
+        raise ValueError(f"{what}size must be at most {most} samples, got {size}{hint}")
     return size
 
 
@@ -181,8 +223,9 @@ def _split(workers: int | None, values: int, frames: int, block: int) -> list[in
 def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
     a = np.asarray(input)
     work = _work_dtype(a.dtype)
-    size = _check_size(size)
-    axis = operator.index(axis)
+    binomial = kind == lib.MT_FILTER_CORRELATE
+    size = _check_size(size, MAX_BINOMIAL_SIZE if binomial else MAX_SIZE, "binomial " if binomial else "")
+    axis = _integer(axis, "axis")
     if not -a.ndim <= axis < a.ndim:
         raise np.exceptions.AxisError(axis, a.ndim)
     axis %= a.ndim
@@ -190,15 +233,19 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
         code = MODES[mode]
     except (KeyError, TypeError):
         raise ValueError(f"mode must be one of {', '.join(map(repr, MODES))}; got {mode!r}") from None
-    cval = float(cval)
-    origin = operator.index(origin)
+    try:
+        cval = float(cval)
+    except (TypeError, ValueError):
+        raise TypeError(f"cval must be a real number, got {cval!r}") from None
+    origin = _integer(origin, "origin")
     if not -(size // 2) <= origin <= (size - 1) // 2:
         raise ValueError(f"origin must be in [{-(size // 2)}, {(size - 1) // 2}] for size {size}, got {origin}")
+    target = _target(output, a)
+    if kind == lib.MT_FILTER_MEDIAN and not _exact_in_float64(a):
+        return _median_by_rank(a, size, axis, target, mode, cval, origin, workers)
 
     outer, n, inner = math.prod(a.shape[:axis]), a.shape[axis], math.prod(a.shape[axis + 1 :])
     bounds = _split(workers, a.size, n, lib.mt_filter1d_block(size))
-    target = _target(output, a)
-
     if a.dtype != work or not (a.flags.c_contiguous and a.flags.aligned):
         a = np.require(a, work, ["C", "A"])
     # The kernel writes straight into the target when it has the kernel's layout
@@ -211,15 +258,59 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
     )
     result = target if direct else np.empty(a.shape, work)
     if a.size:
-        weights = ffi.from_buffer("double[]", _pascal(size)) if kind == lib.MT_FILTER_CORRELATE else ffi.NULL
+        weights = ffi.from_buffer("double[]", _pascal(size)) if binomial else ffi.NULL
         head = (kind, _NATIVE[work], ffi.from_buffer(a), ffi.from_buffer(result), outer, n, inner)
         tail = (size, origin, code, cval, weights)
         run_ranges(lambda begin, end: lib.mt_filter1d(*head, begin, end, *tail), bounds, "mt_filter1d")
     if not direct:
-        if target.dtype == np.bool_:
-            # scipy stores through npy_bool, an unsigned char: values truncate, so only |x| >= 1 is True.
-            result = np.abs(result) >= 1
-        np.copyto(target, result, casting="unsafe")
+        _store(target, result)
+    return target
+
+
+def _store(target: np.ndarray, result, where=True) -> None:
+    """Cast ``result`` into ``target`` as scipy does."""
+    if target.dtype == np.bool_:
+        # scipy stores through npy_bool, an unsigned char: values truncate, so only |x| >= 1 is True.
+        result = np.abs(result) >= 1
+    np.copyto(target, result, casting="unsafe", where=where)
+
+
+def _exact_in_float64(a: np.ndarray) -> bool:
+    """Whether float64 holds every value of ``a`` exactly (64-bit integers beyond 2**53 it does not)."""
+    if a.dtype.kind not in "iu" or a.dtype.itemsize < 8 or not a.size:
+        return True
+    return -(2**53) <= int(a.min()) and int(a.max()) <= 2**53
+
+
+def _median_by_rank(a: np.ndarray, size, axis, target, mode, cval, origin, workers) -> np.ndarray:
+    """The median of 64-bit integers beyond float64's exact range, exactly.
+
+    A median is a rank: it commutes with any increasing map.  The values are
+    replaced by their ranks among the distinct values (float64 holds those
+    exactly), the ranks filtered, and the ranks of the result looked up.
+    cval, a float, gets the rank of its place among the values (a half rank
+    between two of them), so that it orders exactly as it does against them.
+    """
+    values = np.unique(a)
+    ranks = np.searchsorted(values, a).astype(np.float64)
+    if math.isnan(cval):
+        cval_rank = math.nan
+    else:
+        # the values below cval are those below ceil(cval), compared as Python integers (exact)
+        ceiling = math.ceil(cval) if math.isfinite(cval) else int(math.copysign(2**64, cval))
+        if ceiling <= int(values[0]):
+            below = 0
+        elif ceiling > int(values[-1]):
+            below = len(values)
+        else:
+            below = int(np.searchsorted(values, ceiling))
+        equal = below < len(values) and cval == int(values[below])
+        cval_rank = float(below) if equal else below - 0.5
+    picked = _filter1d(lib.MT_FILTER_MEDIAN, ranks, size, axis, None, mode, cval_rank, origin, workers)
+    exact = picked == np.floor(picked)
+    _store(target, values[np.where(exact, picked, 0).astype(np.intp)], where=exact)
+    if not exact.all():
+        _store(target, np.float64(cval), where=~exact)
     return target
 
 

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _checks
 from ._cdata import c_array
 from ._mtcore import lib
 from ._parallel import even_bounds, run_ranges, thread_count
@@ -25,10 +26,6 @@ DOFS = {
     "l": lib.MT_DOF_L,
 }
 _PARALLEL_MIN_TRANSFORMS = 20_000  # frames x joints below which one thread is faster
-
-
-def _doubles(a) -> np.ndarray:
-    return np.ascontiguousarray(a, dtype=np.float64)
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,28 +51,42 @@ class JointTree:
     parent_frame: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        n = len(self.parent)
+        parent = _checks.integers(self.parent, "parent", (None,), -1, len(np.asarray(self.parent)))
+        n = len(parent)
+        dof_kind = _checks.integers(self.dof_kind, "dof_kind", (None,), min(DOFS.values()), max(DOFS.values()) + 1)
         fields = dict(
-            parent=(np.int64, (n,)),
-            order=(np.int64, (n,)),
-            axis=(np.float64, (n, 3, 3)),
-            direction=(np.float64, (n, 3)),
-            segment=(np.float64, (n, 3)),
-            dof_start=(np.uintp, (n + 1,)),
-            dof_kind=(np.intc, None),
-            dof_column=(np.uintp, None),
-            parent_frame=(np.uint8, (n,)),
+            parent=parent,
+            order=_checks.integers(self.order, "order", (n,), 0, n),
+            axis=_checks.real(self.axis, "axis", (n, 3, 3)),
+            direction=_checks.real(self.direction, "direction", (n, 3)),
+            segment=_checks.real(self.segment, "segment", (n, 3)),
+            dof_start=_checks.integers(self.dof_start, "dof_start", (n + 1,), 0, len(dof_kind) + 1, np.uintp),
+            dof_kind=dof_kind.astype(np.intc),
+            dof_column=_checks.integers(self.dof_column, "dof_column", (len(dof_kind),), 0, 2**62, np.uintp),
+            parent_frame=np.zeros(n, np.uint8)
+            if self.parent_frame is None
+            else _checks.integers(self.parent_frame, "parent_frame", (n,), 0, 2, np.uint8),
         )
-        if self.parent_frame is None:
-            object.__setattr__(self, "parent_frame", np.zeros(n, np.uint8))
-        for name, (dtype, shape) in fields.items():
-            array = np.ascontiguousarray(getattr(self, name), dtype=dtype)
-            if shape is not None and array.shape != shape:
-                raise ValueError(f"{name} must have shape {shape}, got {array.shape}")
+        for name, array in fields.items():
             array.flags.writeable = False
             object.__setattr__(self, name, array)
-        if len(self.dof_kind) != len(self.dof_column) or (n and self.dof_start[-1] != len(self.dof_kind)):
-            raise ValueError("dof_start must end at the length of dof_kind and dof_column")
+        scale = _checks.real(self.angle_scale, "angle_scale", ())
+        if not np.isfinite(scale):
+            raise ValueError(f"angle_scale must be finite, got {float(scale)}")
+        object.__setattr__(self, "angle_scale", float(scale))
+        starts = self.dof_start
+        if n and (starts[0] != 0 or starts[-1] != len(dof_kind) or (np.diff(starts.astype(np.int64)) < 0).any()):
+            raise ValueError(
+                f"dof_start must rise from 0 to the length of dof_kind ({len(dof_kind)}), got {starts.tolist()}"
+            )
+        seen = np.zeros(n, bool)
+        for i, j in enumerate(self.order.tolist()):
+            if seen[j]:
+                raise ValueError(f"order must list every joint once, got joint {j} twice (order[{i}])")
+            p = int(self.parent[j])
+            if p >= 0 and not seen[p]:
+                raise ValueError(f"order must list each joint after its parent: joint {j} at order[{i}] before {p}")
+            seen[j] = True
 
     @property
     def joints(self) -> int:
@@ -89,9 +100,9 @@ def forward_kinematics(
     """Positions (frames, joints, 3) of each joint's end, and optionally world and
     local rotations (frames, joints, 3, 3), for values (frames, channels).
     Frames are split over the cores for large motions (``workers`` as for the filters)."""
-    values = _doubles(values)
-    if values.ndim != 2:
-        raise ValueError(f"values must be (frames, channels), got shape {values.shape}")
+    if not isinstance(tree, JointTree):
+        raise TypeError(f"tree must be a JointTree, got {type(tree).__name__}")
+    values = _checks.real(values, "values", (None, None))
     frames, channels = values.shape
     if len(tree.dof_column) and tree.dof_column.max() >= channels:
         raise ValueError(f"the tree reads column {tree.dof_column.max()} but values have {channels} channels")

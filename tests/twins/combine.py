@@ -1,35 +1,54 @@
-"""Two slow twins of the combiner's C loop: vectorised numpy, and the thesis's per-frame Python loop."""
+"""Twins of mt_combine: whole-array numpy, and the thesis's per-frame Python loop."""
+
+from __future__ import annotations
 
 import numpy as np
 
 
-def numpy_combine(old, new, plan, selected, offset_row=None, offsets=None, offset_channels=()):
-    """The same per-frame rule as mt_combine, in whole-array numpy operations."""
-    old_rows = old[np.maximum(plan.old_row, 0)] if old is not None else np.zeros((len(plan.weight), new.shape[1]))
-    fresh = new[np.maximum(plan.new_row, 0)]
-    following = fresh if plan.next_row is None else new[np.maximum(plan.next_row, 0)]
-    a = np.zeros((len(plan.weight), 1)) if plan.ramp is None else plan.ramp[:, None]
-    u = plan.weight[:, None]
+def combine_frames(
+    old,
+    new,
+    old_row,
+    new_row,
+    weight,
+    *,
+    next_row=None,
+    ramp=None,
+    selected=None,
+    offset_row=None,
+    offsets=None,
+    offset_channels=(),
+) -> np.ndarray:
+    """The per-frame rule of mt_combine (the arguments of mtcore.combine.combine_frames) in
+    whole-array numpy operations."""
+    new = np.asarray(new, float)
+    weight = np.asarray(weight, float)
+    frames, channels = len(weight), new.shape[1]
+    old_rows = np.asarray(old, float)[np.maximum(old_row, 0)] if old is not None else np.zeros((frames, channels))
+    fresh = new[np.maximum(new_row, 0)]
+    following = fresh if ramp is None or next_row is None else new[np.maximum(next_row, 0)]
+    a = np.zeros((frames, 1)) if ramp is None else np.asarray(ramp, float)[:, None]
+    u = weight[:, None]
     fresh = np.where(a == 0, fresh, (1 - a) * fresh + a * following)
     mixed = np.where(u == 0, old_rows, np.where(u == 1, fresh, (1 - u) * old_rows + u * fresh))
-    out = np.where(selected.astype(bool), mixed, old_rows)
+    chosen = np.ones(channels, bool) if selected is None else np.asarray(selected).astype(bool)
+    out = np.where(chosen, mixed, old_rows)
     if offset_row is not None:
-        rows = offset_row >= 0
-        out[np.ix_(rows, list(offset_channels))] += offsets[offset_row[rows]]
+        rows = np.asarray(offset_row) >= 0
+        out[np.ix_(rows, list(offset_channels))] += np.asarray(offsets, float)[np.asarray(offset_row)[rows]]
     return out
 
 
-def python_combine(old, new, plan, selected):
-    """The thesis's structure: a loop over output frames and channels in plain Python."""
+def python_combine(old, new, old_row, new_row, weight, *, next_row=None, ramp=None, selected=None) -> list:
+    """The thesis's structure: a loop over output frames and channels in plain Python (lists in, lists out)."""
     out = []
-    old_rows, new_rows = plan.old_row.tolist(), plan.new_row.tolist()
-    next_rows = new_rows if plan.next_row is None else plan.next_row.tolist()
-    ramps = [0.0] * len(new_rows) if plan.ramp is None else plan.ramp.tolist()
-    weights, chosen = plan.weight.tolist(), selected.tolist()
-    for f in range(len(weights)):
-        o = old[old_rows[f]] if old_rows[f] >= 0 else None
-        n, m = new[new_rows[f]] if new_rows[f] >= 0 else None, new[next_rows[f]] if next_rows[f] >= 0 else None
-        u, a = weights[f], ramps[f]
+    next_row = new_row if ramp is None or next_row is None else next_row
+    ramp = [0.0] * len(weight) if ramp is None else ramp
+    chosen = [1] * len(new[0]) if selected is None else selected
+    for f in range(len(weight)):
+        o = old[old_row[f]] if old_row[f] >= 0 else None
+        n, m = new[new_row[f]] if new_row[f] >= 0 else None, new[next_row[f]] if next_row[f] >= 0 else None
+        u, a = weight[f], ramp[f]
         row = []
         for c in range(len(chosen)):
             if u == 0 or not chosen[c]:

@@ -217,12 +217,3 @@ def fill_gaps_twin(x, max_gap, method="linear"):
         else:
             out[first:stop, c] = _hermite(knots, values, _spline_slopes(knots, values), t)
     return out, nan_runs_twin(out)
-
-
-TWINS = {
-    "mt_equalize": equalize_twin,
-    "mt_sosfiltfilt": sosfiltfilt_twin,
-    "mt_upfirdn": upfirdn_twin,
-    "mt_fill_gaps": fill_gaps_twin,
-    "mt_nan_runs": nan_runs_twin,
-}

@@ -1,0 +1,513 @@
+"""One slow, obvious twin per C entry point (every mt_* function of csrc/mtcore.h).
+
+``TWINS`` maps the name of each entry point to a :class:`Twin`: the mtcore call that
+reaches it (``fast``), the twin that computes the same from the contract in plain Python
+or numpy (``slow``, the same arguments), argument tuples over the shapes and options that
+matter (``cases``) and how the two results must agree (``same``).  The model is
+bottleneck's ``slow/`` functions paired with the fast ones by ``tests/util.py::func_dict``.
+
+``EXEMPT`` names the entry points that are not kernels, and why they need no twin.
+tests/test_twins.py pairs every twin with its kernel, checks that none is missing and that
+no input is modified; tests/test_concurrent.py calls every ``fast`` from eight threads.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+import mtcore
+from mtcore import rotations as rot
+from mtcore import signal as mt_signal
+from mtcore import text as mt_text
+from mtcore.combine import combine_frames
+from mtcore.kinematics import JointTree, forward_kinematics
+
+from . import combine, filters, kinematics, rotations
+from . import signal as signal_twins
+from . import text as text_twins  # binds twins.text too: mtcore's is mt_text
+
+
+@dataclass(frozen=True)
+class Twin:
+    fast: Callable[..., Any]
+    slow: Callable[..., Any]
+    cases: Callable[[np.random.Generator], list[tuple]]
+    same: Callable[[Any, Any], None]
+
+
+def exact(got, want) -> None:
+    """Equal bit for bit but for NaN payloads: arrays (shape, dtype, values, NaN places), tuples of them, texts."""
+    if isinstance(got, tuple):
+        assert isinstance(want, tuple) and len(got) == len(want)
+        for g, w in zip(got, want):
+            exact(g, w)
+    elif isinstance(got, np.ndarray):
+        want = np.asarray(want)
+        assert got.shape == want.shape, (got.shape, want.shape)
+        np.testing.assert_array_equal(got, want.astype(got.dtype))
+        np.testing.assert_array_equal(np.signbit(got), np.signbit(want))
+    else:
+        assert got == want, (got, want)
+
+
+def close(atol: float) -> Callable[[Any, Any], None]:
+    """Equal to atol times the larger of 1 and the largest finite magnitude (NaN and infinities exactly)."""
+
+    def same(got, want) -> None:
+        if isinstance(got, tuple):
+            for g, w in zip(got, want, strict=True):
+                same(g, w)
+            return
+        got, want = np.asarray(got), np.asarray(want)
+        assert got.shape == want.shape, (got.shape, want.shape)
+        finite = want[np.isfinite(want)]
+        scale = max(1.0, float(np.abs(finite).max())) if finite.size else 1.0
+        np.testing.assert_allclose(got, want, rtol=0, atol=atol * scale)
+
+    return same
+
+
+def angles_close(got, want) -> None:
+    """Angles equal to 1e-12 radians modulo a turn (pi and -pi agree)."""
+    np.testing.assert_allclose(np.angle(np.exp(1j * (got - want))), 0.0, rtol=0, atol=1e-12)
+
+
+# --- filters --------------------------------------------------------------------------------
+
+FILTERS = {"median": mtcore.median_filter1d, "uniform": mtcore.uniform_filter1d, "binomial": mtcore.binomial_filter1d}
+SHAPES = [((0,), 0), ((1,), 0), ((6,), 0), ((7, 3), 0), ((3, 7), 1), ((2, 5, 4), 1), ((4, 1, 18), 2)]
+
+
+def filter_cases(rng: np.random.Generator) -> list[tuple]:
+    """Every filter and mode on every shape, sizes 1 to beyond the line, origins at both ends."""
+    out = []
+    for kind in filters.KINDS:
+        for mode in filters.MODES:
+            for shape, axis in SHAPES:
+                size = int(rng.choice([1, 2, 3, 4, 5, 8, 9, 12, 25]))
+                origin = int(rng.integers(-(size // 2), (size - 1) // 2 + 1))
+                dtype = rng.choice([np.float64, np.float32])
+                x = (rng.standard_normal(shape) * 10).astype(dtype)
+                if x.size > 3:
+                    x.flat[rng.integers(x.size)] = rng.choice([np.nan, np.inf, -np.inf])
+                out.append((kind, x, size, axis, mode, 0.75, origin))
+    return out
+
+
+def fast_filter(kind, x, size, axis, mode, cval, origin):
+    return FILTERS[kind](x, size, axis, mode=mode, cval=cval, origin=origin)
+
+
+def slow_filter(kind, x, size, axis, mode, cval, origin):
+    return filters.filter1d(kind, x, size, axis, mode, float(x.dtype.type(cval)), origin).astype(x.dtype)
+
+
+def filter_same(got, want) -> None:
+    close(1e-5 if got.dtype == np.float32 else 1e-12)(got, want)
+
+
+# --- text -----------------------------------------------------------------------------------
+
+KEYS = [b"root", b"lfemur", b"ltibia", b"head"]
+OFFSETS = [0, 6, 9, 0]
+COUNTS = [6, 3, 1, 0]  # head: a key without numbers
+CHANNELS = 11  # column 10 is no key's: NaN
+
+
+def numbers(rng: np.random.Generator, n: int) -> np.ndarray:
+    """Mocap-like short decimals and doubles of every magnitude."""
+    short = np.round(rng.uniform(-400, 400, n), int(rng.integers(0, 7)))
+    wide = rng.standard_normal(n) * 10.0 ** rng.integers(-300, 300, n)
+    return np.where(rng.random(n) < 0.5, short, wide)
+
+
+def frame_text_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for frames in (0, 1, 2, 7):
+        values = numbers(rng, frames * CHANNELS).reshape(frames, CHANNELS)
+        first = int(rng.integers(0, 1000))
+        newline = [b"\n", b"\r\n", b"\r"][int(rng.integers(3))]
+        lines = [b"# a comment", b""]
+        for f in range(frames):
+            lines.append(b"%d" % (first + f))
+            for i in rng.permutation(len(KEYS)):
+                words = [text_twins.format_number(v).encode() for v in values[f, OFFSETS[i] : OFFSETS[i] + COUNTS[i]]]
+                lines.append(b"\t".join([KEYS[i], *words]) if f % 2 else b" ".join([KEYS[i], *words]))
+        out.append((newline.join(lines) + newline, KEYS, OFFSETS, COUNTS, CHANNELS))
+    return out
+
+
+def table_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for rows, columns in ((0, 3), (1, 1), (3, 4), (9, 2)):
+        values = numbers(rng, rows * columns).reshape(rows, columns)
+        lines = [b" ".join(text_twins.format_number(v).encode() for v in row) for row in values]
+        out.append((b"\r\n".join(lines) + b"\r\n", rows, columns))
+    return out
+
+
+SPECIAL = [0.0, -0.0, math.inf, -math.inf, math.nan, -math.nan, 5e-324, 1.7976931348623157e308, 1e16, 1e-5, 123456.0]
+
+
+def number_cases(rng: np.random.Generator) -> list[tuple]:
+    return [(v,) for v in SPECIAL + numbers(rng, 300).tolist()]
+
+
+def value_cases(rng: np.random.Generator) -> list[tuple]:
+    return [(numbers(rng, r * c).reshape(r, c),) for r, c in ((0, 2), (1, 1), (3, 4), (5, 11))]
+
+
+def frame_value_cases(rng: np.random.Generator) -> list[tuple]:
+    return [
+        (numbers(rng, f * CHANNELS).reshape(f, CHANNELS), int(rng.integers(0, 10**6)), KEYS, OFFSETS, COUNTS)
+        for f in (0, 1, 3, 8)
+    ]
+
+
+def written(write: Callable[[Callable[[bytes], object]], None]) -> bytes:
+    out: list[bytes] = []
+    write(out.append)
+    return b"".join(out)
+
+
+# --- kinematics -----------------------------------------------------------------------------
+
+
+def random_tree(rng: np.random.Generator, joints: int) -> JointTree:
+    """Joints in a random order (parents first), each with random dofs of every kind."""
+    order = rng.permutation(joints)
+    parent = np.full(joints, -1)
+    for i in range(1, joints):
+        parent[order[i]] = order[rng.integers(i)]
+    dof_start, dof_kind = [0], []
+    for _ in range(joints):
+        dof_kind += rng.integers(0, 7, int(rng.integers(0, 6))).tolist()
+        dof_start.append(len(dof_kind))
+    axis = rotations.matrices(rng.uniform(-3, 3, (joints, 3)), "xyz")
+    axis[rng.random(joints) < 0.3] = np.eye(3)  # the plain case C = I
+    direction = rng.normal(size=(joints, 3))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    return JointTree(
+        parent=parent,
+        order=order,
+        axis=axis,
+        direction=direction,
+        segment=direction * rng.uniform(0.5, 3, (joints, 1)),
+        dof_start=dof_start,
+        dof_kind=dof_kind,
+        dof_column=rng.permutation(max(len(dof_kind), 1))[: len(dof_kind)],
+        angle_scale=float(rng.choice([1.0, math.pi / 180])),
+        parent_frame=rng.integers(0, 2, joints),
+    )
+
+
+def kinematics_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for joints, frames in ((1, 0), (1, 1), (3, 8), (6, 9), (9, 17)):
+        tree = random_tree(rng, joints)
+        out.append((rng.uniform(-180, 180, (frames, max(len(tree.dof_kind), 1))), tree))
+    return out
+
+
+# --- rotations ------------------------------------------------------------------------------
+
+ROTATION_SHAPES = [(0,), (1,), (7,), (2, 3)]
+
+
+def euler_cases(rng: np.random.Generator) -> list[tuple]:
+    out = [
+        (rng.uniform(-7, 7, shape + (3,)), order, bool(rng.integers(2)))
+        for shape in ROTATION_SHAPES
+        for order in rot.ORDERS
+    ]
+    return out + [(rng.uniform(-7, 7, (5, len(axes))), axes, True) for axes in ("", "z", "yx", "xyzx", "zzyxz")]
+
+
+def fast_euler(angles, axes, extrinsic):
+    if axes in rot.ORDERS:
+        return rot.euler_to_matrices(angles, axes, extrinsic=extrinsic)
+    # any sequence of axes: the kernel's own generality, below the public three-angle orders
+    return rot._sequence_matrices(np.asarray(angles, float), [rot.AXES[a] for a in axes], False, 1.0)
+
+
+def matrices_to_euler_cases(rng: np.random.Generator) -> list[tuple]:
+    """Away from gimbal lock, where the angles are unique."""
+    out = []
+    for order in rot.ORDERS:
+        for extrinsic in (True, False):
+            angles = rng.uniform(-3, 3, (20, 3))
+            angles[:, 1] = rng.uniform(0.05, 3.09, 20) if order[0] == order[2] else rng.uniform(-1.52, 1.52, 20)
+            out.append((rotations.euler_to_matrices(angles, order, extrinsic), order, extrinsic))
+    return out
+
+
+def rotation_matrix_cases(rng: np.random.Generator) -> list[tuple]:
+    return [(rotations.matrices(rng.uniform(-3, 3, shape + (3,)), "zyx"),) for shape in ROTATION_SHAPES]
+
+
+def quaternion_cases(rng: np.random.Generator) -> list[tuple]:
+    return [(rng.normal(size=shape + (4,)) * rng.uniform(0.1, 10),) for shape in ROTATION_SHAPES]
+
+
+def rotvec_cases(rng: np.random.Generator) -> list[tuple]:
+    cases = [(rng.normal(size=shape + (3,)) * 2,) for shape in ROTATION_SHAPES]
+    return cases + [(np.array([[0.0, 0, 0], [1e-9, 0, 0], [0, 0, 3.0]]),)]
+
+
+def unroll_quaternion_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for frames in (0, 1, 2, 9):
+        q = rng.normal(size=(2, frames, 3, 4))
+        if frames > 2:
+            q[1, 1, 2] = np.nan
+        out.append((q, 1))
+    return out + [(rng.normal(size=(30, 4)), 0)]
+
+
+def unroll_euler_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for order in ("xyz", "zxy", "zxz", "yxy"):
+        for degrees in (False, True):
+            half = 180.0 if degrees else math.pi
+            a = rng.uniform(-half, half, (2, 40, 3))
+            a[:, ::2] += 2 * half * rng.integers(-3, 4, (2, 20, 3))
+            a[1, 10] = np.nan
+            out.append((a, order, 1, degrees))
+    return out
+
+
+def slerp_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for shape in ROTATION_SHAPES:
+        q0 = rng.normal(size=shape + (4,))
+        q1 = q0 + rng.normal(size=shape + (4,)) * rng.choice([1e-9, 0.1, 3.0])
+        out.append((q0, q1, rng.uniform(-0.5, 1.5, shape)))
+    return out
+
+
+def rotvec_interpolation_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for shape in ROTATION_SHAPES:
+        for aligned in (False, True):
+            out.append(
+                (
+                    rng.normal(size=shape + (3,)) * 2,
+                    rng.normal(size=shape + (3,)) * 2,
+                    rng.uniform(0, 1, shape),
+                    aligned,
+                )
+            )
+    return out + [(np.zeros(3), np.array([0.0, 0, 3.5]), 0.5, True)]
+
+
+# --- combine --------------------------------------------------------------------------------
+
+
+def combine_cases(rng: np.random.Generator) -> list[tuple]:
+    """Random frame maps: pure old, pure new, cross-fades, ramps, selections, offsets, no old motion."""
+    out = []
+    for frames, channels in ((0, 3), (1, 1), (9, 4), (40, 7)):
+        old, new = rng.normal(size=(frames + 5, channels)), rng.normal(size=(frames + 3, channels))
+        weight = rng.choice([0.0, 1.0, 0.25, 0.5], frames)
+        old_row = rng.integers(0, len(old), frames)
+        new_row = rng.integers(0, len(new), frames)
+        next_row = np.minimum(new_row + 1, len(new) - 1)
+        ramp = rng.choice([0.0, 0.3], frames)
+        selected = rng.integers(0, 2, channels).astype(np.uint8)
+        offset_channels = rng.permutation(channels)[: min(2, channels)]
+        offsets = rng.normal(size=(3, len(offset_channels)))
+        offset_row = rng.integers(-1, 3, frames)
+        out.append((old, new, old_row, new_row, weight, next_row, ramp, selected, offset_row, offsets, offset_channels))
+        out.append((old, new, old_row, np.where(weight > 0, new_row, -1), weight, None, None, None, None, None, ()))
+        out.append((None, new, np.full(frames, -1), new_row, np.ones(frames), next_row, ramp, None, None, None, ()))
+    return out
+
+
+def _combine_keywords(old, new, old_row, new_row, weight, next_row, ramp, selected, offset_row, offsets, channels):
+    return (old, new, old_row, new_row, weight), dict(
+        next_row=next_row,
+        ramp=ramp,
+        selected=selected,
+        offset_row=offset_row,
+        offsets=offsets,
+        offset_channels=channels,
+    )
+
+
+def fast_combine(*args):
+    positional, keywords = _combine_keywords(*args)
+    return combine_frames(*positional, **keywords)
+
+
+def slow_combine(*args):
+    positional, keywords = _combine_keywords(*args)
+    return combine.combine_frames(*positional, **keywords)
+
+
+# --- signal processing ------------------------------------------------------------------------
+
+
+def signal_lines(rng: np.random.Generator) -> list[np.ndarray]:
+    """(frames, channels) lines of the lengths that matter: empty, one frame, odd, even, long."""
+    return [
+        rng.normal(size=(frames, channels)).cumsum(axis=0) for frames, channels in ((1, 1), (7, 2), (64, 3), (301, 2))
+    ]
+
+
+def equalize_cases(rng: np.random.Generator) -> list[tuple]:
+    gains = [(), (1.0,), (0.0, 0.0), (1.5, 0.5, 2.0, 1.0)]
+    return [
+        (x, g, mode)
+        for x in signal_lines(rng)
+        for g in gains
+        if len(g) <= mt_signal.band_count(len(x))  # a line of n frames has floor(log2 n) bands
+        for mode in ("nearest", "reflect", "wrap")
+    ]
+
+
+def sosfiltfilt_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for order, cut, kind in ((1, 0.2, "low"), (4, 0.1, "low"), (3, 0.3, "high"), (2, (0.1, 0.4), "band")):
+        sos = mt_signal.butter_sos(order, cut, kind)
+        out += [(sos, x, padtype) for x in signal_lines(rng)[1:] for padtype in ("odd", "even", "constant")]
+        out = [c for c in out if len(c[1]) > 3 * (2 * len(c[0]) + 1)]  # scipy's padding needs a long enough line
+    return out
+
+
+def upfirdn_cases(rng: np.random.Generator) -> list[tuple]:
+    return [
+        (rng.normal(size=taps), x, up, down)
+        for x in signal_lines(rng)
+        for taps, up, down in ((1, 1, 1), (5, 1, 3), (9, 4, 1), (21, 3, 2))
+    ]
+
+
+def fast_upfirdn(h, x, up, down):
+    """The kernel over its full output with no extension: upsample, convolve, downsample."""
+    from mtcore._cdata import c_array
+    from mtcore._mtcore import lib
+
+    h, x = np.ascontiguousarray(h, float), np.ascontiguousarray(x, float)
+    out = np.empty((((len(x) - 1) * up + len(h) - 1) // down + 1, x.shape[1]))
+    status = lib.mt_upfirdn(
+        c_array(h), len(h), up, down, c_array(x), len(x), x.shape[1], c_array(None), 0, c_array(None), 0, 0, 0,
+        len(out), c_array(out),
+    )  # fmt: skip
+    assert status == 0
+    return out
+
+
+def gap_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for x in signal_lines(rng):
+        holes = x.copy()
+        holes[rng.random(x.shape) < 0.2] = np.nan
+        holes[: min(2, len(x))] = np.nan  # a run at the start stays
+        out += [(holes, max_gap, method) for max_gap in (1, 3) for method in ("linear", "cubic")]
+    return out
+
+
+def fast_fill(x, max_gap, method):
+    filled = mt_signal.fill_gaps(x, max_gap, method)
+    return filled.values, filled.unfilled
+
+
+def nan_run_cases(rng: np.random.Generator) -> list[tuple]:
+    return [(x, max_gap, method) for x, max_gap, method in gap_cases(rng)][::2]
+
+
+def parse_cases(rng: np.random.Generator) -> list[tuple]:
+    digits = [str(d) for d in rng.integers(0, 10**9, 20)]
+    return [(t,) for t in ("0", "-0", "1e-5", "inf", "-nan", ".5", "5.", "1.23246e-013", *digits)] + [
+        (f"{m}e{e}",) for m, e in zip(rng.normal(size=20) * 1e3, rng.integers(-320, 300, 20))
+    ]
+
+
+# --- the registry ---------------------------------------------------------------------------
+
+TWINS: dict[str, Twin] = {
+    "mt_filter1d": Twin(fast_filter, slow_filter, filter_cases, filter_same),
+    "mt_scan_frames": Twin(mt_text.scan_frames, text_twins.scan_frames, frame_text_cases, exact),
+    "mt_scan_table": Twin(mt_text.scan_table, text_twins.scan_table, table_cases, exact),
+    "mt_format_double": Twin(mtcore.format_number, text_twins.format_number, number_cases, exact),
+    "mt_format_table": Twin(
+        lambda values: written(lambda w: mt_text.format_table(values, w)), text_twins.format_table, value_cases, exact
+    ),
+    "mt_format_frames": Twin(
+        lambda values, first, keys, offsets, counts: written(
+            lambda w: mt_text.format_frames(values, first, keys, offsets, counts, w)
+        ),
+        text_twins.format_frames,
+        frame_value_cases,
+        exact,
+    ),
+    "mt_forward_kinematics": Twin(
+        lambda values, tree: forward_kinematics(values, tree, world=True, local=True),
+        kinematics.forward_kinematics,
+        kinematics_cases,
+        close(1e-12),
+    ),
+    "mt_euler_to_matrices": Twin(fast_euler, rotations.euler_to_matrices, euler_cases, close(1e-14)),
+    "mt_matrices_to_euler": Twin(
+        lambda m, order, extrinsic: rot.matrices_to_euler(m, order, extrinsic=extrinsic),
+        rotations.matrices_to_euler,
+        matrices_to_euler_cases,
+        angles_close,
+    ),
+    "mt_matrices_to_quaternions": Twin(
+        rot.matrices_to_quaternions, rotations.matrices_to_quaternions, rotation_matrix_cases, close(1e-14)
+    ),
+    "mt_quaternions_to_matrices": Twin(
+        rot.quaternions_to_matrices, rotations.quaternions_to_matrices, quaternion_cases, close(1e-14)
+    ),
+    "mt_quaternions_to_rotvecs": Twin(
+        rot.quaternions_to_rotvecs, rotations.quaternions_to_rotvecs, quaternion_cases, close(1e-14)
+    ),
+    "mt_rotvecs_to_quaternions": Twin(
+        rot.rotvecs_to_quaternions, rotations.rotvecs_to_quaternions, rotvec_cases, close(1e-15)
+    ),
+    "mt_unroll_quaternions": Twin(
+        lambda q, axis: rot.unroll_quaternions(q, axis), rotations.unroll_quaternions, unroll_quaternion_cases, exact
+    ),
+    "mt_unroll_euler": Twin(
+        lambda a, order, axis, degrees: rot.unroll_euler(a, order, axis=axis, degrees=degrees),
+        rotations.unroll_euler,
+        unroll_euler_cases,
+        close(1e-12),
+    ),
+    "mt_slerp": Twin(rot.slerp, rotations.slerp, slerp_cases, close(1e-12)),
+    "mt_interpolate_rotvecs": Twin(
+        lambda v0, v1, t, aligned: rot.interpolate_rotvecs(v0, v1, t, aligned=aligned),
+        rotations.interpolate_rotvecs,
+        rotvec_interpolation_cases,
+        close(1e-14),
+    ),
+    "mt_combine": Twin(fast_combine, slow_combine, combine_cases, exact),
+    "mt_parse_number": Twin(mt_text.parse_number, float, parse_cases, close(0.0)),
+    "mt_equalize": Twin(
+        lambda x, g, mode: mt_signal.equalize(x, g, 0, mode), signal_twins.equalize_twin, equalize_cases, close(1e-12)
+    ),
+    "mt_sosfiltfilt": Twin(
+        lambda sos, x, padtype: mt_signal.sosfiltfilt(sos, x, 0, padtype),
+        lambda sos, x, padtype: signal_twins.sosfiltfilt_twin(sos, x, padtype),
+        sosfiltfilt_cases,
+        close(1e-12),
+    ),
+    "mt_upfirdn": Twin(fast_upfirdn, signal_twins.upfirdn_twin, upfirdn_cases, close(1e-12)),
+    "mt_fill_gaps": Twin(fast_fill, signal_twins.fill_gaps_twin, gap_cases, close(1e-9)),
+    "mt_nan_runs": Twin(
+        lambda x, *_: mt_signal.nan_runs(x), lambda x, *_: signal_twins.nan_runs_twin(x), nan_run_cases, exact
+    ),
+}
+
+EXEMPT = {
+    "mt_strerror": "a message per status code, not a kernel (test_status checks every code has its own)",
+    "mt_filter1d_block": "a constant of mt_filter1d's contract (test_filters_layouts checks any split gives the same bits)",
+    "mt_format_bound": "a capacity bound for mt_format_frames, which fails with MT_ERANGE below it",
+    "mt_format_table_bound": "a capacity bound for mt_format_table, which fails with MT_ERANGE below it",
+}
