@@ -5,7 +5,7 @@ The take is cmu/01_01 (2,751 frames, 120 Hz, 31 joints), end to end from
 the motion: legs, upper-body kinematics, floor fit, footplant detection,
 targets, the cleanup's phases and the channels written back.  The numpy
 peer is the same pipeline with the kernels' phases in whole-array numpy
-(tests/footskate_twin.py: leg kinematics, plan, root, solve).  The hour
+(tests/twins/footskate.py: leg kinematics, plan, root, solve).  The hour
 is 01_01 tiled to 432,000 frames (one hour at 120 Hz, 62 channels), on one
 core (the kernels run in the calling thread).
 """
@@ -23,7 +23,7 @@ from motiontheater.footskate import clean_footskate
 from mtcore import footskate as kernels
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-import footskate_twin
+from twins import footskate as footskate_twin
 
 DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 TAKE = "detect + clean up cmu/01_01 (2751 frames)"

@@ -7,13 +7,13 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
-import footskate_twin as twin
 import motiontheater as mt
 from conftest import DATA
 from motiontheater.contacts import plant_targets, runs
 from motiontheater.footskate import contacts_of, prepare
 from mtcore import footskate as fs
 from mtcore._mtcore import ffi, lib
+from twins import footskate as twin
 
 TAKES = {
     "cmu 07_05 walk": ("cmu/07-walk.asf", "cmu/07_05-walk.amc", None),
