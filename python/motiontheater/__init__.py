@@ -18,6 +18,7 @@ from . import (  # noqa: F401 (importing them registers their steps)
     filtering,
     footskate,
     interpolators,
+    markers,
     signal,
 )
 from ._version import __version__

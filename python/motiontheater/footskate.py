@@ -166,7 +166,8 @@ def clean_footskate(
     - ``up``: the up axis ("y", "z", "-y"...); default y for ASF, detected for BVH.
     - ``floor``: the floor's level along up, file units (then level); default: fitted, tilted, to
       the feet at rest.
-    - ``meters_per_unit``: default the skeleton's (give it for BVH, whose files do not say).
+    - ``meters_per_unit``: default the skeleton's length unit (an ASF's ``:units length``, a
+      BVH's detected from its size, or as read with ``unit=`` / ``--unit``).
     - ``blend``: seconds over which adjustments fade in and out around constraints;
       ``root_window``: seconds of smoothing of the root's moves; ``knee_soft``: degrees short
       of straight that a constrained knee keeps unless the input's is straighter.
@@ -231,7 +232,6 @@ def cleanup(
         Literal["x", "y", "z", "-x", "-y", "-z"] | None, "the up axis (default: y for ASF, found for BVH)"
     ] = None,
     legs: Annotated[Joints, "hip,knee,ankle[,toe] of the left then the right leg (default: found by name)"] = None,
-    meters_per_unit: Annotated[float | None, "metres per file length unit (default: the skeleton's)"] = None,
     blend: Annotated[float, "seconds over which adjustments fade in and out around plants"] = 0.2,
     knee_soft: Annotated[float, "degrees short of straight that a constrained knee keeps"] = 3.0,
 ) -> Motion:
@@ -250,7 +250,6 @@ def cleanup(
         legs=legs,
         up=up,
         floor=floor,
-        meters_per_unit=meters_per_unit,
         blend=blend,
         knee_soft=knee_soft,
     ).motion

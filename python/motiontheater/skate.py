@@ -160,7 +160,8 @@ def skate_metrics(
     cleanup (``Cleanup.legs``, so that heels derived from the input are
     kept); ``ground``: the floor to measure against (default: fitted to this
     motion, or level at ``floor``), e.g. ``Cleanup.ground`` to measure a
-    cleaned motion against the floor it was cleaned on.
+    cleaned motion against the floor it was cleaned on; ``meters_per_unit``:
+    default the skeleton's length unit.
     """
     arrays, fitted, mpu = prepare(motion, legs=legs, up=up, floor=floor, meters_per_unit=meters_per_unit)
     ground = fitted if ground is None else ground
