@@ -37,7 +37,8 @@ enum mt_status {
     MT_EMISSING = -8,   /* a frame lacks a key that takes numbers */
     MT_EFRAME = -9,     /* a frame number out of sequence, or a key line before any frame */
     MT_ERANGE = -10,    /* more frames than the output holds, or an output buffer too small */
-    MT_EFRAMERANGE = -11 /* a frame number outside 0 .. MT_FRAME_MAX, read or to be written */
+    MT_EFRAMERANGE = -11, /* a frame number outside 0 .. MT_FRAME_MAX, read or to be written */
+    MT_EIO = -12          /* a memory-mapped file shrank while it was read (see mt_guard_install) */
 };
 
 enum mt_dtype {
@@ -71,6 +72,18 @@ enum mt_filter {
 };
 
 const char *mt_strerror(int status);
+
+/*
+ * Reading memory-mapped files safely: a file truncated while it is mapped
+ * and read raises SIGBUS past its new end, which kills the process.  After
+ * mt_guard_install() (once per process; it keeps any handler there was for
+ * a SIGBUS elsewhere), the scanners (mt_scan_frames, mt_scan_table) and
+ * mt_copy_mapped return MT_EIO instead.
+ */
+int mt_guard_install(void);
+
+/* Copies n bytes of a mapping to target; MT_EIO where the mapping's file has shrunk. */
+int mt_copy_mapped(const char *source, size_t n, char *target);
 
 /*
  * One-dimensional filter along the middle axis of (outer, n, inner) arrays of

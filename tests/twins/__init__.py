@@ -429,6 +429,23 @@ def parse_cases(rng: np.random.Generator) -> list[tuple]:
     ]
 
 
+def mapped_cases(rng: np.random.Generator) -> list[tuple]:
+    data = rng.integers(0, 256, 70_000, dtype=np.uint8).tobytes()
+    return [(data, begin, end) for begin, end in ((0, 0), (0, 1), (5, 70_000), (65_530, 69_999), (100, 100_000))]
+
+
+def copy_mapped(data: bytes, begin: int, end: int) -> bytes:
+    """The guarded copy from a real mapping of a file holding ``data``."""
+    import mmap
+    import tempfile
+
+    with tempfile.TemporaryFile() as f:
+        f.write(data)
+        f.flush()
+        with mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
+            return mt_text.copy_text(mapped, begin, end)
+
+
 # --- footskate ------------------------------------------------------------------------------
 
 LEG_LAYOUTS = [  # rotation channels of hip, knee, ankle, toe, as the captures have them and not
@@ -618,6 +635,7 @@ TWINS: dict[str, Twin] = {
         close(1e-14),
     ),
     "mt_combine": Twin(fast_combine, slow_combine, combine_cases, exact),
+    "mt_copy_mapped": Twin(copy_mapped, lambda data, begin, end: data[begin:end], mapped_cases, exact),
     "mt_parse_number": Twin(mt_text.parse_number, float, parse_cases, close(0.0)),
     "mt_equalize": Twin(
         lambda x, g, mode: mt_signal.equalize(x, g, 0, mode), signal_twins.equalize_twin, equalize_cases, close(1e-12)
@@ -651,4 +669,5 @@ EXEMPT = {
     "mt_filter1d_block": "a constant of mt_filter1d's contract (test_filters_layouts checks any split gives the same bits)",
     "mt_format_bound": "a capacity bound for mt_format_frames, which fails with MT_ERANGE below it",
     "mt_format_table_bound": "a capacity bound for mt_format_table, which fails with MT_ERANGE below it",
+    "mt_guard_install": "installs a signal handler once; test_hardening shrinks mapped files under the scanners",
 }
