@@ -175,9 +175,10 @@ static void rotvec_exp(const double *v, double *m)
     about(axis, norm3(v), m);
 }
 
+/* whole turns nearest to x / 2 pi; below 3 (0.48 turn) that is 0, the common case, without the call */
 static double round_turns(double x)
 {
-    return nearbyint(x / (2 * pi));
+    return fabs(x) < 3.0 ? 0.0 : nearbyint(x / (2 * pi));
 }
 
 /* angle plus the whole turns that bring it nearest to ref */
@@ -189,6 +190,13 @@ static double wrap_near(double angle, double ref)
 static double wrap(double angle)
 {
     return angle - 2 * pi * round_turns(angle);
+}
+
+/* sqrt(x^2 + y^2) without hypot's care for overflow, which costs a call: the arguments here are
+ * coordinates of unit vectors and of a human's limbs, far from the limits of a double */
+static double length2(double x, double y)
+{
+    return sqrt(x * x + y * y);
 }
 
 static double clip(double x, double lo, double hi)
@@ -291,12 +299,12 @@ static void euler_nearest(const double *m, const int *axes, const double *ref, d
     double a, b, c, h;
     int last;
     if (proper) {
-        h = hypot(M(j, i), M(k, i));
+        h = length2(M(j, i), M(k, i));
         b = atan2(h, M(i, i));
         c = h < 1e-9 ? ref[2] : atan2(M(j, i), -eps * M(k, i));
         last = i;
     } else {
-        h = hypot(M(i, i), M(j, i));
+        h = length2(M(i, i), M(j, i));
         b = atan2(-eps * M(k, i), h);
         c = h < 1e-9 ? ref[2] : atan2(eps * M(j, i), M(i, i));
         last = k;
@@ -355,7 +363,7 @@ static void realize(const struct mt_leg *leg, int j, const double *wanted, const
         perpendicular(p, e, pp);
         perpendicular(q, e, qq);
         cross3(pp, qq, n);
-        const double y = dot3(e, n), x = dot3(pp, qq), h = hypot(x, y);
+        const double y = dot3(e, n), x = dot3(pp, qq), h = length2(x, y);
         out[0] = wrap_near(atan2(y, x), ref[0]);
         sines[0] = h > 0 ? y / h : 0.0, cosines[0] = h > 0 ? x / h : 1.0;
         return;
@@ -364,7 +372,7 @@ static void realize(const struct mt_leg *leg, int j, const double *wanted, const
     const double ei[3] = {ai == 0, ai == 1, ai == 2}, ej[3] = {aj == 0, aj == 1, aj == 2};
     double eip[3];
     cross3(ei, p, eip);
-    const double big_a = p[aj], big_b = eip[aj], rho = hypot(big_a, big_b);
+    const double big_a = p[aj], big_b = eip[aj], rho = length2(big_a, big_b);
     if (!(rho > tiny)) { /* aim along the first axis: nothing to turn, the angles kept */
         for (int n = 0; n < 2; n++)
             sines[n] = sin(ref[n]), cosines[n] = cos(ref[n]);
@@ -384,7 +392,7 @@ static void realize(const struct mt_leg *leg, int j, const double *wanted, const
         perpendicular(v, ej, rp);
         perpendicular(q, ej, qp);
         cross3(rp, qp, n);
-        const double y = dot3(ej, n), x = dot3(rp, qp), h = hypot(x, y);
+        const double y = dot3(ej, n), x = dot3(rp, qp), h = length2(x, y);
         const double b = wrap_near(atan2(y, x), ref[1]);
         const double cost = (a - ref[0]) * (a - ref[0]) + (b - ref[1]) * (b - ref[1]);
         if (s == 0 || cost < best_cost) {
@@ -637,7 +645,7 @@ static void raise_lever(const double *lever, const double *pivot, double rest, c
     unit3(axis, axis);
     cross3(axis, lever, side);
     const double need = rest - height(opt, pivot); /* n . R lever must reach this */
-    const double x = dot3(n, lever), y = dot3(n, side), rho = hypot(x, y), phi = atan2(y, x);
+    const double x = dot3(n, lever), y = dot3(n, side), rho = length2(x, y), phi = atan2(y, x);
     const double spread = acos(clip(need / (rho > tiny ? rho : 1.0), -1.0, 1.0));
     const double first = wrap(phi - spread), second = wrap(phi + spread);
     const int low = x < need && rho > tiny && across > tiny;
@@ -658,7 +666,7 @@ static struct hinge hinge_of(const struct mt_leg *leg, const double *knee_local,
     mat_vec(knee_local, leg->segment[1], u);
     cross3(axis, u, au);
     const double c0 = dot3(s1, axis) * dot3(u, axis), x = dot3(s1, u) - c0, y = dot3(s1, au);
-    const double rho = hypot(x, y);
+    const double rho = length2(x, y);
     struct hinge h = {dot3(s1, s1) + dot3(u, u) + 2 * c0, rho, atan2(y, x), rho > 0 ? x / rho : 1.0,
                       rho > 0 ? y / rho : 0.0};
     return h;
@@ -1096,7 +1104,7 @@ static void bend_toes(const struct mt_leg *leg, const double *foot, const double
     mat_vec(toe_local, t, u);
     cross3(axis, u, au);
     const double c0 = dot3(k, axis) * dot3(u, axis), x = dot3(k, u) - c0, y = dot3(k, au);
-    const double rho = hypot(x, y), phi = atan2(y, x), base = height(opt, ball);
+    const double rho = length2(x, y), phi = atan2(y, x), base = height(opt, ball);
     if (!(base + dot3(k, u) < clearance_tip && rho > tiny))
         return;
     const double need = clearance_tip - base - c0; /* rho cos(delta - phi) must reach this */
