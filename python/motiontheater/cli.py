@@ -302,7 +302,7 @@ def _combine(args: argparse.Namespace) -> int:
 
 
 def _ground_options(parser: argparse.ArgumentParser) -> None:
-    """The flags of the footskate verbs (skate, contacts): they are the cleanup step's."""
+    """The flags of the footskate verbs (skate, contacts, view's plants): they are the cleanup step's."""
     cleanup = {o.name: o for o in lookup("cleanup").options}
     for name in ("floor", "up", "legs"):
         option = cleanup[name]
@@ -413,10 +413,22 @@ def _view(args: argparse.Namespace) -> int:
     from .view import write_page
 
     paths = [args.take, *args.more]
-    takes = [read_take(path, args.asf, args.frame_rate) for path in paths]
+    takes = [read_take(path, args.asf, args.frame_rate, args.unit) for path in paths]
     out = Path(args.output or Path(args.take).stem + ".html")
-    write_page(takes, out, names=[Path(p).name for p in paths], max_frames=args.max_frames)
-    print(f"wrote {out} ({out.stat().st_size / 1e6:.2f} MB, {len(takes)} take(s), {takes[0].frames} frames)")
+    plants: list[Any] = [None] * len(takes)
+    if args.plants or args.contacts:
+        from .footskate import contacts_of, prepare
+
+        for i, motion in enumerate(takes):
+            given = args.contacts if i == 0 else None  # a contacts table is of the first take
+            if given is None and not args.plants:
+                continue
+            arrays, ground, mpu = prepare(motion, legs=args.legs, up=args.up, floor=args.floor)
+            plants[i] = contacts_of(given, motion, arrays, ground, mpu)
+    names = [Path(p).name for p in paths]
+    write_page(takes, out, names=names, plants=plants, legs=args.legs, max_frames=args.max_frames)
+    shown = "".join(f", {len(p)} footplants on {name}" for p, name in zip(plants, names) if p is not None)
+    print(f"wrote {out} ({out.stat().st_size / 1e6:.2f} MB, {len(takes)} take(s), {takes[0].frames} frames{shown})")
     if not args.no_open and not webbrowser.open(out.resolve().as_uri()):
         print(f"no browser could be started: open {out} in one", file=sys.stderr)
     return 0
@@ -478,9 +490,12 @@ def _add_seeing_verbs(verbs: Any) -> None:
             "joint's channels and an axis-angle glyph of its rotation, its curves (click to seek, drag to "
             "select frames), more takes overlaid for comparison, and an editor that stacks interpolators and "
             "filters over frame ranges, previews them and exports the stack as a recipe for motiontheater "
-            "apply. Takes longer than --max-frames are shown decimated, with a note, and editing off."
+            "apply. Takes longer than --max-frames are shown decimated, with a note, and editing off. "
+            "Footplants (--plants: detected; --contacts FILE: a table) are marked green on the feet, listed "
+            "beside the clock and drawn as rows under the curves."
         ),
-        epilog="Example: motiontheater view 01_01.amc smooth.amc -o compare.html",
+        epilog="Example: motiontheater view 01_01.amc smooth.amc -o compare.html; "
+        "motiontheater view 07_05.amc cleaned.amc --plants",
     )
     view.add_argument("take", help="the take to play and edit (AMC or BVH)")
     view.add_argument("more", nargs="*", help="takes to compare with it, ghosted and overlaid")
@@ -492,6 +507,18 @@ def _add_seeing_verbs(verbs: Any) -> None:
         default=30_000,
         help="longer takes are shown decimated to at most this many frames, editing off (default 30000)",
     )
+    view.add_argument(
+        "--plants",
+        action="store_true",
+        help="detect the footplants of every take (as motiontheater contacts does) and mark them on the feet "
+        "and on the timeline",
+    )
+    view.add_argument(
+        "--contacts",
+        metavar="FILE",
+        help="mark the first take's footplants from this CSV table (as motiontheater contacts writes it)",
+    )
+    _ground_options(view)
     _take_options(view)
     view.set_defaults(run=_view)
 

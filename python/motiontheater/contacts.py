@@ -106,6 +106,28 @@ class Contacts:
         """The plants of a foot (its ankle joint's name), of one point or both."""
         return tuple(p for p in self.plants if p.foot == foot and (point is None or p.point == point))
 
+    def check_take(self, first_frame: int, frames: int) -> None:
+        """Raise ValueError unless the table is of a take of ``frames`` frames from ``first_frame``."""
+        if (self.first_frame, self.frames) != (first_frame, frames):
+            raise ValueError(
+                f"the contacts are for frames {self.first_frame}..{self.first_frame + self.frames - 1}, the take "
+                f"has frames {first_frame}..{first_frame + frames - 1}: they are for another take"
+            )
+
+    def marks(self, legs: Legs) -> list[tuple[str, int, np.ndarray]]:
+        """Where each foot's plants are shown: (label such as "lfoot heel", the index in
+        :meth:`Motion.positions` of the point marked, flags (frames,) bool), heel then ball of
+        each leg.  The ball is marked at the ball; the heel at the heel joint where the skeleton
+        has one, else (a derived heel) at the ankle above it.  Raises UnknownNameError as
+        :meth:`masks`."""
+        masks = self.masks(legs)
+        out = []
+        for i, foot in enumerate(legs.feet):
+            heel = int(legs.points[i, 5]) if legs.points[i, 5] >= 0 else int(legs.points[i, 2])
+            for k, (point, where) in enumerate(zip(PLANT_POINTS, (heel, int(legs.points[i, 3])))):
+                out.append((f"{foot} {point}", where, masks[i, :, k]))
+        return out
+
     def masks(self, legs: Legs) -> np.ndarray:
         """(legs, frames, 2) bool: whether each leg's heel and ball are planted at each frame.
         Raises UnknownNameError for a plant of a foot that is not one of the legs'."""
@@ -330,7 +352,5 @@ def plant_targets(masks: np.ndarray, points: np.ndarray) -> np.ndarray:
             if bounds[-1] == frames:  # reduceat sums the last piece to the end
                 bounds = bounds[:-1]
             means = np.add.reduceat(points[i, :, column], bounds, axis=0)[::2] / (ends - starts)[:, None]
-            plant = np.searchsorted(starts, np.arange(frames), side="right") - 1
-            planted = masks[i, :, k]
-            out[i, planted, k] = means[plant[planted]]
+            out[i, masks[i, :, k], k] = np.repeat(means, ends - starts, axis=0)  # planted frames, in order
     return out

@@ -133,11 +133,7 @@ def contacts_of(
         table = contacts
     else:
         raise TypeError(f"contacts must be a Contacts table, a CSV file or None, got {type(contacts).__name__}")
-    if (table.first_frame, table.frames) != (motion.first_frame, motion.frames):
-        raise ValueError(
-            f"the contacts are for frames {table.first_frame}..{table.first_frame + table.frames - 1}, the take "
-            f"has frames {motion.first_frame}..{motion.last_frame}: they are for another take"
-        )
+    table.check_take(motion.first_frame, motion.frames)
     table.masks(arrays.legs)  # every foot named is one of the legs'
     return table
 
@@ -210,12 +206,16 @@ def clean_footskate(
         workers=workers,
     )
     values = motion.values.copy()
-    for i, r, n in zip(*np.nonzero(arrays.columns >= 0)):
-        rows = angles[i, :, r, n] != arrays.angles[i, :, r, n]  # unchanged angles keep their channel's bits
-        values[rows, arrays.columns[i, r, n]] = angles[i, rows, r, n] / arrays.angle_scale
-    for axis, column in enumerate(root_columns):
-        moved = root[:, axis] != 0
-        values[moved, column] += root[moved, axis]
+    frames = motion.frames
+    for i in range(len(arrays.columns)):
+        slots = np.flatnonzero(arrays.columns[i].reshape(12) >= 0)
+        solved = np.take(angles[i].reshape(frames, 12), slots, axis=1)
+        given = np.take(arrays.angles[i].reshape(frames, 12), slots, axis=1)
+        columns = arrays.columns[i].reshape(12)[slots]
+        kept = np.take(values, columns, 1)  # unchanged angles keep their channel's bits
+        _put_columns(values, columns, np.where(solved != given, solved / arrays.angle_scale, kept))
+    block = np.take(values, root_columns, 1)
+    _put_columns(values, np.asarray(root_columns), np.where(root != 0, block + root, block))  # -0.0 + 0.0 is +0.0
     values.flags.writeable = False
     return Cleanup(motion.replace(values=values), table, ground, arrays.legs, root, enforced, mpu)
 
@@ -253,6 +253,16 @@ def cleanup(
         blend=blend,
         knee_soft=knee_soft,
     ).motion
+
+
+def _put_columns(values: np.ndarray, columns: np.ndarray, block: np.ndarray) -> None:
+    """values[:, columns] = block, a slice at a time where the columns run on: a column index
+    array makes numpy gather and scatter element by element."""
+    start = 0
+    for end in range(1, len(columns) + 1):
+        if end == len(columns) or columns[end] != columns[end - 1] + 1:
+            values[:, columns[start] : columns[end - 1] + 1] = block[:, start:end]
+            start = end
 
 
 def _root_translation(motion: Motion) -> list[int]:
