@@ -38,6 +38,8 @@ from .legs import find_legs
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .pipeline import Pipeline
 from .registry import StepError, steps
+from .retarget import plan_retarget, retarget
+from .rigs import joint_map
 from .scene import Scene, Track, read_recipe
 from .skate import skate_metrics
 from .skeleton import Bone, Root, Skeleton
@@ -63,14 +65,17 @@ __all__ = [
     "filter_motion",
     "find_legs",
     "interpolate",
+    "joint_map",
     "median3",
     "median_filter1d",
     "pascal_weights",
+    "plan_retarget",
     "read_amc",
     "read_asf",
     "read_bvh",
     "read_recipe",
     "read_take",
+    "retarget",
     "skate_metrics",
     "skeleton_path_for",
     "steps",
