@@ -329,8 +329,9 @@ def detect_contacts(
     thresholds: Thresholds = DEFAULT,
 ) -> Contacts:
     """The footplants of a take's legs (:class:`~motiontheater.legs.LegArrays`) on its ground."""
-    heights = ground.heights(arrays.points)[:, :, :2].transpose(0, 2, 1)  # (legs, heel and ball, frames)
-    heel_ball = arrays.points[:, :, [3, 2]].transpose(0, 2, 1, 3)
+    heel_ball = arrays.points[:, :, [3, 2]]
+    heights = (ground.above(heel_ball) - ground.clearance[:, None, :2]).transpose(0, 2, 1)  # (legs, 2, frames)
+    heel_ball = heel_ball.transpose(0, 2, 1, 3)
     speed = speeds(heel_ball, frame_rate)
     central = speeds(heel_ball, frame_rate, central=True)
     scale = body_scale(arrays.legs, meters_per_unit)
