@@ -426,6 +426,12 @@ def test_detected_footplants_are_shown_on_the_feet_the_clock_and_the_timeline(br
         for row in (0, 1):  # the left foot's rows under the curves, at the other frame (the playhead is at this one)
             y = rect["y"] + rect["height"] - 7 * (4 - row) + 0.5
             assert inked(picture, curve_x(browser, other), y, 1) == other_planted
+    # the clock's list changes on the very frame a plant starts
+    start = int(np.flatnonzero(np.diff(masks[0, :, 0].astype(int)) == 1)[0]) + 1
+    for index in (start - 1, start):
+        browser.execute_script("mtView.seek(arguments[0])", index)
+        wait_frame(browser, index + motion.first_frame)
+        assert ("lfoot heel" in browser.find_element(By.ID, "planted").text) == (index == start)
     assert console_errors(browser) == []
 
 
