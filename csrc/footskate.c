@@ -269,6 +269,13 @@ static void local_rotation_of(const struct mt_leg *leg, int j, const double *sin
         memcpy(out, m, sizeof m);
         return;
     }
+    if (count == 1) { /* C R C^T is the turn about C's column of the channel's axis: Rodrigues, no products */
+        const double *c = leg->axis[j];
+        const int a = leg->axes[j][0];
+        const double u[3] = {c[a], c[3 + a], c[6 + a]};
+        about_cs(u, cosines[0], sines[0], out);
+        return;
+    }
     double m[9];
     memcpy(m, leg->axis[j], sizeof m);
     for (int n = count - 1; n >= 0; n--)
