@@ -55,6 +55,11 @@ def _rate(entry) -> float:
     return amount / seconds
 
 
+def _amount(x: float) -> str:
+    """A rate in the table's millions: whole above 100, else three significant digits."""
+    return f"{x:.0f}" if x >= 100 else f"{x:.3g}"
+
+
 def _time(seconds: float) -> str:
     return f"{seconds * 1e6:.1f} us" if seconds < 1e-3 else f"{seconds * 1e3:.1f} ms"
 
@@ -69,7 +74,7 @@ def pytest_terminal_summary(terminalreporter):
     for case, whos in RESULTS.items():
         if case in CEILING.values():
             entry = whos["copy"]
-            write(f"| {case} | {_time(entry[0])} | {_rate(entry) / 1e6:.0f} {entry[2]}/s | 100% | - | ceiling |")
+            write(f"| {case} | {_time(entry[0])} | {_amount(_rate(entry) / 1e6)} {entry[2]}/s | 100% | - | ceiling |")
             continue
         ours = whos.get("mtcore")
         if ours is None:
@@ -78,7 +83,7 @@ def pytest_terminal_summary(terminalreporter):
         vs_copy = f"{_rate(ours) / _rate(ref):.0%}" if ref else "-"
         peers = ", ".join(f"{who} {_rate(ours) / _rate(e):.1f}x" for who, e in whos.items() if who != "mtcore")
         write(
-            f"| {case} | {_time(ours[0])} | {_rate(ours) / 1e6:.0f} {ours[2]}/s | {vs_copy} | "
+            f"| {case} | {_time(ours[0])} | {_amount(_rate(ours) / 1e6)} {ours[2]}/s | {vs_copy} | "
             f"{peers or '-'} | {TARGETS.get(case, '')} |"
         )
     for note in NOTES:

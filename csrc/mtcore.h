@@ -447,6 +447,118 @@ int mt_fill_gaps(const double *in, double *out, size_t n, size_t channels, size_
  */
 int mt_nan_runs(const double *in, size_t n, size_t channels, size_t stride, size_t *runs, size_t capacity,
                 size_t *count);
+
+/*
+ * Footskate cleanup (footskate.c; Kovar, Schreiner & Gleicher, SCA 2002).
+ *
+ * A leg is the chain of four joints turning the thigh, shin, foot and toes
+ * (hip, knee, ankle, toe).  Joint j's local rotation is L = C M C^T, C =
+ * axis[j] (row-major) and M the rotation of its channels: angles about the
+ * axes axes[j][0], [1], [2] (MT_DOF_RX .. MT_DOF_RZ, -1 past the last),
+ * each applied about a fixed axis after the ones before.  The hip and knee
+ * have at least one channel; a toe with none is no toe.  segment[] are rest
+ * vectors, each in the frame of the joint that turns it: hip -> knee,
+ * knee -> ankle, ankle -> ball, ankle -> heel, ball -> toe tip (zero: none).
+ * Per frame a leg is given by its hip point (3), the world rotation of its
+ * hip joint's parent (9) and its angles (4 x 3 radians, unused ones 0).
+ * Points (5 x 3 per frame): knee, ankle, ball, heel, toe tip.
+ */
+struct mt_leg {
+    double axis[4][9];
+    int axes[4][3];
+    double segment[5][3];
+};
+
+/*
+ * The floor and the settings.  A point p is at height p.(up - slope) - level
+ * above the floor (up unit, slope perpendicular to it).  blend: frames over
+ * which adjustments fade in and out around constraints; root_window: the
+ * half-width of the moving mean applied twice to the root's moves, and
+ * root_passes the smoothings of what is still short before the last
+ * per-frame correction; knee_soft: radians short of straight at which a knee
+ * stops straightening unless it is straighter in the input; knee_keep: the
+ * share of its bend in the input that the root moves to let a constrained
+ * knee keep.
+ */
+struct mt_footskate {
+    double up[3];
+    double slope[3];
+    double level;
+    size_t blend;
+    size_t root_window;
+    size_t root_passes;
+    double knee_soft;
+    double knee_keep;
+};
+
+/* Points (nlegs x frames x 5 x 3) and, where feet is not NULL, the feet's world rotations
+ * (nlegs x frames x 9) of legs given per leg and frame (hips nlegs x frames x 3, parents x 9,
+ * angles x 12). */
+int mt_leg_points(const struct mt_leg *legs, size_t nlegs, size_t frames, const double *hips,
+                  const double *parents, const double *angles, double *points, double *feet);
+
+/*
+ * Phases 1 and 2 for one leg, of its angles and points (frames x 5 x 3, as
+ * mt_leg_points gives them).  planted (frames x 2): heel and ball planted;
+ * targets (frames x 2 x 3): where, read where planted; clearance (3): the
+ * heights at which heel, ball and toe tip rest.
+ * 1. Frame by frame a planted point keeps the target it had at the frame
+ *    before; a new plant's target is put on the floor at its clearance, and
+ *    set at the foot's heel-to-ball length from the other point's target
+ *    when that one is planted, or was within max(1, blend / 4) frames before
+ *    (a roll), in the direction between them.  -> enforced (frames x 2 x 3,
+ *    NaN where not planted).
+ * 2. Where both points are planted (or a roll begins) the foot turns by the
+ *    smallest rotation taking heel -> ball onto the targets'; between, turns
+ *    blend as rotation vectors, weights smoothstep(1 - d / w) of the nearest
+ *    such frames before and after (w = min(blend, their distance)); where one
+ *    point is planted the foot turns further about it if the other is below
+ *    the floor, and the ankle follows it; unconstrained frames blend the
+ *    ankle's shift and the foot's turn from the nearest constrained frames
+ *    alike.  -> goal (frames x 3) for the ankle, turn (frames x 3, rotation
+ *    vector; the foot's goal is turn times its rotation now), weight (1
+ *    constrained, the larger blend weight elsewhere), reach (the longest
+ *    hip-to-ankle distance with the knee bent at least min(knee_soft, its
+ *    bend) and knee_keep times its bend), knee (4: the hinge axis in the
+ *    hip joint's frame, its channel's or the take's mean bend axis, and the
+ *    side it bends to, +1 or -1).
+ */
+int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *angles, const double *points,
+                      const unsigned char *planted, const double *targets, const double *clearance,
+                      const struct mt_footskate *opt, double *enforced, double *goal, double *turn,
+                      double *weight, double *reach, double *knee);
+
+/*
+ * Phase 3 for one or two legs (hips, goals legs x frames x 3; reaches,
+ * weights legs x frames): the root's translation (frames x 3) that puts each
+ * hip within reach of its goal where its weight is positive.  Per frame the
+ * least move: onto one sphere, or for two the projection onto one that lies
+ * in the other ball, else onto their intersection circle; the moves are
+ * smoothed (root_window), what is still short smoothed in root_passes times,
+ * and the rest moved per frame.
+ */
+int mt_footskate_root(size_t legs, size_t frames, const double *hips, const double *goals,
+                      const double *reaches, const double *weights, const struct mt_footskate *opt,
+                      double *root);
+
+/*
+ * Phases 4 and 5 for one leg (its points as for mt_footskate_plan): the new
+ * angles (frames x 4 x 3).  Frames that
+ * are constrained, blended, or whose root moved, are solved by two-bone IK:
+ * the knee bends about its hinge to the goal's distance (within reach, never
+ * past straight), the hip turns the leg onto the goal, the ankle takes the
+ * foot's goal (a joint with fewer than three channels turns its segment
+ * exactly where asked; a planted foot's ankle is re-aimed twice so that the
+ * planted point lands).  A free foot below the floor is lifted by the upper
+ * envelope of its depths under a bump blend / 2 frames wide, and per frame
+ * by what remains; toe tips below the floor bend the toes up.  Other frames
+ * keep their angles bit for bit.
+ */
+int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hips, const double *parents,
+                       const double *angles, const double *points, const unsigned char *planted,
+                       const double *goal, const double *turn, const double *weight, const double *knee,
+                       const double *root, const double *clearance, const struct mt_footskate *opt,
+                       double *out);
 /*
  * Retargeting (retarget.c): a motion of a source skeleton as the rotation
  * channels of a target skeleton.

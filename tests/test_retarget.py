@@ -406,5 +406,7 @@ def test_after_the_cleanup_the_feet_hold_the_cleanups_bounds(data_dir, pair):
     after = measured(cleaned)
     assert after.worst("sliding_mean_mm") <= 1.0
     assert after.worst("sliding_max_mm") <= 5.0
-    assert after.worst("planted_skating_ratio") <= 0.01
+    # (the papers' skating ratio counts swing near the floor too: real walks score 10-40 % on it before a
+    # cleanup and after, see motiontheater.skate; the sliding above is the planted feet's own measure)
+    assert after.worst("penetration_mm") <= 5.0
     assert cleaned.skeleton is target

@@ -117,9 +117,33 @@ def test_compared_takes_and_footplants():
     flags[5:12] = flags[20:] = True
     data = page_data(page([a, b], names=["before", "after"], plants=[{"toe": flags}, None]))
     assert [t["name"] for t in data["takes"]] == ["before", "after"]
-    assert data["takes"][0]["plants"] == {"toe": [[5, 11], [20, 39]]}
-    assert data["takes"][1]["plants"] == {}
+    point = a.skeleton.point_names.index("toe")
+    assert data["takes"][0]["plants"] == [{"label": "toe", "point": point, "spans": [[5, 11], [20, 39]]}]
+    assert data["takes"][1]["plants"] == []
     assert data["editable"] is True
+
+
+def test_a_contacts_table_marks_heels_and_balls(data_dir):
+    """A Contacts table gives a row per foot point: the ball at the ball, a derived heel (CMU has no
+    heel joint) at the ankle above it, with the table's plants as spans of frame indices."""
+    from motiontheater.contacts import Contacts, Plant
+
+    motion = mt.read_amc(data_dir / "cmu" / "01_01.amc", mt.read_asf(data_dir / "cmu" / "01.asf"))
+    table = Contacts([Plant("lfoot", "heel", 11, 50), Plant("rfoot", "ball", 2000, 2751)], 1, motion.frames)
+    rows = page_data(page([motion], plants=[table]))["takes"][0]["plants"]
+    points = motion.skeleton.point_names
+    assert [(r["label"], points[r["point"]], r["spans"]) for r in rows] == [
+        ("lfoot heel", "ltibia", [[10, 49]]),  # an ASF bone's point is where it ends: ltibia ends at the ankle
+        ("lfoot ball", "lfoot", []),
+        ("rfoot heel", "rtibia", []),
+        ("rfoot ball", "rfoot", [[1999, 2750]]),
+    ]
+    decimated = page_data(page([motion], plants=[table], max_frames=1000))["takes"][0]["plants"]
+    assert decimated[0]["spans"] == [[4, 16]]  # frames 13, 16 .. 49 of the 1 in 3 shown (indices 12 .. 48)
+    with pytest.raises(ValueError, match="another take"):
+        page([motion.replace(values=motion.values[:100])], plants=[table])
+    with pytest.raises(mt.errors.UnknownNameError, match="nose"):
+        page([motion], plants=[Contacts([Plant("nose", "ball", 1, 2)], 1, motion.frames)])
 
 
 def test_editor_steps_are_registered_steps():
@@ -176,6 +200,41 @@ def test_cli_view_writes_the_page(tmp_path, data_dir, monkeypatch, capsys):
     assert main(["view", str(take), "--no-open", "--max-frames", "1000", "-o", "small.html"]) == 0
     data = page_data((tmp_path / "small.html").read_text(encoding="utf-8"))
     assert data["takes"][0]["step"] == 3 and "1 frame in 3 of its 2,751" in data["note"]
+
+
+def test_cli_view_marks_footplants(tmp_path, data_dir, monkeypatch, capsys):
+    from motiontheater.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    take = data_dir / "cmu" / "07_05-walk.amc"
+    assert main(["contacts", str(take), "-o", "plants.csv"]) == 0
+    detected = page_data_of(main, ["view", str(take), "--no-open", "--plants"], tmp_path / "07_05-walk.html")
+    given = page_data_of(
+        main, ["view", str(take), "--no-open", "--contacts", "plants.csv"], tmp_path / "07_05-walk.html"
+    )
+    rows = detected["takes"][0]["plants"]
+    assert [r["label"] for r in rows] == ["lfoot heel", "lfoot ball", "rfoot heel", "rfoot ball"]
+    assert all(r["spans"] for r in rows) and given["takes"][0]["plants"] == rows
+    assert "footplants on 07_05-walk.amc" in capsys.readouterr().out
+    # an edited table is shown as edited: a plant removed is not marked
+    lines = (tmp_path / "plants.csv").read_text().splitlines()
+    removed = lines.pop(2).split(",")
+    (tmp_path / "plants.csv").write_text("\n".join(lines) + "\n")
+    edited = page_data_of(
+        main, ["view", str(take), "--no-open", "--contacts", "plants.csv"], tmp_path / "07_05-walk.html"
+    )
+    row = next(r for r in edited["takes"][0]["plants"] if r["label"] == f"{removed[0]} {removed[1]}")
+    assert [int(removed[2]) - 1, int(removed[3]) - 1] not in row["spans"]
+    # plants of another take: a one-line reason, no page
+    (tmp_path / "07_05-walk.html").unlink()
+    other = data_dir / "cmu" / "01_01.amc"
+    assert main(["view", str(other), "--no-open", "-o", "x.html", "--contacts", "plants.csv"]) == 2
+    assert "another take" in capsys.readouterr().err and not (tmp_path / "x.html").exists()
+
+
+def page_data_of(main, argv, path):
+    assert main(argv) == 0
+    return page_data(path.read_text(encoding="utf-8"))
 
 
 @pytest.mark.parametrize("verb", ["view", "plot", "render", "c3d"])

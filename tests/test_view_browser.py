@@ -377,6 +377,64 @@ def test_footplants_are_marked_on_the_feet_and_the_timeline(browser, data_dir, t
     assert not green[int(y) - 3 : int(y) + 4, int(x) - 3 : int(x) + 4].any()
 
 
+def green_near(picture, x, y, radius=3) -> bool:
+    """Whether the footplant green is drawn within radius pixels of (x, y)."""
+    patch = picture[round(y) - radius : round(y) + radius + 1, round(x) - radius : round(x) + radius + 1]
+    return bool(((patch[..., 1] > 120) & (patch[..., 0] < 80) & (patch[..., 2] < 110)).any())
+
+
+def test_detected_footplants_are_shown_on_the_feet_the_clock_and_the_timeline(browser, data_dir, tmp_path):
+    """motiontheater view --plants on a real walk: at a frame where the left foot stands, its heel
+    (marked at the ankle: CMU has no heel joint) and ball are green, listed beside the clock and
+    inked on their timeline rows; in its swing, none of it."""
+    from motiontheater.cli import main
+    from motiontheater.footskate import contacts_of, prepare
+
+    take = data_dir / "cmu" / "07_05-walk.amc"
+    motion = mt.read_amc(take, mt.read_asf(data_dir / "cmu" / "07-walk.asf"))
+    arrays, ground, mpu = prepare(motion)
+    masks = contacts_of(None, motion, arrays, ground, mpu).masks(arrays.legs)  # (legs, frames, heel and ball)
+    labels = ["lfoot heel", "lfoot ball", "rfoot heel", "rfoot ball"]
+    out = tmp_path / "walk.html"
+    assert main(["view", str(take), "--no-open", "--plants", "-o", str(out)]) == 0
+    browser.get_log("browser")
+    browser.get(out.as_uri())
+    WebDriverWait(browser, 30).until(lambda d: d.execute_script("return document.body.dataset.ready === '1'"))
+    names = motion.skeleton.point_names
+    ankle, ball = names.index("ltibia"), names.index("lfoot")  # an ASF bone's point is where it ends
+    positions = motion.positions()
+    # frames 5 or more from a change of the left foot's plants (a pixel on the timeline holds two frames)
+    margin = np.ones(9, int)
+    standing = np.flatnonzero(np.convolve(masks[0].all(axis=1).astype(int), margin, "same") == 9)
+    swinging = np.flatnonzero(np.convolve(masks[0].any(axis=1).astype(int), margin, "same") == 0)
+    assert len(standing) and len(swinging)
+    # in the swing, the frame where the left foot is farthest from the right one: no ring of the right foot near it
+    apart = np.linalg.norm(positions[swinging, ankle] - positions[swinging, names.index("rtibia")], axis=1)
+    cases = ((int(standing[len(standing) // 2]), True), (int(swinging[np.argmax(apart)]), False))
+    rect = browser.find_element(By.ID, "curves").rect
+    for (index, planted), (other, other_planted) in zip(cases, cases[::-1]):
+        browser.execute_script("mtView.seek(arguments[0])", index)
+        wait_frame(browser, index + motion.first_frame)
+        settle(browser)
+        shown = [label for label, flags in zip(labels, masks.transpose(0, 2, 1).reshape(4, -1)) if flags[index]]
+        assert browser.find_element(By.ID, "planted").text == "planted: " + (", ".join(shown) or "none")
+        assert ("lfoot heel" in shown and "lfoot ball" in shown) == planted
+        picture = screenshot(browser)
+        on_screen = joints_on_screen(browser)
+        assert green_near(picture, *on_screen[ankle]) == planted
+        assert green_near(picture, *on_screen[ball]) == planted
+        for row in (0, 1):  # the left foot's rows under the curves, at the other frame (the playhead is at this one)
+            y = rect["y"] + rect["height"] - 7 * (4 - row) + 0.5
+            assert inked(picture, curve_x(browser, other), y, 1) == other_planted
+    # the clock's list changes on the very frame a plant starts
+    start = int(np.flatnonzero(np.diff(masks[0, :, 0].astype(int)) == 1)[0]) + 1
+    for index in (start - 1, start):
+        browser.execute_script("mtView.seek(arguments[0])", index)
+        wait_frame(browser, index + motion.first_frame)
+        assert ("lfoot heel" in browser.find_element(By.ID, "planted").text) == (index == start)
+    assert console_errors(browser) == []
+
+
 def apply_recipe(text: str, motion: mt.Motion, tmp_path) -> mt.Motion:
     """The recipe applied by the command line (motiontheater apply) to the take, read back."""
     from motiontheater.cli import main

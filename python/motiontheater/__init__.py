@@ -11,31 +11,47 @@ here.
 
 from mtcore import binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
 
-from . import convert, errors, export, filtering, interpolators, markers, signal  # noqa: F401 (importing them registers their steps)
+from . import (  # noqa: F401 (importing them registers their steps)
+    convert,
+    errors,
+    export,
+    filtering,
+    footskate,
+    interpolators,
+    markers,
+    signal,
+)
 from ._version import __version__
 from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
 from .bvh import read_bvh, write_bvh
 from .combine import combine
+from .contacts import Contacts, Plant, detect_contacts
 from .convert import to_asf, to_bvh
 from .errors import *  # the exceptions, errors.__all__
 from .export import write_positions
 from .filtering import filter_motion
+from .footskate import Cleanup, clean_footskate
 from .formats import read_take, write_take
 from .interpolators import interpolate, median3
+from .legs import find_legs
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .pipeline import Pipeline
 from .registry import StepError, steps
 from .retarget import plan_retarget, retarget
 from .rigs import joint_map
 from .scene import Scene, Track, read_recipe
+from .skate import skate_metrics
 from .skeleton import Bone, Root, Skeleton
 
 __all__ = [
     "DEFAULT_FRAME_RATE",
     "Bone",
+    "Cleanup",
+    "Contacts",
     "Motion",
     "Pipeline",
+    "Plant",
     "Root",
     "Scene",
     "Skeleton",
@@ -43,8 +59,11 @@ __all__ = [
     "Track",
     "__version__",
     "binomial_filter1d",
+    "clean_footskate",
     "combine",
+    "detect_contacts",
     "filter_motion",
+    "find_legs",
     "interpolate",
     "joint_map",
     "median3",
@@ -57,6 +76,7 @@ __all__ = [
     "read_recipe",
     "read_take",
     "retarget",
+    "skate_metrics",
     "skeleton_path_for",
     "steps",
     "to_asf",

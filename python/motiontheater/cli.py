@@ -304,6 +304,42 @@ def _combine(args: argparse.Namespace) -> int:
     return 0
 
 
+def _ground_options(parser: argparse.ArgumentParser) -> None:
+    """The flags of the footskate verbs (skate, contacts, view's plants): they are the cleanup step's."""
+    cleanup = {o.name: o for o in lookup("cleanup").options}
+    for name in ("floor", "up", "legs"):
+        option = cleanup[name]
+        parser.add_argument(
+            option.flag,
+            dest=name,
+            type=option.parse,
+            metavar=option.metavar,
+            choices=option.choices or None,
+            help=option.help,
+        )
+
+
+def _skate(args: argparse.Namespace) -> int:
+    from .skate import skate_metrics
+
+    motion = read_take(args.input, args.asf, args.frame_rate, args.unit)
+    report = skate_metrics(motion, args.contacts, legs=args.legs, up=args.up, floor=args.floor)
+    print(report.to_json() if args.json else report.text())
+    return 0
+
+
+def _contacts(args: argparse.Namespace) -> int:
+    from .footskate import contacts_of, prepare
+
+    target = _output(args, args.input)
+    motion = read_take(args.input, args.asf, args.frame_rate, args.unit)
+    arrays, ground, mpu = prepare(motion, legs=args.legs, up=args.up, floor=args.floor)
+    table = contacts_of(None, motion, arrays, ground, mpu)
+    table.to_csv(target)
+    print(f"contacts: {len(table)} plants in {motion.frames} frames of {args.input}: wrote {target}")
+    return 0
+
+
 def _step_verb(verbs: Any, step: Step) -> None:
     """The verb of a registered step: ``motiontheater NAME TAKE -o OUT --option ...``."""
     what = "the file to write (" + (", ".join(step.suffixes) if step.is_exporter else ".amc or .bvh") + ")"
@@ -382,10 +418,22 @@ def _view(args: argparse.Namespace) -> int:
     from .view import write_page
 
     paths = [args.take, *args.more]
-    takes = [read_take(path, args.asf, args.frame_rate) for path in paths]
+    takes = [read_take(path, args.asf, args.frame_rate, args.unit) for path in paths]
     out = Path(args.output or Path(args.take).stem + ".html")
-    write_page(takes, out, names=[Path(p).name for p in paths], max_frames=args.max_frames)
-    print(f"wrote {out} ({out.stat().st_size / 1e6:.2f} MB, {len(takes)} take(s), {takes[0].frames} frames)")
+    plants: list[Any] = [None] * len(takes)
+    if args.plants or args.contacts:
+        from .footskate import contacts_of, prepare
+
+        for i, motion in enumerate(takes):
+            given = args.contacts if i == 0 else None  # a contacts table is of the first take
+            if given is None and not args.plants:
+                continue
+            arrays, ground, mpu = prepare(motion, legs=args.legs, up=args.up, floor=args.floor)
+            plants[i] = contacts_of(given, motion, arrays, ground, mpu)
+    names = [Path(p).name for p in paths]
+    write_page(takes, out, names=names, plants=plants, legs=args.legs, max_frames=args.max_frames)
+    shown = "".join(f", {len(p)} footplants on {name}" for p, name in zip(plants, names) if p is not None)
+    print(f"wrote {out} ({out.stat().st_size / 1e6:.2f} MB, {len(takes)} take(s), {takes[0].frames} frames{shown})")
     if not args.no_open and not webbrowser.open(out.resolve().as_uri()):
         print(f"no browser could be started: open {out} in one", file=sys.stderr)
     return 0
@@ -447,9 +495,12 @@ def _add_seeing_verbs(verbs: Any) -> None:
             "joint's channels and an axis-angle glyph of its rotation, its curves (click to seek, drag to "
             "select frames), more takes overlaid for comparison, and an editor that stacks interpolators and "
             "filters over frame ranges, previews them and exports the stack as a recipe for motiontheater "
-            "apply. Takes longer than --max-frames are shown decimated, with a note, and editing off."
+            "apply. Takes longer than --max-frames are shown decimated, with a note, and editing off. "
+            "Footplants (--plants: detected; --contacts FILE: a table) are marked green on the feet, listed "
+            "beside the clock and drawn as rows under the curves."
         ),
-        epilog="Example: motiontheater view 01_01.amc smooth.amc -o compare.html",
+        epilog="Example: motiontheater view 01_01.amc smooth.amc -o compare.html; "
+        "motiontheater view 07_05.amc cleaned.amc --plants",
     )
     view.add_argument("take", help="the take to play and edit (AMC or BVH)")
     view.add_argument("more", nargs="*", help="takes to compare with it, ghosted and overlaid")
@@ -461,6 +512,18 @@ def _add_seeing_verbs(verbs: Any) -> None:
         default=30_000,
         help="longer takes are shown decimated to at most this many frames, editing off (default 30000)",
     )
+    view.add_argument(
+        "--plants",
+        action="store_true",
+        help="detect the footplants of every take (as motiontheater contacts does) and mark them on the feet "
+        "and on the timeline",
+    )
+    view.add_argument(
+        "--contacts",
+        metavar="FILE",
+        help="mark the first take's footplants from this CSV table (as motiontheater contacts writes it)",
+    )
+    _ground_options(view)
     _take_options(view)
     view.set_defaults(run=_view)
 
@@ -643,6 +706,42 @@ def build_parser() -> argparse.ArgumentParser:
     recipe.add_argument("-o", "--output", help="the take to write (.amc or .bvh, as the motions)")
     recipe.add_argument("--dry-run", action="store_true", help="print the frame maps and borders, write nothing")
     recipe.set_defaults(run=_combine)
+
+    skating = verbs.add_parser(
+        "skate",
+        help="measure footskate: sliding, skating ratio, penetration and float of each foot",
+        description=(
+            "Measure how much a take's planted feet slide (mm from where each plant began), how often "
+            "they skate (the motion-generation papers' ratio, and the same over planted frames), how "
+            "deep they go below the floor and how high planted points float. The plants are detected "
+            "unless --contacts gives a table; the floor is fitted unless --floor gives its level. "
+            "Prints a Markdown table, or JSON."
+        ),
+        epilog="Example: motiontheater skate 07_05-walk.amc --json",
+    )
+    skating.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    skating.add_argument("--contacts", metavar="FILE", help="the footplants CSV to measure on (default: detected)")
+    skating.add_argument("--json", action="store_true", help="print JSON")
+    _ground_options(skating)
+    _take_options(skating)
+    skating.set_defaults(run=_skate)
+
+    plants = verbs.add_parser(
+        "contacts",
+        help="detect the footplants of a take and write them as a CSV table to read and edit",
+        description=(
+            "Detect when each foot's heel and ball stand on the floor (height above rest and speed, "
+            "with hysteresis) and write the table: one row per plant, foot,point,first,last (frame "
+            "numbers, both included). Edit it (delete a row, add one) and give it back to cleanup "
+            "with --contacts."
+        ),
+        epilog="Example: motiontheater contacts 07_05-walk.amc -o plants.csv",
+    )
+    plants.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    _output_options(plants, "the CSV file to write")
+    _ground_options(plants)
+    _take_options(plants)
+    plants.set_defaults(run=_contacts)
 
     timing = verbs.add_parser(
         "bench",

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 import mtcore
+from mtcore import footskate as fs
 from mtcore import rotations as rot
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
@@ -29,7 +30,7 @@ from mtcore.combine import combine_frames
 from mtcore.kinematics import JointTree, forward_kinematics
 from mtcore.retarget import RetargetPlan, retarget_rotations
 
-from . import combine, filters, kinematics, retarget, rotations
+from . import combine, filters, footskate, kinematics, retarget, rotations
 from . import signal as signal_twins
 from . import text as text_twins  # binds twins.text too: mtcore's is mt_text
 
@@ -517,6 +518,135 @@ def copy_mapped(data: bytes, begin: int, end: int) -> bytes:
             return mt_text.copy_text(mapped, begin, end)
 
 
+# --- footskate ------------------------------------------------------------------------------
+
+LEG_LAYOUTS = [  # rotation channels of hip, knee, ankle, toe, as the captures have them and not
+    [[2, 0, 1], [0, -1, -1], [0, 2, -1], [0, -1, -1]],  # CMU ASF: a hinge knee, a two-channel foot
+    [[2, 0, 1], [2, 0, 1], [2, 0, 1], [2, 0, 1]],  # BVH ZXY everywhere
+    [[0, 1, 0], [1, 2, 1], [2, 0, 2], [0, 1, 0]],  # proper Euler
+    [[0, 2, 1], [0, 2, -1], [1, -1, -1], [-1, -1, -1]],  # a one-channel ankle, no toe joint
+]
+
+
+def random_leg(rng: np.random.Generator, layout) -> fs.LegChain:
+    """A y-up leg of about human size (metres) with random axis frames C."""
+    segments = np.array([[0, -0.42, 0.02], [0, -0.42, -0.02], [0, -0.08, 0.14], [0, -0.08, -0.04], [0, 0, 0.05]])
+    segments = segments + rng.normal(0, 0.01, (5, 3))
+    if layout[3][0] < 0:
+        segments[4] = 0
+    return fs.LegChain(axis=rotations.matrices(rng.uniform(-3, 3, (4, 3)), "xyz"), axes=layout, segments=segments)
+
+
+def random_walk(rng: np.random.Generator, chain: fs.LegChain, frames: int) -> dict:
+    """A leg walking along z: hips, parents, smooth angles, its points, random plants and
+    targets near the points (some beyond reach), clearances and the floor under the feet."""
+    t = np.arange(frames) / 30.0
+    hips = np.stack([np.full(frames, 0.1), 0.88 + 0.02 * np.sin(7 * t), 1.2 * t], axis=1)
+    parents = rotations.matrices(np.stack([0.05 * np.sin(3 * t), 0.1 * np.sin(2 * t), 0 * t], axis=1), "xyz")
+    phase = rng.uniform(0, 6, (1, 4, 3))
+    angles = 0.3 * np.sin(6 * t[:, None, None] + phase) * (chain.axes >= 0)
+    points = footskate.leg_points([chain], hips[None], parents[None], angles[None])[0]
+    planted = np.zeros((frames, 2), bool)
+    for k in range(2):
+        start = 0
+        while start < frames:
+            start += int(rng.integers(0, 8))
+            length = int(rng.integers(1, 20))
+            planted[start : start + length, k] = True
+            start += length
+    targets = points[:, [3, 2]] + rng.normal(0, 0.06, (frames, 2, 3))
+    clearance = np.array([0.06, 0.03, 0.01]) + rng.uniform(-0.01, 0.01, 3)
+    level = float(points[:, 3, 1].min(initial=0.0)) - 0.06 + rng.uniform(-0.05, 0.05)
+    options = fs.CleanupOptions(
+        level=level,
+        slope=(float(rng.uniform(-0.05, 0.05)), 0.0, 0.0),
+        blend=int(rng.choice([0, 1, 6, 24])),
+        root_window=int(rng.choice([0, 2, 6])),
+        root_passes=int(rng.choice([0, 1, 3])),
+        knee_soft=float(rng.choice([0.0, 0.05])),
+        knee_keep=float(rng.choice([0.0, 0.5, 1.0])),
+    )
+    return dict(hips=hips, parents=parents, angles=angles, points=points, planted=planted, targets=targets,
+                clearance=clearance, options=options)  # fmt: skip
+
+
+def walks(rng: np.random.Generator) -> list[tuple[fs.LegChain, dict]]:
+    return [
+        (chain, random_walk(rng, chain, frames))
+        for layout in LEG_LAYOUTS
+        for frames in (0, 1, 2, 9, 40)
+        for chain in (random_leg(rng, layout),)
+    ]
+
+
+def leg_points_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for legs, frames in ((1, 0), (1, 1), (2, 7), (2, 30)):
+        chains = tuple(random_leg(rng, LEG_LAYOUTS[int(rng.integers(len(LEG_LAYOUTS)))]) for _ in range(legs))
+        hips = rng.normal(size=(legs, frames, 3))
+        parents = rotations.matrices(rng.uniform(-3, 3, (legs, frames, 3)), "zyx")
+        angles = rng.uniform(-3, 3, (legs, frames, 4, 3)) * np.stack([c.axes >= 0 for c in chains])[:, None]
+        out += [(chains, hips, parents, angles, feet) for feet in (False, True)]
+    return out
+
+
+def plan_cases(rng: np.random.Generator) -> list[tuple]:
+    return [
+        (chain, w["angles"], w["points"], w["planted"], w["targets"], w["clearance"], w["options"])
+        for chain, w in walks(rng)
+    ]
+
+
+def fast_plan(*args) -> tuple:
+    plan = fs.plan_leg(*args)
+    return plan.enforced, plan.goal, plan.turn, plan.weight, plan.reach, plan.knee
+
+
+def root_cases(rng: np.random.Generator) -> list[tuple]:
+    """Goals in and beyond reach of one or two hips, weights 0 (free), between and 1."""
+    out = []
+    for legs, frames in ((1, 0), (1, 1), (2, 2), (1, 17), (2, 40)):
+        hips = rng.normal(0, 0.1, (legs, frames, 3))
+        goals = hips + rng.normal(0, 1, (legs, frames, 3))
+        reaches = rng.uniform(0.5, 1.2, (legs, frames))
+        weights = rng.choice([0.0, 0.3, 1.0], (legs, frames))
+        options = fs.CleanupOptions(root_window=int(rng.choice([0, 1, 4])), root_passes=int(rng.choice([0, 3])))
+        out.append((hips, goals, reaches, weights, options))
+    return out
+
+
+def solve_cases(rng: np.random.Generator) -> list[tuple]:
+    """The walks with their twin-made plans and root."""
+    out = []
+    for chain, w in walks(rng):
+        plan = footskate.plan_leg(
+            chain, w["angles"], w["points"], w["planted"], w["targets"], w["clearance"], w["options"]
+        )
+        root = footskate.adjust_root(w["hips"][None], plan[1][None], plan[4][None], plan[3][None], w["options"])
+        out.append(
+            (chain, w["hips"], w["parents"], w["angles"], w["points"], w["planted"], *plan[1:4], plan[5], root,
+             w["clearance"], w["options"])
+        )  # fmt: skip
+    return out
+
+
+def joint_rotations(chain: fs.LegChain, angles: np.ndarray) -> np.ndarray:
+    """The local rotations (frames, 4, 3, 3) of solved angles: near gimbal lock only those are
+    defined, not the split of an Euler triple."""
+    return np.stack([footskate.local(chain, j, angles[:, j]) for j in range(4)], axis=1)
+
+
+def fast_solve(chain, hips, parents, angles, points, planted, goal, turn, weight, knee, root, clearance, options):
+    plan = fs.LegPlan(np.empty(0), goal, turn, weight, np.empty(0), knee)
+    return joint_rotations(
+        chain, fs.solve_leg(chain, hips, parents, angles, points, planted, plan, root, clearance, options)
+    )
+
+
+def slow_solve(chain, *args):
+    return joint_rotations(chain, footskate.solve_leg(chain, *args))
+
+
 # --- the registry ---------------------------------------------------------------------------
 
 TWINS: dict[str, Twin] = {
@@ -594,6 +724,17 @@ TWINS: dict[str, Twin] = {
     "mt_nan_runs": Twin(
         lambda x, *_: mt_signal.nan_runs(x), lambda x, *_: signal_twins.nan_runs_twin(x), nan_run_cases, exact
     ),
+    "mt_leg_points": Twin(
+        lambda chains, hips, parents, angles, feet: fs.leg_points(chains, hips, parents, angles, feet=feet),
+        lambda chains, hips, parents, angles, feet: footskate.leg_points(chains, hips, parents, angles, feet=feet),
+        leg_points_cases,
+        close(1e-12),
+    ),
+    # the plan's goals and turns and the solved rotations to 1e-9 and 1e-6: acos and asin near 1
+    # (a knee almost straight, a toe just touching the floor) take square roots of rounding
+    "mt_footskate_plan": Twin(fast_plan, footskate.plan_leg, plan_cases, close(1e-9)),
+    "mt_footskate_root": Twin(fs.adjust_root, footskate.adjust_root, root_cases, close(1e-9)),
+    "mt_footskate_solve": Twin(fast_solve, slow_solve, solve_cases, close(1e-6)),
 }
 
 EXEMPT = {

@@ -6,7 +6,7 @@ perspective view drawn with Canvas 2D, a floor grid, orbit/zoom/pan and a
 camera that follows the root), the joint tree with the selected joint's
 channel values and an axis-angle glyph of its rotation, the selected joint's
 channel curves with a playhead, several takes compared (overlaid curves and
-ghosted skeletons, aligned in time), optional footplants, and an editor that
+ghosted skeletons, aligned in time), footplants when given, and an editor that
 stacks the registered interpolators (:mod:`motiontheater.interpolators`) and
 filters (:mod:`motiontheater.filtering`) over frame ranges, previews them
 (JavaScript ports of those steps, equal to about 1e-12) and exports the
@@ -42,10 +42,12 @@ import numpy as np
 
 from .._io import Source, output
 from .._version import __version__
+from ..contacts import Contacts
 from ..filtering import FILTERS
 from ..interpolators import INTERPOLATORS
+from ..legs import resolve_legs
 from ..motion import Motion
-from ..registry import lookup
+from ..registry import Joints, lookup
 
 __all__ = ["DEFAULT_MAX_FRAMES", "EDIT_STEPS", "page", "write_page"]
 
@@ -98,22 +100,41 @@ def _spans(flags: np.ndarray) -> list[list[int]]:
     return [[int(a), int(b) - 1] for a, b in zip(edges[::2], edges[1::2])]
 
 
-def _take_data(motion: Motion, label: str, step: int, plants: Mapping[str, np.ndarray] | None) -> dict:
+def _plant_rows(
+    motion: Motion, label: str, step: int, plants: Mapping[str, np.ndarray] | Contacts | None, legs: Joints
+) -> list[dict]:
+    """The footplant rows of a take as the page draws them: label, point index, spans of shown frames."""
+    if plants is None:
+        return []
+    if isinstance(plants, Contacts):
+        plants.check_take(motion.first_frame, motion.frames)
+        marks = plants.marks(resolve_legs(motion.skeleton, legs))
+    else:
+        points = motion.skeleton.point_names
+        marks = []
+        for point, flags in plants.items():
+            if point not in points:
+                raise ValueError(f"footplants name '{point}', which is not a point of {label}")
+            marks.append((point, points.index(point), np.asarray(flags, bool)))
+    rows = []
+    for name, where, flags in marks:
+        if flags.shape != (motion.frames,):
+            raise ValueError(
+                f"footplants of '{name}' must have one flag per frame ({motion.frames}), got {flags.shape}"
+            )
+        rows.append({"label": name, "point": where, "spans": _spans(flags[::step])})
+    return rows
+
+
+def _take_data(
+    motion: Motion, label: str, step: int, plants: Mapping[str, np.ndarray] | Contacts | None, legs: Joints
+) -> dict:
     skeleton = motion.skeleton
     tree = skeleton.tree
     names = skeleton.joint_names
     index = {name: i for i, name in enumerate(names)}
     values = motion.values[::step]
-    shown_plants = {}
-    for point, flags in (plants or {}).items():
-        flags = np.asarray(flags, bool)
-        if point not in skeleton.point_names:
-            raise ValueError(f"footplants name '{point}', which is not a point of {label}")
-        if flags.shape != (motion.frames,):
-            raise ValueError(
-                f"footplants of '{point}' must have one flag per frame ({motion.frames}), got {flags.shape}"
-            )
-        shown_plants[point] = _spans(flags[::step])
+    shown_plants = _plant_rows(motion, label, step, plants, legs)
     return {
         "name": label,
         "frameRate": motion.frame_rate,
@@ -149,7 +170,8 @@ def page(
     takes: Sequence[Motion],
     *,
     names: Sequence[str] | None = None,
-    plants: Sequence[Mapping[str, np.ndarray] | None] | None = None,
+    plants: Sequence[Mapping[str, np.ndarray] | Contacts | None] | None = None,
+    legs: Joints = None,
     max_frames: int = DEFAULT_MAX_FRAMES,
     title: str | None = None,
 ) -> str:
@@ -158,10 +180,15 @@ def page(
     The first take is the one played and edited; the others are compared
     with it (ghosted skeletons and dashed curves at the same time from each
     take's start).  ``names`` label the takes (default "take 1", ...).
-    ``plants`` gives, per take, optional footplants: point name (one of
-    ``skeleton.point_names``) -> bool array with one flag per frame, True
-    where the point is planted.  A take of more than ``max_frames`` frames is
-    shown decimated to at most that many, and editing is then off.
+    ``plants`` gives, per take, optional footplants, marked on the feet (a
+    ring on the floor and a dot on the point, while planted) and on the
+    timeline under the curves (a row each): a :class:`~motiontheater.contacts.Contacts`
+    table of that take (its heels and balls; its feet are those of the legs
+    found by name, or of ``legs``: hip,knee,ankle[,toe] of the left then the
+    right leg), or a mapping point name (one of ``skeleton.point_names``) ->
+    bool array with one flag per frame, True where the point is planted.  A
+    take of more than ``max_frames`` frames is shown decimated to at most that
+    many, and editing is then off.
     """
     if not takes:
         raise ValueError("give at least one take to view")
@@ -188,7 +215,7 @@ def page(
         "note": (
             "; ".join(notes) + f" (pages hold up to {max_frames:,} frames per take; editing is off)" if notes else ""
         ),
-        "takes": [_take_data(m, label, k, p) for m, label, k, p in zip(takes, labels, steps, plant_list)],
+        "takes": [_take_data(m, label, k, p, legs) for m, label, k, p in zip(takes, labels, steps, plant_list)],
     }
     text = title or "motiontheater: " + " vs ".join(labels)
     resources = files(__package__)

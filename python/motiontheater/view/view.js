@@ -82,17 +82,17 @@
       parentFrame: Uint8Array.from(t.parentFrame),
       plain: new Uint8Array(J),
       jointIndex: new Map(t.joints.map((name, i) => [name, i])),
-      plantFlags: {},
+      plantRows: [],
     });
     for (let j = 0; j < J; j++) {
       let identity = true;
       for (let e = 0; e < 9; e++) if (take.axis[9 * j + e] !== (e % 4 === 0 ? 1 : 0)) identity = false;
       take.plain[j] = identity ? 1 : 0;
     }
-    for (const [point, spans] of Object.entries(t.plants || {})) {
+    for (const { label, point, spans } of t.plants || []) {
       const flags = new Uint8Array(t.frames);
       for (const [a, b] of spans) flags.fill(1, a, b + 1);
-      take.plantFlags[point] = flags;
+      take.plantRows.push({ label, j: point, flags });
     }
     take.positions = allPositions(take, take.values);
     return take;
@@ -705,9 +705,8 @@
       ctx.fill();
     }
     // contacts: a ring on the floor under each planted foot, and the foot point marked
-    for (const [name, flags] of Object.entries(take.plantFlags)) {
-      const j = take.points.indexOf(name);
-      if (j < 0 || !flags[i]) continue;
+    for (const { j, flags } of take.plantRows) {
+      if (!flags[i]) continue;
       const p = point(P, base, j);
       ctx.strokeStyle = "#1a9e3a";
       ctx.fillStyle = "#1a9e3a";
@@ -912,7 +911,7 @@
 
   function curveGeometry() {
     const dpr = window.devicePixelRatio || 1;
-    const plantRows = S.takes.reduce((n, t) => n + Object.keys(t.plantFlags).length, 0);
+    const plantRows = S.takes.reduce((n, t) => n + t.plantRows.length, 0);
     const strip = plantRows ? plantRows * 7 + 4 : 0;
     const W = curves.width, H = curves.height;
     const x0 = M.left * dpr, x1 = W - M.right * dpr, y0 = M.top * dpr, y1 = H - (M.bottom + strip) * dpr;
@@ -987,7 +986,7 @@
     // footplant strip: one row per foot per take
     let row = 0;
     for (const take of S.takes)
-      for (const [point, flags] of Object.entries(take.plantFlags)) {
+      for (const { label, flags } of take.plantRows) {
         const y = G.y1 + M.bottom * G.dpr + 2 * G.dpr + row * 7 * G.dpr;
         c.fillStyle = take.colour;
         for (let f = 0; f < take.frames; f++) {
@@ -998,7 +997,7 @@
         c.textAlign = "right";
         c.textBaseline = "top";
         c.font = `${8 * G.dpr}px system-ui, sans-serif`;
-        c.fillText(point, G.x0 - 4 * G.dpr, y - G.dpr);
+        c.fillText(label, G.x0 - 4 * G.dpr, y - G.dpr);
         row++;
       }
     c.textAlign = "left";
@@ -1209,6 +1208,9 @@
     $("slider").value = S.cur;
     $("clock").textContent = `frame ${frame} of ${frameNumber(t, 0)}..${frameNumber(t, t.frames - 1)} \u00b7 ${S.time.toFixed(3)} s / ${duration(t).toFixed(3)} s \u00b7 ${t.frameRate / t.step} Hz`;
     document.body.dataset.frame = String(frame);
+    const planted = $("planted");
+    planted.hidden = !t.plantRows.length;
+    planted.textContent = "planted: " + (t.plantRows.filter((r) => r.flags[S.cur]).map((r) => r.label).join(", ") || "none");
   }
 
   function setUpControls() {

@@ -1,0 +1,422 @@
+"""Footskate cleanup of legs over frames, in C (Kovar, Schreiner & Gleicher, SCA 2002).
+
+Array level: a leg is a chain of four joints turning the thigh, shin, foot
+and toes (see :class:`LegChain`); motiontheater builds the chains and the
+arrays from a skeleton and a motion, and plans the footplants.
+
+Conventions (those of :func:`mtcore.kinematics.forward_kinematics`): a
+joint's local rotation is L = C M C^T, C its axis frame and M the rotation of
+its rotation channels applied in order about fixed axes; its world rotation
+is its parent's times L; a segment's rest vector, in the frame of the joint
+that turns it, is the difference of rest positions (rest rotations are the
+identity).  Angles are radians.  Lengths are any one unit.
+
+Shapes: ``hips`` (legs, frames, 3) the hip points; ``parents`` (legs, frames,
+3, 3) the world rotations of each hip joint's parent; ``angles`` (legs,
+frames, 4, 3) the rotation channels of hip, knee, ankle and toe joints in the
+order they apply (unused entries 0).  Points are (legs, frames, 5, 3): knee,
+ankle, ball, heel, toe tip.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._cdata import c_array
+from ._mtcore import ffi, lib
+from ._parallel import run_all, thread_count
+from ._status import check
+
+__all__ = [
+    "POINTS",
+    "CleanupOptions",
+    "LegChain",
+    "LegPlan",
+    "adjust_root",
+    "cleanup",
+    "leg_points",
+    "plan_leg",
+    "solve_leg",
+]
+
+POINTS = ("knee", "ankle", "ball", "heel", "tip")
+_PARALLEL_MIN_FRAMES = 1000  # frames below which the second leg's thread costs more than it gains
+SEGMENTS = ("thigh", "shin", "ball", "heel", "toes")
+JOINTS = ("hip", "knee", "ankle", "toe")
+
+
+@dataclass(frozen=True, eq=False)
+class LegChain:
+    """One leg as the kernels take it (see mtcore.h, ``struct mt_leg``).
+
+    ``axis`` (4, 3, 3): C of the hip, knee, ankle and toe joints; ``axes``
+    (4, 3) int: the axis (0 x, 1 y, 2 z) of each rotation channel, in the
+    order they apply, -1 past the last; ``segments`` (5, 3): hip -> knee in
+    the hip joint's frame, knee -> ankle in the knee's, ankle -> ball and
+    ankle -> heel in the ankle's, ball -> tip in the toe's (zero: no tip).
+    A toe joint without channels is no toe joint.  Hip and knee need at least
+    one channel; channels of a joint with three must not repeat an axis
+    twice in a row, nor, with fewer, at all.
+    """
+
+    axis: np.ndarray
+    axes: np.ndarray
+    segments: np.ndarray
+
+    def __post_init__(self) -> None:
+        axis = np.ascontiguousarray(self.axis, dtype=np.float64)
+        axes = np.ascontiguousarray(self.axes, dtype=np.intc)
+        segments = np.ascontiguousarray(self.segments, dtype=np.float64)
+        for name, a, shape in (("axis", axis, (4, 3, 3)), ("axes", axes, (4, 3)), ("segments", segments, (5, 3))):
+            if a.shape != shape:
+                raise ValueError(f"LegChain.{name} must have shape {shape}, got {a.shape}")
+        if not (np.isfinite(axis).all() and np.isfinite(segments).all()):
+            raise ValueError("LegChain axis and segments must be finite")
+        for j, joint in enumerate(JOINTS):
+            row = axes[j]
+            count = self.count(j, axes)
+            if (row[count:] != -1).any() or ((row[:count] < 0) | (row[:count] > 2)).any():
+                raise ValueError(
+                    f"LegChain.axes[{j}] ({joint}) must list axes 0-2 then -1 for unused entries, got {row.tolist()}"
+                )
+            used = list(row[:count])
+            if (count < 3 and len(set(used)) < count) or (count == 3 and (used[0] == used[1] or used[1] == used[2])):
+                raise ValueError(f"LegChain.axes[{j}] ({joint}) repeats an axis: {used}")
+        if self.count(0, axes) == 0 or self.count(1, axes) == 0:
+            raise ValueError("the hip and knee joints need at least one rotation channel")
+        for name, a in (("axis", axis), ("axes", axes), ("segments", segments)):
+            a.flags.writeable = False
+            object.__setattr__(self, name, a)
+
+    @staticmethod
+    def count(joint: int, axes: np.ndarray) -> int:
+        """Rotation channels of a joint (its entries before the first -1)."""
+        row = list(axes[joint])
+        return row.index(-1) if -1 in row else 3
+
+    def channels(self, joint: int) -> int:
+        """Rotation channels of joint 0-3 (hip, knee, ankle, toe)."""
+        return self.count(joint, self.axes)
+
+
+@dataclass(frozen=True)
+class CleanupOptions:
+    """Everything the cleanup needs besides the legs and the frames (lengths in the arrays' unit).
+
+    The floor: a point p is at height ``p . up - p . slope - level`` above it
+    (``up`` a unit vector, ``slope`` the floor's gradient, perpendicular to
+    up).  ``blend``: frames over which adjustments fade in and out where
+    constraints switch; ``root_window``: half-width in frames of the moving
+    mean that smooths the root's adjustment (applied twice), ``root_passes``:
+    how many times what is still short is smoothed in before the last
+    per-frame correction; ``knee_soft``: radians short of full extension at
+    which a knee stops straightening (unless the input's is straighter);
+    ``knee_keep``: the share of the input's knee bend that the root moves to
+    keep where a leg is constrained.
+    """
+
+    up: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    slope: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    level: float = 0.0
+    blend: int = 24
+    root_window: int = 6
+    root_passes: int = 3
+    knee_soft: float = math.radians(3.0)
+    knee_keep: float = 0.5
+
+    def __post_init__(self) -> None:
+        up, slope = np.asarray(self.up, float), np.asarray(self.slope, float)
+        if up.shape != (3,) or not np.isfinite(up).all() or abs(np.linalg.norm(up) - 1) > 1e-9:
+            raise ValueError(f"up must be a unit vector of 3, got {self.up}")
+        if slope.shape != (3,) or not np.isfinite(slope).all() or abs(slope @ up) > 1e-9:
+            raise ValueError(f"slope must be a vector of 3 perpendicular to up, got {self.slope}")
+        if not math.isfinite(self.level):
+            raise ValueError(f"level must be finite, got {self.level}")
+        for name in ("blend", "root_window", "root_passes"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                raise ValueError(f"{name} must be a whole number >= 0, got {value!r}")
+        if not 0 <= self.knee_soft < math.pi / 2:
+            raise ValueError(f"knee_soft must be in [0, pi/2) radians, got {self.knee_soft}")
+        if not 0 <= self.knee_keep <= 1:
+            raise ValueError(f"knee_keep must be in [0, 1], got {self.knee_keep}")
+
+    def struct(self):
+        """The options as the kernels take them (``struct mt_footskate``)."""
+        opt = ffi.new("struct mt_footskate *")
+        opt.up = list(self.up)
+        opt.slope = list(self.slope)
+        opt.level = self.level
+        opt.blend = self.blend
+        opt.root_window = self.root_window
+        opt.root_passes = self.root_passes
+        opt.knee_soft = self.knee_soft
+        opt.knee_keep = self.knee_keep
+        return opt
+
+
+@dataclass(frozen=True, eq=False)
+class LegPlan:
+    """What phases 1 and 2 give for one leg (see :func:`plan_leg`)."""
+
+    enforced: np.ndarray
+    goal: np.ndarray
+    turn: np.ndarray
+    weight: np.ndarray
+    reach: np.ndarray
+    knee: np.ndarray
+
+
+def _leg_struct(chains: tuple[LegChain, ...]):
+    legs = ffi.new("struct mt_leg[]", max(len(chains), 1))
+    for leg, chain in zip(legs, chains):
+        ffi.memmove(leg.axis, chain.axis.tobytes(), 4 * 9 * 8)
+        ffi.memmove(leg.axes, chain.axes.tobytes(), 4 * 3 * ffi.sizeof("int"))
+        ffi.memmove(leg.segment, chain.segments.tobytes(), 5 * 3 * 8)
+    return legs
+
+
+def _doubles(a, name: str, shape: tuple[int, ...]) -> np.ndarray:
+    out = np.ascontiguousarray(a, dtype=np.float64)
+    if out.shape != shape:
+        raise ValueError(f"{name} must have shape {shape}, got {out.shape}")
+    return out
+
+
+def _leg_frames(chain, hips, parents, angles) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """One leg's arrays, checked: hips (frames, 3), parents (frames, 3, 3), angles (frames, 4, 3)."""
+    if not isinstance(chain, LegChain):
+        raise TypeError(f"chain must be a LegChain, got {type(chain).__name__}")
+    hips = np.ascontiguousarray(hips, dtype=np.float64)
+    if hips.ndim != 2 or hips.shape[1] != 3:
+        raise ValueError(f"hips must have shape (frames, 3), got {hips.shape}")
+    frames = hips.shape[0]
+    return hips, _doubles(parents, "parents", (frames, 3, 3)), _doubles(angles, "angles", (frames, 4, 3)), frames
+
+
+def leg_points(chains, hips, parents, angles, *, feet: bool = False):
+    """World points (legs, frames, 5, 3) of the legs: knee, ankle, ball, heel and toe tip
+    (the ball's position where the leg has no toe tip); with ``feet=True`` also the feet's world
+    rotations (legs, frames, 3, 3).  NaN in, NaN out."""
+    chains = tuple(chains)
+    if not chains or not all(isinstance(c, LegChain) for c in chains):
+        raise TypeError("chains must be one or more LegChain")
+    n = len(chains)
+    hips = np.ascontiguousarray(hips, dtype=np.float64)
+    if hips.ndim != 3 or hips.shape[0] != n or hips.shape[2] != 3:
+        raise ValueError(f"hips must have shape ({n}, frames, 3), got {hips.shape}")
+    frames = hips.shape[1]
+    parents = _doubles(parents, "parents", (n, frames, 3, 3))
+    angles = _doubles(angles, "angles", (n, frames, 4, 3))
+    out = np.empty((n, frames, 5, 3))
+    rotations = np.empty((n, frames, 3, 3)) if feet else None
+    check(
+        lib.mt_leg_points(
+            _leg_struct(chains),
+            n,
+            frames,
+            c_array(hips),
+            c_array(parents),
+            c_array(angles),
+            c_array(out),
+            c_array(rotations),
+        ),
+        "mt_leg_points",
+    )
+    return (out, rotations) if feet else out
+
+
+def _clearance(clearance) -> np.ndarray:
+    out = _doubles(clearance, "clearance", (3,))
+    if not np.isfinite(out).all():
+        raise ValueError(f"clearance must be finite, got {out.tolist()}")
+    return out
+
+
+def _planted(planted, frames: int) -> np.ndarray:
+    out = np.asarray(planted)
+    if out.shape != (frames, 2) or out.dtype.kind not in "bui":
+        raise ValueError(f"planted must be booleans of shape ({frames}, 2), got {out.dtype} {out.shape}")
+    return np.ascontiguousarray(out != 0, dtype=np.uint8)
+
+
+def _points(points, frames: int) -> np.ndarray:
+    return _doubles(points, "points", (frames, 5, 3))
+
+
+def plan_leg(chain, angles, points, planted, targets, clearance, options: CleanupOptions) -> LegPlan:
+    """Phases 1 and 2 for one leg (``mt_footskate_plan``), of its angles (frames, 4, 3) and
+    points (frames, 5, 3) as :func:`leg_points` gives them.
+
+    ``planted`` (frames, 2): whether the heel and the ball are planted;
+    ``targets`` (frames, 2, 3): where (read where planted: the mean position
+    over the plant, as motiontheater gives it); ``clearance`` (3,): the
+    heights at which heel, ball and toe tip rest above the floor.  Returns
+    the targets as enforced (on the floor, a new one at the foot's
+    heel-to-ball length from the other's; NaN where not planted), the ankle's
+    goal (frames, 3), the foot's turn (frames, 3) as a rotation vector (its
+    goal rotation is the turn times its rotation now), each frame's blend
+    weight (1 constrained, 0 untouched), the knee's reach (the longest
+    hip-to-ankle distance the root must keep it within) and the knee's hinge
+    axis in the thigh's frame with the side it bends to, (4,).
+    """
+    if not isinstance(chain, LegChain):
+        raise TypeError(f"chain must be a LegChain, got {type(chain).__name__}")
+    angles = np.ascontiguousarray(angles, dtype=np.float64)
+    if angles.ndim != 3 or angles.shape[1:] != (4, 3):
+        raise ValueError(f"angles must have shape (frames, 4, 3), got {angles.shape}")
+    frames = angles.shape[0]
+    points = _points(points, frames)
+    planted = _planted(planted, frames)
+    targets = _doubles(targets, "targets", (frames, 2, 3))
+    if not np.isfinite(targets[planted.astype(bool)]).all():
+        raise ValueError("targets must be finite where planted")
+    plan = LegPlan(
+        np.empty((frames, 2, 3)),
+        np.empty((frames, 3)),
+        np.empty((frames, 3)),
+        np.empty(frames),
+        np.empty(frames),
+        np.empty(4),
+    )
+    check(
+        lib.mt_footskate_plan(
+            _leg_struct((chain,)),
+            frames,
+            c_array(angles),
+            c_array(points),
+            c_array(planted, "unsigned char[]"),
+            c_array(targets),
+            c_array(_clearance(clearance)),
+            options.struct(),
+            c_array(plan.enforced),
+            c_array(plan.goal),
+            c_array(plan.turn),
+            c_array(plan.weight),
+            c_array(plan.reach),
+            c_array(plan.knee),
+        ),
+        "mt_footskate_plan",
+    )
+    return plan
+
+
+def adjust_root(hips, goals, reaches, weights, options: CleanupOptions) -> np.ndarray:
+    """Phase 3 (``mt_footskate_root``): the root's translation (frames, 3) that lets one or two
+    legs reach their ankle goals: hips, goals (legs, frames, 3), reaches and weights (legs,
+    frames) as :func:`plan_leg` gives them; frames of weight 0 do not constrain."""
+    hips = np.ascontiguousarray(hips, dtype=np.float64)
+    if hips.ndim != 3 or hips.shape[0] not in (1, 2) or hips.shape[2] != 3:
+        raise ValueError(f"hips must have shape (1 or 2 legs, frames, 3), got {hips.shape}")
+    n, frames = hips.shape[:2]
+    goals = _doubles(goals, "goals", (n, frames, 3))
+    reaches = _doubles(reaches, "reaches", (n, frames))
+    weights = _doubles(weights, "weights", (n, frames))
+    root = np.empty((frames, 3))
+    check(
+        lib.mt_footskate_root(
+            n,
+            frames,
+            c_array(hips),
+            c_array(goals),
+            c_array(reaches),
+            c_array(weights),
+            options.struct(),
+            c_array(root),
+        ),
+        "mt_footskate_root",
+    )
+    return root
+
+
+def solve_leg(
+    chain, hips, parents, angles, points, planted, plan: LegPlan, root, clearance, options: CleanupOptions
+) -> np.ndarray:
+    """Phases 4 and 5 for one leg (``mt_footskate_solve``): the new angles (frames, 4, 3),
+    the input's bit for bit in frames that need no change.  ``points`` as for :func:`plan_leg`;
+    ``root`` (frames, 3) is the root's translation from :func:`adjust_root`."""
+    hips, parents, angles, frames = _leg_frames(chain, hips, parents, angles)
+    points = _points(points, frames)
+    planted = _planted(planted, frames)
+    root = _doubles(root, "root", (frames, 3))
+    goal = _doubles(plan.goal, "plan.goal", (frames, 3))
+    turn = _doubles(plan.turn, "plan.turn", (frames, 3))
+    weight = _doubles(plan.weight, "plan.weight", (frames,))
+    knee = _doubles(plan.knee, "plan.knee", (4,))
+    out = np.empty_like(angles)
+    check(
+        lib.mt_footskate_solve(
+            _leg_struct((chain,)),
+            frames,
+            c_array(hips),
+            c_array(parents),
+            c_array(angles),
+            c_array(points),
+            c_array(planted, "unsigned char[]"),
+            c_array(goal),
+            c_array(turn),
+            c_array(weight),
+            c_array(knee),
+            c_array(root),
+            c_array(_clearance(clearance)),
+            options.struct(),
+            c_array(out),
+        ),
+        "mt_footskate_solve",
+    )
+    return out
+
+
+def cleanup(
+    chains,
+    hips,
+    parents,
+    angles,
+    points,
+    planted,
+    targets,
+    clearance,
+    options: CleanupOptions,
+    *,
+    workers: int | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Footskate cleanup of one or two legs over frames: (angles, root, enforced).
+
+    The arrays are those of the phases, with a leading axis of legs:
+    ``hips`` (legs, frames, 3), ``parents`` (legs, frames, 3, 3), ``angles``
+    (legs, frames, 4, 3), ``points`` (legs, frames, 5, 3), ``planted``
+    (legs, frames, 2), ``targets`` (legs, frames, 2, 3), ``clearance`` (legs,
+    3).  Returns the new angles, the root's translation to add (frames, 3) and
+    the enforced targets (legs, frames, 2, 3): :func:`plan_leg` per leg,
+    :func:`adjust_root`, :func:`solve_leg` per leg; the legs in two threads
+    (``workers`` as for the filters: None for every core on takes of a
+    thousand frames or more, 1 for the calling thread alone).
+    """
+    chains = tuple(chains)
+    if len(chains) not in (1, 2):
+        raise ValueError(f"cleanup takes one or two legs, got {len(chains)}")
+    threads = thread_count(workers, len(hips[0]) >= _PARALLEL_MIN_FRAMES if len(hips) else False)
+
+    def each_leg(task):
+        calls = [lambda i=i: task(i) for i in range(len(chains))]
+        return run_all(calls) if threads > 1 else [call() for call in calls]
+
+    plans = each_leg(lambda i: plan_leg(chains[i], angles[i], points[i], planted[i], targets[i], clearance[i], options))
+    root = adjust_root(
+        hips,
+        np.stack([p.goal for p in plans]),
+        np.stack([p.reach for p in plans]),
+        np.stack([p.weight for p in plans]),
+        options,
+    )
+    out = np.stack(
+        each_leg(
+            lambda i: solve_leg(
+                chains[i], hips[i], parents[i], angles[i], points[i], planted[i], plans[i], root, clearance[i], options
+            )
+        )
+    )
+    return out, root, np.stack([p.enforced for p in plans])
