@@ -57,6 +57,41 @@ static MT_INLINE void sincos_block(const double *x, double *sin_out, double *cos
             }
 }
 
+/*
+ * atan2(y, x) (radians, in [-pi, pi]), branch-free: the angle of z = min / max of |x| and |y|
+ * in [0, 1] by the rational approximation of Cephes (Moshier), through pi/4 + atan((z - 1) /
+ * (z + 1)) above 0.66, then reflected about pi/4 and pi/2 by the octant, pi/2 and pi each in
+ * two parts.  Within about 2 ulp of pi of libm's; the same at 0, +-0 and infinities, NaN for NaN.
+ */
+static MT_INLINE void atan2_block(const double *y, const double *x, double *out)
+{
+    static const double p0 = -8.750608600031904122785e-1, p1 = -1.615753718733365076637e1,
+                        p2 = -7.500855792314704667340e1, p3 = -1.228866684490136173410e2,
+                        p4 = -6.485021904942025371773e1;
+    static const double q0 = 2.485846490142306297962e1, q1 = 1.650270098316988542046e2,
+                        q2 = 4.328810604912902668951e2, q3 = 4.853903996359136964868e2,
+                        q4 = 1.945506571482613964425e2;
+    static const double quarter = 7.85398163397448278999e-1, half = 1.57079632679489661923,
+                        low = 6.123233995736765886130e-17; /* pi/2 - half */
+    for (int b = 0; b < BLOCK; b++) {
+        const double yb = y[b], xb = x[b], ay = fabs(yb), ax = fabs(xb);
+        const int steep = ay > ax;
+        const double hi = steep ? ay : ax, lo = steep ? ax : ay;
+        /* z = lo / hi, but 0 for 0/0 and 1 for inf/inf */
+        const int infinite = lo == INFINITY;
+        const double h = infinite || hi == 0 ? 1.0 : hi, l = infinite ? 1.0 : lo;
+        const int upper = l > 0.66 * h; /* (z - 1) / (z + 1) = (l - h) / (l + h) */
+        const double w = (upper ? l - h : l) / (upper ? l + h : h), ww = w * w;
+        const double p = (((p0 * ww + p1) * ww + p2) * ww + p3) * ww + p4;
+        const double q = ((((ww + q0) * ww + q1) * ww + q2) * ww + q3) * ww + q4;
+        const double t = w * (ww * p / q) + w;
+        const double r = upper ? quarter + (t + 0.5 * low) : t;        /* atan z, in [0, pi/4] */
+        const double s = steep ? (half - r) + low : r;                  /* in [0, pi/2] */
+        const double u = copysign(1.0, xb) < 0 ? (2 * half - s) + 2 * low : s; /* in [0, pi] */
+        out[b] = (xb != xb) | (yb != yb) ? xb + yb : copysign(u, yb);
+    }
+}
+
 /* m = R(axis, angle) m for BLOCK matrices m[entry][frame]. */
 static MT_INLINE void rotate_left_block(double m[9][BLOCK], int axis, const double *s, const double *c)
 {

@@ -10,8 +10,13 @@ checked against the header by the tests) gives every ``lib`` function and
 constant its type.
 """
 
+import os
 import re
 import sys
+
+# Run as a script, this file's folder leads sys.path, where mtcore's signal.py would shadow the standard library's
+# signal (which subprocess, imported by pycparser, needs).
+sys.path = [p for p in sys.path if os.path.abspath(p or ".") != os.path.dirname(os.path.abspath(__file__))]
 
 import cffi
 from pycparser import c_ast, c_parser
