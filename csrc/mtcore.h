@@ -322,6 +322,15 @@ int mt_slerp(const double *q0, const double *q1, const double *t, size_t n, doub
 int mt_interpolate_rotvecs(const double *v0, const double *v1, const double *t, size_t n, int aligned,
                            double *out);
 
+/*
+ * The vectorised elementary functions of the rotation kernels, n values at a
+ * time: atan2(y, x) in radians, in [-pi, pi], within 2 ulp of pi of the C
+ * library's (the same at zeros of either sign and infinities, NaN for NaN);
+ * sin and cos of x within about 1e-16 for |x| < 2^30, the C library's beyond.
+ */
+int mt_atan2(const double *y, const double *x, size_t n, double *out);
+int mt_sincos(const double *x, size_t n, double *sin_out, double *cos_out);
+
 /* How mt_interpolate_euler goes from key 0 to key 1. */
 enum mt_blend {
     MT_BLEND_SLERP = 0,          /* mt_slerp of the keys' quaternions */

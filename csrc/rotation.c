@@ -7,9 +7,10 @@
  * conversions below use atan2 of well-conditioned pairs instead of acos and
  * asin, and series where a quotient tends to 0/0.
  *
- * Every conversion is a stage over BLOCK rotations at a time, each quantity
- * an array over the block (blocks.h), so that its loops vectorise, sin, cos
- * and atan2 included.  The entry points run one stage or a few over their
+ * Every conversion is a stage over LANES rotations at a time, each quantity
+ * an array over them (as in blocks.h), so that its loops vectorise, sin, cos
+ * and atan2 included; enough of them that the stages' long chains of
+ * dependent operations overlap.  The entry points run one stage or a few over their
  * arrays; mt_interpolate_euler runs them all, Euler keys to Euler angles, in
  * one pass.
  */
@@ -22,6 +23,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+
+enum { LANES = 32 };
 
 static const double pi = 3.14159265358979323846;
 
@@ -39,15 +42,15 @@ static int is_axis(int axis)
 
 /* Rows 0 .. m-1 of src (width values each) into the lanes of dst; the lanes past m repeat row m-1, so that
    every lane computes what a real row gives, and are not stored. */
-static MT_INLINE void load_block(const double *src, size_t width, size_t m, double (*dst)[BLOCK])
+static MT_INLINE void load_block(const double *src, size_t width, size_t m, double (*dst)[LANES])
 {
-    for (size_t l = 0; l < BLOCK; l++)
+    for (size_t l = 0; l < LANES; l++)
         for (size_t c = 0; c < width; c++)
             dst[c][l] = src[(l < m ? l : m - 1) * width + c];
 }
 
 /* Lanes 0 .. m-1 of src to rows of width values of dst. */
-static MT_INLINE void store_block(double (*src)[BLOCK], size_t width, size_t m, double *dst)
+static MT_INLINE void store_block(double (*src)[LANES], size_t width, size_t m, double *dst)
 {
     for (size_t l = 0; l < m; l++)
         for (size_t c = 0; c < width; c++)
@@ -91,6 +94,46 @@ int mt_euler_to_matrices(const double *angles, size_t n, const int *axes, size_t
     return MT_OK;
 }
 
+static MT_CLONES void atan2_n(const double *y, const double *x, size_t n, double *out)
+{
+    for (size_t f0 = 0; f0 < n; f0 += LANES) {
+        const size_t lanes = n - f0 < LANES ? n - f0 : LANES;
+        double a[1][LANES], b[1][LANES], c[1][LANES];
+        load_block(y + f0, 1, lanes, a);
+        load_block(x + f0, 1, lanes, b);
+        atan2_lanes(a[0], b[0], c[0], LANES);
+        store_block(c, 1, lanes, out + f0);
+    }
+}
+
+int mt_atan2(const double *y, const double *x, size_t n, double *out)
+{
+    if (n > 0 && (y == NULL || x == NULL || out == NULL))
+        return MT_EINVAL;
+    atan2_n(y, x, n, out);
+    return MT_OK;
+}
+
+static MT_CLONES void sincos_n(const double *x, size_t n, double *sin_out, double *cos_out)
+{
+    for (size_t f0 = 0; f0 < n; f0 += LANES) {
+        const size_t lanes = n - f0 < LANES ? n - f0 : LANES;
+        double a[1][LANES], s[1][LANES], c[1][LANES];
+        load_block(x + f0, 1, lanes, a);
+        sincos_lanes(a[0], s[0], c[0], LANES);
+        store_block(s, 1, lanes, sin_out + f0);
+        store_block(c, 1, lanes, cos_out + f0);
+    }
+}
+
+int mt_sincos(const double *x, size_t n, double *sin_out, double *cos_out)
+{
+    if (n > 0 && (x == NULL || sin_out == NULL || cos_out == NULL))
+        return MT_EINVAL;
+    sincos_n(x, n, sin_out, cos_out);
+    return MT_OK;
+}
+
 /*
  * A convention of three Euler angles, Tait-Bryan or proper, and what solving
  * a matrix for its angles takes of it.
@@ -128,20 +171,20 @@ static int convention(const int *axes, int intrinsic, double scale, struct conve
 
 /* The unit quaternions of Euler angles (in units of the convention): the product of the quaternions
    (cos h, sin h axis) of the half angles h, each applied on the left, as the matrices of euler_block. */
-static MT_INLINE void euler_quaternion_block(double angles[3][BLOCK], const struct convention *cv,
-                                             double q[4][BLOCK])
+static MT_INLINE void euler_quaternion_block(double angles[3][LANES], const struct convention *cv,
+                                             double q[4][LANES])
 {
-    double h[BLOCK], sn[BLOCK], cs[BLOCK];
-    for (int l = 0; l < BLOCK; l++)
+    double h[LANES], sn[LANES], cs[LANES];
+    for (int l = 0; l < LANES; l++)
         q[0][l] = 1, q[1][l] = 0, q[2][l] = 0, q[3][l] = 0;
     for (int step = 0; step < 3; step++) {
         const int a = cv->intrinsic ? 2 - step : step, axis = cv->axes[a];
         /* (cos h, sin h e) (w, v) = (w cos h - v.e sin h, v cos h + e w sin h + e x v sin h) */
         double *w = q[0], *va = q[1 + axis], *vb = q[1 + (axis + 1) % 3], *vd = q[1 + (axis + 2) % 3];
-        for (int l = 0; l < BLOCK; l++)
+        for (int l = 0; l < LANES; l++)
             h[l] = angles[a][l] * cv->scale * 0.5;
-        sincos_block(h, sn, cs);
-        for (int l = 0; l < BLOCK; l++) {
+        sincos_lanes(h, sn, cs, LANES);
+        for (int l = 0; l < LANES; l++) {
             const double w0 = w[l], a0 = va[l], b0 = vb[l], d0 = vd[l];
             w[l] = cs[l] * w0 - sn[l] * a0;
             va[l] = cs[l] * a0 + sn[l] * w0;
@@ -152,9 +195,9 @@ static MT_INLINE void euler_quaternion_block(double angles[3][BLOCK], const stru
 }
 
 /* The matrices of quaternions, normalised. */
-static MT_INLINE void quaternion_matrix_block(double q[4][BLOCK], double m[9][BLOCK])
+static MT_INLINE void quaternion_matrix_block(double q[4][LANES], double m[9][LANES])
 {
-    for (int l = 0; l < BLOCK; l++) {
+    for (int l = 0; l < LANES; l++) {
         const double w = q[0][l], x = q[1][l], y = q[2][l], z = q[3][l];
         const double s = 2 / (w * w + x * x + y * y + z * z);
         m[0][l] = 1 - s * (y * y + z * z), m[1][l] = s * (x * y - w * z), m[2][l] = s * (x * z + w * y);
@@ -164,7 +207,7 @@ static MT_INLINE void quaternion_matrix_block(double q[4][BLOCK], double m[9][BL
 }
 
 /* The Euler angles (in units of the convention) of matrices; see struct convention. */
-static MT_INLINE void matrix_euler_block(double m[9][BLOCK], const struct convention *cv, double out[3][BLOCK])
+static MT_INLINE void matrix_euler_block(double m[9][LANES], const struct convention *cv, double out[3][LANES])
 {
 #define R(u, v) m[cv->intrinsic ? 3 * (v) + (u) : 3 * (u) + (v)]
     const int i = cv->i, j = cv->j, k = cv->k, o = cv->o;
@@ -172,31 +215,31 @@ static MT_INLINE void matrix_euler_block(double m[9][BLOCK], const struct conven
     const double *rki = R(k, i), *rkj = R(k, j), *rkk = R(k, k), *roj = R(o, j), *rok = R(o, k);
 #undef R
     const double e = cv->e, f = cv->f, s = cv->s, unit = s / cv->scale;
-    double b[BLOCK], y[BLOCK], x[BLOCK], h[BLOCK], num[BLOCK], den[BLOCK], a[BLOCK], c[BLOCK];
+    double b[LANES], y[LANES], x[LANES], h[LANES], num[LANES], den[LANES], a[LANES], c[LANES];
     if (cv->proper) {
-        for (int l = 0; l < BLOCK; l++) {
+        for (int l = 0; l < LANES; l++) {
             num[l] = sqrt(rij[l] * rij[l] + rik[l] * rik[l]), den[l] = rii[l];
             y[l] = s * rji[l], x[l] = -s * e * rki[l];
         }
-        atan2_block(num, den, b);
-        for (int l = 0; l < BLOCK; l++)
+        atan2_lanes(num, den, b, LANES);
+        for (int l = 0; l < LANES; l++)
             b[l] *= s;
     } else {
-        for (int l = 0; l < BLOCK; l++) {
+        for (int l = 0; l < LANES; l++) {
             num[l] = -e * rki[l], den[l] = sqrt(rkj[l] * rkj[l] + rkk[l] * rkk[l]);
             y[l] = e * rji[l], x[l] = rii[l];
         }
-        atan2_block(num, den, b);
+        atan2_lanes(num, den, b, LANES);
     }
-    for (int l = 0; l < BLOCK; l++) {
+    for (int l = 0; l < LANES; l++) {
         h[l] = sqrt(x[l] * x[l] + y[l] * y[l]);
         const int lock = h[l] <= gimbal_lock;
-        const double k = 1 / h[l], cc = lock ? 1.0 : x[l] * k, sc = lock ? 0.0 : y[l] * k;
+        const double inverse = 1 / h[l], cc = lock ? 1.0 : x[l] * inverse, sc = lock ? 0.0 : y[l] * inverse;
         num[l] = -e * (cc * rjk[l] + f * sc * rok[l]), den[l] = cc * rjj[l] + f * sc * roj[l];
     }
-    atan2_block(num, den, a);
-    atan2_block(y, x, c);
-    for (int l = 0; l < BLOCK; l++) {
+    atan2_lanes(num, den, a, LANES);
+    atan2_lanes(y, x, c, LANES);
+    for (int l = 0; l < LANES; l++) {
         out[0][l] = a[l] * unit;
         out[1][l] = b[l] * unit;
         out[2][l] = h[l] <= gimbal_lock ? 0.0 : c[l] * unit;
@@ -205,9 +248,9 @@ static MT_INLINE void matrix_euler_block(double m[9][BLOCK], const struct conven
 
 static MT_CLONES void matrices_euler(const double *m, size_t n, const struct convention *cv, double *angles)
 {
-    for (size_t f0 = 0; f0 < n; f0 += BLOCK) {
-        const size_t lanes = n - f0 < BLOCK ? n - f0 : BLOCK;
-        double r[9][BLOCK], out[3][BLOCK];
+    for (size_t f0 = 0; f0 < n; f0 += LANES) {
+        const size_t lanes = n - f0 < LANES ? n - f0 : LANES;
+        double r[9][LANES], out[3][LANES];
         load_block(m + 9 * f0, 9, lanes, r);
         matrix_euler_block(r, cv, out);
         store_block(out, 3, lanes, angles + 3 * f0);
@@ -254,9 +297,9 @@ int mt_matrices_to_quaternions(const double *m, size_t n, double *q)
 
 static MT_CLONES void quaternions_matrices(const double *q, size_t n, double *m)
 {
-    for (size_t f0 = 0; f0 < n; f0 += BLOCK) {
-        const size_t lanes = n - f0 < BLOCK ? n - f0 : BLOCK;
-        double in[4][BLOCK], out[9][BLOCK];
+    for (size_t f0 = 0; f0 < n; f0 += LANES) {
+        const size_t lanes = n - f0 < LANES ? n - f0 : LANES;
+        double in[4][LANES], out[9][LANES];
         load_block(q + 4 * f0, 4, lanes, in);
         quaternion_matrix_block(in, out);
         store_block(out, 9, lanes, m + 9 * f0);
@@ -273,15 +316,15 @@ int mt_quaternions_to_matrices(const double *q, size_t n, double *m)
 
 /* The quaternions of rotation vectors, w of either sign: (cos(x/2), v sin(x/2) / x), x = |v|, by the series
    of sin(x/2) / x where it tends to 0/0 (the next term, x^4/3840, is below an ulp). */
-static MT_INLINE void exp_map_block(double v[3][BLOCK], double q[4][BLOCK])
+static MT_INLINE void exp_map_block(double v[3][LANES], double q[4][LANES])
 {
-    double angle[BLOCK], half[BLOCK], sn[BLOCK], cs[BLOCK];
-    for (int l = 0; l < BLOCK; l++) {
+    double angle[LANES], half[LANES], sn[LANES], cs[LANES];
+    for (int l = 0; l < LANES; l++) {
         angle[l] = sqrt(v[0][l] * v[0][l] + v[1][l] * v[1][l] + v[2][l] * v[2][l]);
         half[l] = angle[l] / 2;
     }
-    sincos_block(half, sn, cs);
-    for (int l = 0; l < BLOCK; l++) {
+    sincos_lanes(half, sn, cs, LANES);
+    for (int l = 0; l < LANES; l++) {
         const double x = angle[l], k = x < 1e-4 ? 0.5 - x * x / 48 : sn[l] / x;
         q[0][l] = cs[l], q[1][l] = k * v[0][l], q[2][l] = k * v[1][l], q[3][l] = k * v[2][l];
     }
@@ -289,12 +332,12 @@ static MT_INLINE void exp_map_block(double v[3][BLOCK], double q[4][BLOCK])
 
 static MT_CLONES void rotvecs_quaternions(const double *v, size_t n, double *q)
 {
-    for (size_t f0 = 0; f0 < n; f0 += BLOCK) {
-        const size_t lanes = n - f0 < BLOCK ? n - f0 : BLOCK;
-        double in[3][BLOCK], out[4][BLOCK];
+    for (size_t f0 = 0; f0 < n; f0 += LANES) {
+        const size_t lanes = n - f0 < LANES ? n - f0 : LANES;
+        double in[3][LANES], out[4][LANES];
         load_block(v + 3 * f0, 3, lanes, in);
         exp_map_block(in, out);
-        for (int l = 0; l < BLOCK; l++) {
+        for (int l = 0; l < LANES; l++) {
             const double sign = out[0][l] < 0 ? -1.0 : 1.0; /* angles past pi */
             for (int c = 0; c < 4; c++)
                 out[c][l] *= sign;
@@ -317,15 +360,15 @@ int mt_rotvecs_to_quaternions(const double *v, size_t n, double *q)
  * and asin(|xyz|) are not; v = xyz 2h / (|q| sin h), h / sin h by its series
  * where it tends to 0/0 (the next term, 7 h^4 / 360, is below an ulp).
  */
-static MT_INLINE void rotvec_block(double q[4][BLOCK], double v[3][BLOCK])
+static MT_INLINE void rotvec_block(double q[4][LANES], double v[3][LANES])
 {
-    double xyz[BLOCK], w[BLOCK], h[BLOCK];
-    for (int l = 0; l < BLOCK; l++) {
+    double xyz[LANES], w[LANES], h[LANES];
+    for (int l = 0; l < LANES; l++) {
         xyz[l] = sqrt(q[1][l] * q[1][l] + q[2][l] * q[2][l] + q[3][l] * q[3][l]);
         w[l] = fabs(q[0][l]);
     }
-    atan2_block(xyz, w, h);
-    for (int l = 0; l < BLOCK; l++) {
+    atan2_lanes(xyz, w, h, LANES);
+    for (int l = 0; l < LANES; l++) {
         const double norm = sqrt(q[0][l] * q[0][l] + xyz[l] * xyz[l]);
         const double k = h[l] < 1e-4 ? 2 * (1 + h[l] * h[l] / 6) / norm : 2 * h[l] / xyz[l];
         const double sign = q[0][l] < 0 ? -1.0 : 1.0;
@@ -336,9 +379,9 @@ static MT_INLINE void rotvec_block(double q[4][BLOCK], double v[3][BLOCK])
 
 static MT_CLONES void quaternions_rotvecs(const double *q, size_t n, double *v)
 {
-    for (size_t f0 = 0; f0 < n; f0 += BLOCK) {
-        const size_t lanes = n - f0 < BLOCK ? n - f0 : BLOCK;
-        double in[4][BLOCK], out[3][BLOCK];
+    for (size_t f0 = 0; f0 < n; f0 += LANES) {
+        const size_t lanes = n - f0 < LANES ? n - f0 : LANES;
+        double in[4][LANES], out[3][LANES];
         load_block(q + 4 * f0, 4, lanes, in);
         rotvec_block(in, out);
         store_block(out, 3, lanes, v + 3 * f0);
@@ -449,10 +492,10 @@ int mt_unroll_euler(const double *in, size_t outer, size_t n, size_t inner, int 
 enum { PAIR_A = 0, PAIR_B = 4, PAIR_THETA = 8, PAIR_SIN = 9, PAIR_START = 0, PAIR_END = 3, PAIR = 10 };
 
 /* The pair of SLERP from q0 to q1 (any norm), along the shorter arc. */
-static MT_INLINE void slerp_pair_block(double q0[4][BLOCK], double q1[4][BLOCK], double pair[PAIR][BLOCK])
+static MT_INLINE void slerp_pair_block(double q0[4][LANES], double q1[4][LANES], double pair[PAIR][LANES])
 {
-    double lo[BLOCK], hi[BLOCK], cs[BLOCK];
-    for (int l = 0; l < BLOCK; l++) {
+    double lo[LANES], hi[LANES], cs[LANES];
+    for (int l = 0; l < LANES; l++) {
         const double n0 = sqrt(q0[0][l] * q0[0][l] + q0[1][l] * q0[1][l] + q0[2][l] * q0[2][l] + q0[3][l] * q0[3][l]);
         const double n1 = sqrt(q1[0][l] * q1[0][l] + q1[1][l] * q1[1][l] + q1[2][l] * q1[2][l] + q1[3][l] * q1[3][l]);
         const double dot = q0[0][l] * q1[0][l] + q0[1][l] * q1[1][l] + q0[2][l] * q1[2][l] + q0[3][l] * q1[3][l];
@@ -466,21 +509,21 @@ static MT_INLINE void slerp_pair_block(double q0[4][BLOCK], double q1[4][BLOCK],
         lo[l] = sqrt(diff), hi[l] = sqrt(sum);
     }
     /* the angle between a and b, accurate where acos(a . b) is not */
-    atan2_block(lo, hi, pair[PAIR_THETA]);
-    for (int l = 0; l < BLOCK; l++)
+    atan2_lanes(lo, hi, pair[PAIR_THETA], LANES);
+    for (int l = 0; l < LANES; l++)
         pair[PAIR_THETA][l] *= 2;
-    sincos_block(pair[PAIR_THETA], pair[PAIR_SIN], cs);
+    sincos_lanes(pair[PAIR_THETA], pair[PAIR_SIN], cs, LANES);
 }
 
-static MT_INLINE void slerp_blend_block(double pair[PAIR][BLOCK], const double *t, double q[4][BLOCK])
+static MT_INLINE void slerp_blend_block(double pair[PAIR][LANES], const double *t, double q[4][LANES])
 {
-    double x0[BLOCK], x1[BLOCK], s0[BLOCK], s1[BLOCK], cs[BLOCK];
+    double x0[LANES], x1[LANES], s0[LANES], s1[LANES], cs[LANES];
     const double *theta = pair[PAIR_THETA], *sin_theta = pair[PAIR_SIN];
-    for (int l = 0; l < BLOCK; l++)
+    for (int l = 0; l < LANES; l++)
         x0[l] = (1 - t[l]) * theta[l], x1[l] = t[l] * theta[l];
-    sincos_block(x0, s0, cs);
-    sincos_block(x1, s1, cs);
-    for (int l = 0; l < BLOCK; l++) {
+    sincos_lanes(x0, s0, cs, LANES);
+    sincos_lanes(x1, s1, cs, LANES);
+    for (int l = 0; l < LANES; l++) {
         const double th = theta[l], u = 1 - t[l], v = t[l], small = th < 1e-5;
         const double ka = small ? u * (1 + (1 - u * u) * th * th / 6) : s0[l] / sin_theta[l];
         const double kb = small ? v * (1 + (1 - v * v) * th * th / 6) : s1[l] / sin_theta[l];
@@ -491,9 +534,9 @@ static MT_INLINE void slerp_blend_block(double pair[PAIR][BLOCK], const double *
 
 static MT_CLONES void slerp(const double *q0, const double *q1, const double *t, size_t n, double *out)
 {
-    for (size_t f0 = 0; f0 < n; f0 += BLOCK) {
-        const size_t lanes = n - f0 < BLOCK ? n - f0 : BLOCK;
-        double a[4][BLOCK], b[4][BLOCK], pair[PAIR][BLOCK], u[1][BLOCK], q[4][BLOCK];
+    for (size_t f0 = 0; f0 < n; f0 += LANES) {
+        const size_t lanes = n - f0 < LANES ? n - f0 : LANES;
+        double a[4][LANES], b[4][LANES], pair[PAIR][LANES], u[1][LANES], q[4][LANES];
         load_block(q0 + 4 * f0, 4, lanes, a);
         load_block(q1 + 4 * f0, 4, lanes, b);
         load_block(t + f0, 1, lanes, u);
@@ -513,16 +556,16 @@ int mt_slerp(const double *q0, const double *q1, const double *t, size_t n, doub
 
 /* The rotation vector to interpolate from: v0, or when aligned and the keys' quaternions have a negative
    dot product, that of -q0. */
-static MT_INLINE void align_block(double v0[3][BLOCK], double v1[3][BLOCK], int aligned, double start[3][BLOCK])
+static MT_INLINE void align_block(double v0[3][LANES], double v1[3][LANES], int aligned, double start[3][LANES])
 {
     if (!aligned) {
         memcpy(start, v0, 3 * sizeof *start);
         return;
     }
-    double q0[4][BLOCK], q1[4][BLOCK];
+    double q0[4][LANES], q1[4][LANES];
     exp_map_block(v0, q0);
     exp_map_block(v1, q1);
-    for (int l = 0; l < BLOCK; l++) {
+    for (int l = 0; l < LANES; l++) {
         const double a0 = sqrt(v0[0][l] * v0[0][l] + v0[1][l] * v0[1][l] + v0[2][l] * v0[2][l]);
         const double a1 = sqrt(v1[0][l] * v1[0][l] + v1[1][l] * v1[1][l] + v1[2][l] * v1[2][l]);
         const int flip = q0[0][l] * q1[0][l] + q0[1][l] * q1[1][l] + q0[2][l] * q1[2][l] + q0[3][l] * q1[3][l] < 0;
@@ -534,10 +577,10 @@ static MT_INLINE void align_block(double v0[3][BLOCK], double v1[3][BLOCK], int 
     }
 }
 
-static MT_INLINE void lerp_block(double pair[PAIR][BLOCK], const double *t, double v[3][BLOCK])
+static MT_INLINE void lerp_block(double pair[PAIR][LANES], const double *t, double v[3][LANES])
 {
     for (int c = 0; c < 3; c++)
-        for (int l = 0; l < BLOCK; l++) {
+        for (int l = 0; l < LANES; l++) {
             const double start = pair[PAIR_START + c][l];
             v[c][l] = start + t[l] * (pair[PAIR_END + c][l] - start);
         }
@@ -546,9 +589,9 @@ static MT_INLINE void lerp_block(double pair[PAIR][BLOCK], const double *t, doub
 static MT_CLONES void interpolate_rotvecs(const double *v0, const double *v1, const double *t, size_t n,
                                           int aligned, double *out)
 {
-    for (size_t f0 = 0; f0 < n; f0 += BLOCK) {
-        const size_t lanes = n - f0 < BLOCK ? n - f0 : BLOCK;
-        double a[3][BLOCK], pair[PAIR][BLOCK], u[1][BLOCK], v[3][BLOCK];
+    for (size_t f0 = 0; f0 < n; f0 += LANES) {
+        const size_t lanes = n - f0 < LANES ? n - f0 : LANES;
+        double a[3][LANES], pair[PAIR][LANES], u[1][LANES], v[3][LANES];
         load_block(v0 + 3 * f0, 3, lanes, a);
         load_block(v1 + 3 * f0, 3, lanes, pair + PAIR_END);
         load_block(t + f0, 1, lanes, u);
@@ -568,10 +611,10 @@ int mt_interpolate_rotvecs(const double *v0, const double *v1, const double *t, 
 }
 
 /* The pair of blend (a mt_blend) of the key triples k0, k1. */
-static MT_INLINE void pair_block(double k0[3][BLOCK], double k1[3][BLOCK], const struct convention *cv, int blend,
-                                 double pair[PAIR][BLOCK])
+static MT_INLINE void pair_block(double k0[3][LANES], double k1[3][LANES], const struct convention *cv, int blend,
+                                 double pair[PAIR][LANES])
 {
-    double q0[4][BLOCK], q1[4][BLOCK], v0[3][BLOCK];
+    double q0[4][LANES], q1[4][LANES], v0[3][LANES];
     euler_quaternion_block(k0, cv, q0);
     euler_quaternion_block(k1, cv, q1);
     if (blend == MT_BLEND_SLERP) {
@@ -584,9 +627,9 @@ static MT_INLINE void pair_block(double k0[3][BLOCK], double k1[3][BLOCK], const
 }
 
 /* The quaternions (any sign) a fraction t of the way along the pairs' interpolations. */
-static MT_INLINE void blend_block(double pair[PAIR][BLOCK], const double *t, int blend, double q[4][BLOCK])
+static MT_INLINE void blend_block(double pair[PAIR][LANES], const double *t, int blend, double q[4][LANES])
 {
-    double v[3][BLOCK];
+    double v[3][LANES];
     if (blend == MT_BLEND_SLERP) {
         slerp_blend_block(pair, t, q);
         return;
@@ -599,9 +642,9 @@ static MT_INLINE void blend_block(double pair[PAIR][BLOCK], const double *t, int
 static MT_CLONES void key_pairs(const double *k0, const double *k1, size_t n, const struct convention *cv, int blend,
                                 double *pairs)
 {
-    for (size_t j0 = 0; j0 < n; j0 += BLOCK) {
-        const size_t lanes = n - j0 < BLOCK ? n - j0 : BLOCK;
-        double a[3][BLOCK], b[3][BLOCK], pair[PAIR][BLOCK];
+    for (size_t j0 = 0; j0 < n; j0 += LANES) {
+        const size_t lanes = n - j0 < LANES ? n - j0 : LANES;
+        double a[3][LANES], b[3][LANES], pair[PAIR][LANES];
         load_block(k0 + 3 * j0, 3, lanes, a);
         load_block(k1 + 3 * j0, 3, lanes, b);
         pair_block(a, b, cv, blend, pair);
@@ -622,8 +665,8 @@ struct interpolation {
 /*
  * Lanes lo .. hi-1 of res: of the triples equal to cur, the nearest prev (mt_unroll_euler's step).
  */
-static MT_INLINE void path_lanes(double prev[3][BLOCK], double cur[3][BLOCK], size_t lo, size_t hi,
-                                 const struct unroll_rule *rule, double res[3][BLOCK])
+static MT_INLINE void path_lanes(double prev[3][LANES], double cur[3][LANES], size_t lo, size_t hi,
+                                 const struct unroll_rule *rule, double res[3][LANES])
 {
     for (size_t l = lo; l < hi; l++) {
         const double p[3] = {prev[0][l], prev[1][l], prev[2][l]}, c[3] = {cur[0][l], cur[1][l], cur[2][l]};
@@ -634,30 +677,30 @@ static MT_INLINE void path_lanes(double prev[3][BLOCK], double cur[3][BLOCK], si
 }
 
 /*
- * The items (frame, joint) in order, BLOCK at a time: keys to their pair (or the pair of the joint), the
+ * The items (frame, joint) in order, LANES at a time: keys to their pair (or the pair of the joint), the
  * blend at the frame's t, its Euler angles, then the continuity chosen.  Along a path an item follows the
- * output of the item `joints` before it, which a block holds itself when joints < BLOCK: the lanes then
+ * output of the item `joints` before it, which a block holds itself when joints < LANES: the lanes then
  * go in groups of `joints`.
  */
 static MT_CLONES void interpolate_euler(const struct interpolation *job, double *out)
 {
     const size_t joints = job->joints, items = job->frames * joints;
     const struct unroll_rule rule = euler_rule(job->cv.proper, job->half_turn);
-    for (size_t g0 = 0; g0 < items; g0 += BLOCK) {
-        const size_t m = items - g0 < BLOCK ? items - g0 : BLOCK;
-        size_t joint[BLOCK];
-        double pair[PAIR][BLOCK], t[BLOCK], q[4][BLOCK], r[9][BLOCK], angles[3][BLOCK], res[3][BLOCK];
-        for (size_t l = 0, f = g0 / joints, j = g0 % joints; l < BLOCK; l++) {
+    for (size_t g0 = 0; g0 < items; g0 += LANES) {
+        const size_t m = items - g0 < LANES ? items - g0 : LANES;
+        size_t joint[LANES];
+        double pair[PAIR][LANES], t[LANES], q[4][LANES], r[9][LANES], angles[3][LANES], res[3][LANES];
+        for (size_t l = 0, f = g0 / joints, j = g0 % joints; l < LANES; l++) {
             joint[l] = j, t[l] = job->t[f];
             if (l + 1 < m && ++j == joints)
                 j = 0, f++;
         }
         if (job->pairs != NULL) {
-            for (size_t l = 0; l < BLOCK; l++)
+            for (size_t l = 0; l < LANES; l++)
                 for (int p = 0; p < PAIR; p++)
                     pair[p][l] = job->pairs[joint[l] * PAIR + p];
         } else {
-            double k0[3][BLOCK], k1[3][BLOCK];
+            double k0[3][LANES], k1[3][LANES];
             load_block(job->k0 + 3 * g0, 3, m, k0);
             load_block(job->k1 + 3 * g0, 3, m, k1);
             pair_block(k0, k1, &job->cv, job->blend, pair);
@@ -666,13 +709,13 @@ static MT_CLONES void interpolate_euler(const struct interpolation *job, double 
         quaternion_matrix_block(q, r);
         matrix_euler_block(r, &job->cv, angles);
         if (job->continuity == MT_CONTINUITY_REFERENCE) {
-            double ref[3][BLOCK];
+            double ref[3][LANES];
             load_block(job->reference + 3 * g0, 3, m, ref);
             for (int c = 0; c < 3; c++)
-                for (int l = 0; l < BLOCK; l++)
+                for (int l = 0; l < LANES; l++)
                     res[c][l] = nearest(angles[c][l], ref[c][l], 2 * job->half_turn);
         } else if (job->continuity == MT_CONTINUITY_PATH) {
-            double prev[3][BLOCK];
+            double prev[3][LANES];
             for (size_t lo = 0; lo < m; lo += joints) {
                 const size_t hi = m - lo < joints ? m : lo + joints;
                 for (size_t l = lo; l < hi; l++)

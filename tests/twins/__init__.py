@@ -305,6 +305,38 @@ def rotvec_interpolation_cases(rng: np.random.Generator) -> list[tuple]:
     return out + [(np.zeros(3), np.array([0.0, 0, 3.5]), 0.5, True)]
 
 
+def atan2_cases(rng: np.random.Generator) -> list[tuple]:
+    special = np.array([0.0, -0.0, np.inf, -np.inf, np.nan, 1.0, -1.0, 5e-324, 1e308])
+    grid = tuple(g.ravel() for g in np.meshgrid(special, special))
+    sizes = [(rng.standard_normal((2, n)) * 10.0 ** rng.uniform(-300, 300, (2, n))) for n in (0, 1, 31, 32, 33, 100)]
+    return [grid, *((y, x) for y, x in sizes)]
+
+
+def fast_atan2(y, x):
+    from mtcore._cdata import c_array
+    from mtcore._mtcore import lib
+
+    y, x = np.ascontiguousarray(y, float), np.ascontiguousarray(x, float)
+    out = np.empty_like(y)
+    assert lib.mt_atan2(c_array(y), c_array(x), y.size, c_array(out)) == 0
+    return out
+
+
+def sincos_cases(rng: np.random.Generator) -> list[tuple]:
+    special = np.array([0.0, -0.0, np.inf, -np.inf, np.nan, 5e-324, 2.0**30, 1e300])
+    return [(special,), *((rng.uniform(-s, s, n),) for s, n in ((1, 0), (10, 1), (1e4, 33), (1e9, 100)))]
+
+
+def fast_sincos(x):
+    from mtcore._cdata import c_array
+    from mtcore._mtcore import lib
+
+    x = np.ascontiguousarray(x, float)
+    s, c = np.empty_like(x), np.empty_like(x)
+    assert lib.mt_sincos(c_array(x), x.size, c_array(s), c_array(c)) == 0
+    return s, c
+
+
 def interpolate_euler_cases(rng: np.random.Generator) -> list[tuple]:
     """Keys for every frame or one per joint, 0 to 9 joints (a block of lanes is 8), each blend and
     continuity, Tait-Bryan and proper, degrees and radians; middle angles kept off gimbal lock,
@@ -519,6 +551,8 @@ TWINS: dict[str, Twin] = {
         rotvec_interpolation_cases,
         close(1e-14),
     ),
+    "mt_atan2": Twin(fast_atan2, np.arctan2, atan2_cases, close(4.5e-16)),
+    "mt_sincos": Twin(fast_sincos, rotations.sincos, sincos_cases, close(2.3e-16)),
     "mt_interpolate_euler": Twin(
         fast_interpolate_euler, rotations.interpolate_euler, interpolate_euler_cases, close(1e-12)
     ),

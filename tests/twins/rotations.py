@@ -240,3 +240,9 @@ def interpolate_euler(k0, k1, t, order: str, extrinsic: bool, degrees: bool, ble
     if reference is not None:
         return angles + turn * np.round((np.asarray(reference, dtype=float) - angles) / turn)
     return angles
+
+
+def sincos(x) -> tuple[np.ndarray, np.ndarray]:
+    """numpy's sin and cos (NaN for infinities, quietly)."""
+    with np.errstate(invalid="ignore"):
+        return np.sin(x), np.cos(x)
