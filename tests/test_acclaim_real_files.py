@@ -93,7 +93,11 @@ def test_latin1_header_survives_a_round_trip(data_dir, tmp_path):
 def test_edge_file_skeleton(data_dir):
     """A non-CMU file: tabs, 'length m', non-unit directions, hierarchy out of order."""
     skeleton = mt.read_asf(data_dir / "edge" / "test.asf")
-    assert skeleton.meters_per_unit == 1.0
+    # it says metres, but its numbers are millimetres (a 1.58 m person, not a 1582 m one): the
+    # stated text stays, for writing back, and the unit in effect is the detected one
+    assert skeleton.unit("length") == "m"
+    assert skeleton.length_unit == "mm" and skeleton.length_source == "detected"
+    assert skeleton.meters_per_unit == 0.001
     assert skeleton.unit("mass") == "kg"
     assert skeleton.documentation == ("fps:30",)
     head = skeleton.bone("Head")

@@ -1,4 +1,6 @@
-"""ASF/AMC <-> BVH conversions: forward kinematics gives the same points."""
+"""ASF/AMC <-> BVH conversions: forward kinematics gives the same points, units go with the motion."""
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -7,52 +9,184 @@ import motiontheater as mt
 from conftest import ids, real_files
 from motiontheater.cli import main
 
-BVHS = [p for p in real_files("*/*.bvh")]
+BVHS = real_files("*/*.bvh")
 AMCS = real_files("*/*.amc")
+# one take of each source (CMU, HDM05, the non-CMU edge file) goes through files both ways
+FILE_TRIPS = [p for p in AMCS if p.name in ("02_01.amc", "HDM_bd_hopBothLegs1hops_005_120.amc", "test.amc")]
+TRANSLATIONS = ("tx", "ty", "tz")
 
 
-def asf_end_points_in_bvh(asf_motion, bvh_motion):
-    """BVH point index of each ASF joint's end: the root, a child joint's start, or an End Site."""
-    skeleton, names = asf_motion.skeleton, bvh_motion.skeleton.point_names
-    index = []
-    for joint in skeleton.joint_names:
+def asf_end_points_in_bvh(asf_skeleton, bvh_skeleton):
+    """BVH point index of each ASF joint's end: the root, a child joint's start, or ``<bone>_End`` (an
+    End Site, or the joint of position channels that ends a bone with translation dofs)."""
+    names, index = bvh_skeleton.point_names, []
+    for joint in asf_skeleton.joint_names:
         if joint == "root":
             index.append(0)
         else:
-            children = skeleton.children(joint)
+            children = asf_skeleton.children(joint)
             index.append(names.index(children[0] if children else f"{joint}_End"))
     return index
 
 
+def bvh_points_in_asf(bvh_skeleton, asf_skeleton):
+    """ASF point index of each BVH point: the bone named after the joint (spaces as '_') ends there."""
+    names = asf_skeleton.joint_names
+    return [0] + [names.index(n.replace(" ", "_")) for n in bvh_skeleton.point_names[1:]]
+
+
+def assert_same_points(actual, expected):
+    """Positions equal within 1e-9 of the motion's scale (its largest coordinate), NaN where NaN."""
+    scale = max(1.0, float(np.nanmax(np.abs(expected)))) if expected.size else 1.0
+    np.testing.assert_allclose(actual, expected, rtol=0, atol=1e-9 * scale)
+
+
+def amc_through_files(motion, folder, name="c"):
+    mt.write_asf(motion.skeleton, folder / f"{name}.asf")
+    mt.write_amc(motion, folder / f"{name}.amc")
+    return mt.read_amc(folder / f"{name}.amc", mt.read_asf(folder / f"{name}.asf"))
+
+
+def bvh_through_file(motion, folder, name="c", unit=None):
+    mt.write_bvh(motion, folder / f"{name}.bvh")
+    return mt.read_bvh(folder / f"{name}.bvh", unit=unit)
+
+
+def read_take(amc):
+    return mt.read_amc(amc, mt.read_asf(mt.skeleton_path_for(amc)))
+
+
+def every_joint_moves(motion, seed=0):
+    """A BVH variant with position channels on every joint, as Bandai Namco's dataset has them: the
+    offset itself, drifting a little, so that the channels matter."""
+    skeleton, rng = motion.skeleton, np.random.default_rng(seed)
+    bones = tuple(
+        b if b.end_site else replace(b, dofs=TRANSLATIONS + tuple(d for d in b.dofs if d not in TRANSLATIONS))
+        for b in skeleton.bones
+    )
+    root_turns = tuple(d for d in skeleton.root.order if d not in TRANSLATIONS)
+    moving = replace(skeleton, bones=bones, root=replace(skeleton.root, order=TRANSLATIONS + root_turns))
+    columns = []
+    for joint, dof in moving.channels:
+        if dof in TRANSLATIONS and not moving.is_root(joint):
+            offset = skeleton.bone(joint).direction[TRANSLATIONS.index(dof)]
+            columns.append(offset + 0.02 * offset * np.sin(np.arange(motion.frames) / 5 + rng.uniform(0, 6)))
+        else:
+            columns.append(motion.channel(joint, dof))
+    return mt.Motion(moving, np.column_stack(columns), frame_rate=motion.frame_rate)
+
+
+def stretching_bones(motion, seed=0):
+    """An ASF/AMC variant whose bones translate (tx ty tz) and stretch (l): a root child, a bone with a
+    turned axis, a middle bone and leaves."""
+    extra = {"lfemur": ("tx", "l"), "head": ("ty", "tz"), "rhumerus": ("l", "tx", "ty", "tz"), "ltoes": ("l",)}
+    extra["lowerback"] = ("tz",)
+    skeleton, rng = motion.skeleton, np.random.default_rng(seed)
+    bones = tuple(replace(b, dofs=b.dofs + extra.get(b.name, ()), limits=()) for b in skeleton.bones)
+    moving = replace(skeleton, bones=bones)
+    columns = []
+    for joint, dof in moving.channels:
+        if joint != "root" and dof in (*TRANSLATIONS, "l"):
+            columns.append(rng.uniform(-1, 1) + 0.5 * np.sin(np.arange(motion.frames) / 9 + rng.uniform(0, 6)))
+        else:
+            columns.append(motion.channel(joint, dof))
+    return mt.Motion(moving, np.column_stack(columns), frame_rate=motion.frame_rate)
+
+
 @pytest.mark.parametrize("amc", AMCS, ids=ids(AMCS))
 @pytest.mark.parametrize("order", ["ZXY", "XYZ"])
-def test_amc_to_bvh_keeps_every_point(amc, order, tmp_path):
-    motion = mt.read_amc(amc, mt.read_asf(mt.skeleton_path_for(amc)))
+def test_amc_to_bvh_and_back_keeps_every_point_and_the_unit(amc, order):
+    motion = read_take(amc)
     bvh = mt.to_bvh(motion, order)
-    mt.write_bvh(bvh, tmp_path / "c.bvh")
-    again = mt.read_bvh(tmp_path / "c.bvh")
     expected = motion.positions()
-    scale = np.abs(expected).max()
-    np.testing.assert_allclose(
-        again.positions()[:, asf_end_points_in_bvh(motion, again)], expected, rtol=0, atol=1e-6 * scale
-    )
+    assert_same_points(bvh.positions()[:, asf_end_points_in_bvh(motion.skeleton, bvh.skeleton)], expected)
+    back = mt.to_asf(bvh)
+    assert back.skeleton.units == motion.skeleton.units  # :units length 0.45 (or the edge file's "m") kept
+    assert bvh.skeleton.meters_per_unit == back.skeleton.meters_per_unit == motion.skeleton.meters_per_unit
+    points = bvh_points_in_asf(bvh.skeleton, back.skeleton)
+    assert_same_points(back.positions()[:, points][:, asf_end_points_in_bvh(motion.skeleton, bvh.skeleton)], expected)
+
+
+@pytest.mark.parametrize("amc", FILE_TRIPS, ids=ids(FILE_TRIPS))
+def test_amc_to_bvh_to_amc_through_files(amc, tmp_path):
+    """Through files the BVH needs its unit given (a BVH file states none); the AMC written at the
+    end says :units length as the first did, and every point is where it was, in metres too."""
+    motion = read_take(amc)
+    motion = motion.crop(motion.first_frame, min(motion.last_frame, motion.first_frame + 199))
+    unit = motion.skeleton.length_unit
+    bvh = bvh_through_file(mt.to_bvh(motion), tmp_path, unit=unit)
+    back = amc_through_files(mt.to_asf(bvh), tmp_path)
+    assert back.skeleton.unit("length") == unit
+    assert back.skeleton.meters_per_unit == motion.skeleton.meters_per_unit
+    points = bvh_points_in_asf(bvh.skeleton, back.skeleton)
+    ends = asf_end_points_in_bvh(motion.skeleton, bvh.skeleton)
+    assert_same_points(back.positions()[:, points][:, ends], motion.positions())
+    assert_same_points(back.positions(meters=True)[:, points][:, ends], motion.positions(meters=True))
 
 
 @pytest.mark.parametrize("bvh", BVHS, ids=ids(BVHS))
-def test_bvh_to_amc_keeps_every_point(bvh, tmp_path):
+@pytest.mark.parametrize("variant", ["as found", "every joint moves"])
+def test_every_bvh_to_amc_and_back_through_files(bvh, variant, tmp_path):
     motion = mt.read_bvh(bvh)
-    if any(set(b.dofs) & {"tx", "ty", "tz"} for b in motion.skeleton.bones):
-        pytest.skip("position channels below the root")
-    asf = mt.to_asf(motion)
-    mt.write_asf(asf.skeleton, tmp_path / "c.asf")
-    mt.write_amc(asf, tmp_path / "c.amc")
-    again = mt.read_amc(tmp_path / "c.amc", mt.read_asf(tmp_path / "c.asf"))
+    if variant == "every joint moves":
+        motion = bvh_through_file(every_joint_moves(motion.crop(1, min(motion.frames, 60))), tmp_path, "moving")
+        assert motion.skeleton.length_unit == mt.read_bvh(bvh).skeleton.length_unit  # the same size: the same unit
     expected = motion.positions()
-    names = again.skeleton.joint_names
-    index = [0] + [names.index(n.replace(" ", "_")) for n in motion.skeleton.point_names[1:]]
-    np.testing.assert_allclose(
-        again.positions()[:, index], expected, rtol=0, atol=1e-6 * max(1.0, np.abs(expected).max())
+    asf = amc_through_files(mt.to_asf(motion), tmp_path)
+    assert asf.skeleton.unit("length") == motion.skeleton.length_unit  # detected or assumed, now stated
+    points = bvh_points_in_asf(motion.skeleton, asf.skeleton)
+    assert_same_points(asf.positions()[:, points], expected)
+    assert_same_points(asf.positions(meters=True)[:, points], motion.positions(meters=True))
+    again = bvh_through_file(mt.to_bvh(asf), tmp_path, unit=asf.skeleton.length_unit)
+    assert_same_points(again.positions()[:, asf_end_points_in_bvh(asf.skeleton, again.skeleton)][:, points], expected)
+
+
+def test_bones_that_translate_and_stretch_convert_both_ways(data_dir, tmp_path):
+    motion = amc_through_files(stretching_bones(read_take(data_dir / "cmu" / "02_01.amc").crop(1, 120)), tmp_path)
+    assert motion.skeleton.bone("rhumerus").dofs == ("rx", "ry", "rz", "l", "tx", "ty", "tz")
+    bvh = bvh_through_file(mt.to_bvh(motion), tmp_path, unit="0.45")
+    # the leaf bone 'head' moves its end: a joint of position channels ends it, an End Site ends that
+    assert bvh.skeleton.dofs("head_End") == TRANSLATIONS and bvh.skeleton.bone("head_End_End").end_site
+    # the joint at the end of rhumerus (which translates) carries position channels; its twin does not
+    assert bvh.skeleton.dofs("rradius")[:3] == TRANSLATIONS and bvh.skeleton.dofs("lradius")[:3] != TRANSLATIONS
+    ends = asf_end_points_in_bvh(motion.skeleton, bvh.skeleton)
+    expected = motion.positions()
+    assert_same_points(bvh.positions()[:, ends], expected)
+    back = amc_through_files(mt.to_asf(bvh), tmp_path, "back")
+    assert_same_points(back.positions()[:, bvh_points_in_asf(bvh.skeleton, back.skeleton)][:, ends], expected)
+
+
+def test_position_channels_become_the_change_from_the_offset(data_dir):
+    """Where a BVH repeats its offsets in its position channels (Bandai Namco's files), the ASF's
+    translation dofs are zero and its rest pose is the BVH's."""
+    walk = mt.read_bvh(data_dir / "bvh" / "walk01.bvh").crop(1, 10)
+    moving = every_joint_moves(walk)
+    still = moving.replace(
+        values=np.column_stack(
+            [
+                np.full(walk.frames, moving.skeleton.bone(j).direction[TRANSLATIONS.index(d)])
+                if d in TRANSLATIONS and not moving.skeleton.is_root(j)
+                else moving.channel(j, d)
+                for j, d in moving.skeleton.channels
+            ]
+        )
     )
+    asf = mt.to_asf(still)
+    shifts = [c for c, (j, d) in enumerate(asf.skeleton.channels) if j != "root" and d in TRANSLATIONS]
+    assert shifts and not asf.values[:, shifts].any()
+    rest = asf.skeleton.rest_positions()[bvh_points_in_asf(walk.skeleton, asf.skeleton)]
+    bvh_rest = walk.skeleton.rest_positions()
+    np.testing.assert_allclose(rest - rest[0], bvh_rest - bvh_rest[0], rtol=0, atol=1e-12)  # up to the root's place
+    assert_same_points(asf.positions()[:, bvh_points_in_asf(walk.skeleton, asf.skeleton)], walk.positions())
+
+
+def test_a_bvh_unit_goes_into_the_asf(data_dir):
+    zombie = mt.read_bvh(data_dir / "bvh" / "zombie.bvh")
+    asf = mt.to_asf(zombie)
+    assert asf.skeleton.units == (("mass", "1.0"), ("length", "in"), ("angle", "deg"))
+    assert asf.skeleton.length_source == "detected"  # until written: a written ASF states it
+    given = mt.to_asf(mt.read_bvh(data_dir / "bvh" / "zombie.bvh", unit="0.45"))
+    assert given.skeleton.unit("length") == "0.45" and given.skeleton.meters_per_unit == 0.0254 / 0.45
 
 
 def test_convert_command(data_dir, tmp_path, capsys):
@@ -68,25 +202,33 @@ def test_convert_command(data_dir, tmp_path, capsys):
         )
         == 0
     )
-    assert main(["convert", str(tmp_path / "w.bvh"), str(tmp_path / "w.amc")]) == 0
+    captured = capsys.readouterr()
+    # a CMU character is 27 units tall: as a BVH its size tells no unit, so the command says how to read it
+    assert f"read {tmp_path / 'w.bvh'} with --unit 0.45" in captured.err
+    assert main(["convert", str(tmp_path / "w.bvh"), str(tmp_path / "w.amc"), "--unit", "0.45"]) == 0
     out = capsys.readouterr().out
     assert f"343 frames in {tmp_path / 'w.amc'} and its skeleton {tmp_path / 'w.asf'}" in out
     original = mt.read_amc(data_dir / "cmu" / "02_01.amc", mt.read_asf(data_dir / "cmu" / "02.asf"))
     back = mt.read_amc(tmp_path / "w.amc", mt.read_asf(tmp_path / "w.asf"))
     assert back.frames == 343
+    assert "  length 0.45\n" in (tmp_path / "w.asf").read_text()
     # there and back: every ASF joint's end is at the same point
     bvh = mt.read_bvh(tmp_path / "w.bvh")
-    names = back.skeleton.joint_names
-    index = [0] + [names.index(n.replace(" ", "_")) for n in bvh.skeleton.point_names[1:]]
     expected = original.positions()
-    np.testing.assert_allclose(
-        back.positions()[:, index][:, asf_end_points_in_bvh(original, bvh)],
-        expected,
-        rtol=0,
-        atol=1e-6 * np.abs(expected).max(),
-    )
+    ends = asf_end_points_in_bvh(original.skeleton, bvh.skeleton)
+    assert_same_points(back.positions()[:, bvh_points_in_asf(bvh.skeleton, back.skeleton)][:, ends], expected)
     assert main(["convert", str(tmp_path / "w.bvh"), str(tmp_path / "w.txt")]) == 2
     assert "w.txt: a take's file name must end in .amc or .bvh" in capsys.readouterr().err
+
+
+def test_convert_command_says_when_a_unit_was_assumed(data_dir, tmp_path, capsys):
+    assert main(["convert", str(data_dir / "bvh" / "sinusoidal.bvh"), "-o", str(tmp_path / "s.amc")]) == 0
+    err = capsys.readouterr().err
+    assert "the length unit of the input was assumed (cm)" in err and "--unit UNIT" in err
+    assert main(["convert", str(data_dir / "bvh" / "walk01.bvh"), "-o", str(tmp_path / "w.amc")]) == 0
+    assert capsys.readouterr().err == ""  # detected, and nothing to say
+    assert main(["median", str(data_dir / "bvh" / "sinusoidal.bvh"), "--size", "3", "-o", str(tmp_path / "s.bvh")]) == 0
+    assert capsys.readouterr().err == ""  # a BVH in, a BVH out: its unit, assumed again, matters to neither
 
 
 def test_bad_order():

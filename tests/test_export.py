@@ -16,8 +16,8 @@ def test_csv(motion, tmp_path):
     mt.write_positions(motion, tmp_path / "p.csv")
     lines = (tmp_path / "p.csv").read_text().splitlines()
     header = lines[0].split(",")
-    assert header[:5] == ["frame", "time", "root.x", "root.y", "root.z"]
-    assert header[-1] == f"{motion.skeleton.bone_names[-1]}.z"
+    assert header[:5] == ["frame", "time [s]", "root.x [in/0.45]", "root.y [in/0.45]", "root.z [in/0.45]"]
+    assert header[-1] == f"{motion.skeleton.bone_names[-1]}.z [in/0.45]"
     table = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
     assert table.shape == (motion.frames, 2 + 3 * 31)
     np.testing.assert_array_equal(table[:, 0], np.arange(1, motion.frames + 1))
@@ -79,3 +79,39 @@ def test_positions_command_fails_cleanly(data_dir, tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("motiontheater positions: ") and "test.amc, line 4: unknown bone 'Head'" in err
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_bvh_headers_carry_its_detected_unit(data_dir, tmp_path):
+    walk = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")  # 185 units tall: centimetres
+    mt.write_positions(walk, tmp_path / "w.trc")
+    assert (tmp_path / "w.trc").read_text().split("\n")[2].split("\t")[4] == "cm"
+    mt.write_positions(walk, tmp_path / "w.csv")
+    assert (tmp_path / "w.csv").read_text().split("\n")[0].split(",")[2] == "root.x [cm]"
+    mt.write_positions(walk, tmp_path / "w.npz")
+    data = np.load(tmp_path / "w.npz")
+    assert data["meters_per_unit"] == 0.01 and str(data["length_unit"]) == "cm"
+    zombie = mt.read_bvh(data_dir / "bvh" / "zombie.bvh")  # 45 units tall along z: inches
+    mt.write_positions(zombie, tmp_path / "z.trc")
+    assert (tmp_path / "z.trc").read_text().split("\n")[2].split("\t")[4] == "in"
+
+
+def test_converted_motions_keep_their_unit_in_headers(motion, tmp_path):
+    bvh = mt.to_bvh(motion)  # CMU's inch/0.45 goes with it
+    mt.write_positions(bvh, tmp_path / "b.csv")
+    assert (tmp_path / "b.csv").read_text().split("\n")[0].split(",")[2] == "root.x [in/0.45]"
+    with pytest.raises(ValueError, match="TRC needs a named length unit"):
+        mt.write_positions(bvh, tmp_path / "b.trc")
+    mt.write_positions(bvh, tmp_path / "b.trc", meters=True)
+    table = np.loadtxt(tmp_path / "b.trc", skiprows=6)
+    np.testing.assert_allclose(table[:, 2:5], motion.positions(meters=True)[:, 0], rtol=1e-9)
+
+
+def test_positions_command_takes_a_unit(data_dir, tmp_path, capsys):
+    out = tmp_path / "walk.trc"
+    assert main(["positions", str(data_dir / "bvh" / "walk01.bvh"), "-o", str(out), "--unit", "mm"]) == 0
+    assert out.read_text().split("\n")[2].split("\t")[4] == "mm"
+    assert capsys.readouterr().err == ""
+    assert main(["positions", str(data_dir / "bvh" / "rest.bvh"), "-o", str(tmp_path / "r.csv"), "--meters"]) == 0
+    assert "the length unit of the input was assumed (cm)" in capsys.readouterr().err
+    assert main(["positions", str(data_dir / "bvh" / "walk01.bvh"), "-o", str(out), "--unit", "ells"]) == 2
+    assert "unknown length unit 'ells'" in capsys.readouterr().err

@@ -162,6 +162,9 @@ def test_a_bad_sample_spoils_only_the_windows_that_hold_it(take, kind, bad):
     spoiled = take.replace(values=values).filter(kind, size)
     clean = take.filter(kind, size)
     outside = np.r_[0 : frame - size // 2, frame + size // 2 + 1 : take.frames]
-    np.testing.assert_array_equal(spoiled.values[outside], clean.values[outside])
+    if kind == "mean":  # its running sum is summed afresh once the bad sample leaves: the last bit may differ
+        np.testing.assert_allclose(spoiled.values[outside], clean.values[outside], rtol=1e-13, atol=0)
+    else:
+        np.testing.assert_array_equal(spoiled.values[outside], clean.values[outside])
     others = [c for c in range(values.shape[1]) if c != column]
     np.testing.assert_array_equal(spoiled.values[:, others], clean.values[:, others])

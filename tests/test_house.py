@@ -59,7 +59,7 @@ def test_the_cffi_stub_is_generated_from_the_header(tmp_path):
     subprocess.run(
         [
             sys.executable,
-            str(ROOT / "src" / "mtcore" / "_cffi_build.py"),
+            str(ROOT / "src" / "cffi_build.py"),
             "--stub",
             str(ROOT / "csrc" / "mtcore.h"),
             str(tmp_path / "stub.pyi"),
@@ -68,7 +68,7 @@ def test_the_cffi_stub_is_generated_from_the_header(tmp_path):
     )
     committed = (ROOT / "src" / "mtcore" / "_mtcore.pyi").read_text()
     assert (tmp_path / "stub.pyi").read_text() == committed, (
-        "src/mtcore/_mtcore.pyi is stale: python src/mtcore/_cffi_build.py --stub csrc/mtcore.h src/mtcore/_mtcore.pyi"
+        "src/mtcore/_mtcore.pyi is stale: python src/cffi_build.py --stub csrc/mtcore.h src/mtcore/_mtcore.pyi"
     )
 
 

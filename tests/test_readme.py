@@ -22,3 +22,13 @@ def test_the_python_examples_run_in_order(data_dir, tmp_path, monkeypatch):
             exec(compile(code, f"README.md python block {n}", "exec"), namespace)  # noqa: S102 (running the docs is the point)
         except Exception as e:
             raise AssertionError(f"README python block {n} fails: {e!r}\n{code}") from e
+
+
+def test_the_recipes_read():
+    """Every TOML example is a recipe of steps that the registry accepts."""
+    import motiontheater as mt
+
+    recipes = blocks("toml")
+    assert recipes
+    for text in recipes:
+        assert mt.Pipeline.from_toml(text, "README.md").entries

@@ -11,7 +11,7 @@ here.
 
 from mtcore import binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
 
-from . import convert, errors, export, filtering, interpolators, signal  # noqa: F401 (importing them registers their steps)
+from . import convert, errors, export, filtering, interpolators, markers, signal  # noqa: F401 (importing them registers their steps)
 from ._version import __version__
 from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf

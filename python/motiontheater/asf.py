@@ -11,7 +11,16 @@ from mtcore.text import parse_number
 
 from ._io import LINE_BREAK, Origin, Source, TextStyle, decode, output, read_source
 from ._version import __version__
-from .skeleton import BONE_DOFS, ROOT_DOFS, Bone, Root, Skeleton, canonical_hierarchy, name_problem
+from .skeleton import (
+    BONE_DOFS,
+    ROOT_DOFS,
+    Bone,
+    Root,
+    Skeleton,
+    canonical_hierarchy,
+    name_problem,
+    settle_length_unit,
+)
 
 _LIMIT = re.compile(r"\(\s*(\S+)\s+(\S+)\s*\)")
 
@@ -69,6 +78,7 @@ def read_asf(source: Source) -> Skeleton:
         skeleton = _parse(_Lines(decode(data)))
     except FormatError as e:
         raise e.at(name) from None
+    skeleton = settle_length_unit(skeleton)  # a stated unit that makes the character absurdly sized is corrected
     return replace(skeleton, style=TextStyle.of(data), origin=Origin.of(source))
 
 

@@ -42,6 +42,7 @@ from .errors import FormatError
 from .formats import TAKE_SUFFIXES, require_frames, skeleton_for, write_take
 from .motion import Motion
 from .pipeline import Pipeline
+from .skeleton import settle_length_unit
 from .streaming import CHUNK_FRAMES, stream, streamable
 
 STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed (when its pipeline allows)
@@ -61,6 +62,7 @@ class Job:
     stream_above: int = STREAM_ABOVE
     chunk_frames: int = CHUNK_FRAMES
     bytes: int = 0  # the take's size when planned
+    unit: str | None = None  # the takes' length unit (--unit), when given
 
 
 @dataclass
@@ -166,6 +168,7 @@ def plan_jobs(
     in_place: bool = False,
     stream_above: int = STREAM_ABOVE,
     chunk_frames: int = CHUNK_FRAMES,
+    unit: str | None = None,
 ) -> tuple[list[Job], list[Result]]:
     """The jobs to run, and the takes settled before running (no skeleton, or already done by this
     recipe when resuming).  An output that would replace its own input is refused (ValueError)
@@ -186,7 +189,15 @@ def plan_jobs(
             settled.append(Result(str(take), str(target), ok=False, error=str(e)))
             continue
         job = Job(
-            str(take), str(target), str(asf) if asf else "", pipeline, frame_rate, stream_above, chunk_frames, size
+            str(take),
+            str(target),
+            str(asf) if asf else "",
+            pipeline,
+            frame_rate,
+            stream_above,
+            chunk_frames,
+            size,
+            unit,
         )
         if resume and manifest.done(job):
             settled.append(Result(str(take), str(target), skipped=True, bytes=size))
@@ -205,7 +216,7 @@ def run_job(job: Job) -> Result:
         except OSError as e:
             raise OutputError(e.errno, f"cannot write {os.path.dirname(job.output)}: {e.strerror}") from None
         if job.skeleton and job.bytes > job.stream_above and streamable(job.pipeline):
-            skeleton = _skeleton(job.skeleton, *_stamp(job.skeleton))
+            skeleton = settle_length_unit(_skeleton(job.skeleton, *_stamp(job.skeleton)), job.unit)
             _copy_skeleton(job.skeleton, os.path.dirname(job.output))
             result.frames = stream(
                 job.input, job.output, skeleton, job.pipeline, job.frame_rate, chunk_frames=job.chunk_frames
@@ -228,8 +239,9 @@ def run_job(job: Job) -> Result:
 
 def _read(job: Job) -> Motion:
     if not job.skeleton:
-        return read_bvh(job.input)
-    return read_amc(job.input, _skeleton(job.skeleton, *_stamp(job.skeleton)), job.frame_rate, workers=1)
+        return read_bvh(job.input, unit=job.unit)
+    skeleton = settle_length_unit(_skeleton(job.skeleton, *_stamp(job.skeleton)), job.unit)
+    return read_amc(job.input, skeleton, job.frame_rate, workers=1)
 
 
 def _write(job: Job, result: Motion, motion: Motion) -> str:

@@ -20,7 +20,7 @@ from mtcore.text import format_number, format_table, parse_number, scan_table
 
 from ._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
 from .motion import Motion
-from .skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem
+from .skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem, settle_length_unit
 
 CHANNELS = {
     "xposition": "tx",
@@ -35,8 +35,14 @@ _FRAMES = re.compile(rb"^[ \t]*Frames[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECAS
 _FRAME_TIME = re.compile(rb"^[ \t]*Frame[ \t]+Time[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECASE | re.MULTILINE)
 
 
-def read_bvh(source: Source) -> Motion:
+def read_bvh(source: Source, *, unit: str | None = None) -> Motion:
     """Read a BVH file (path or file object) into a :class:`Motion` of a BVH skeleton.
+
+    A BVH file states no length unit: ``unit`` gives it (m, cm, mm, in, or a
+    number L for inch / L); without it the unit is detected from the size of
+    the rest pose, or assumed where the size tells none
+    (:func:`~motiontheater.skeleton.settle_length_unit`;
+    ``skeleton.length_source`` says which).
 
     Any hierarchy; channel lists of any order and count on any joint; End
     Site in any capitalisation, or none; joint names with spaces, ':' and
@@ -46,9 +52,10 @@ def read_bvh(source: Source) -> Motion:
     """
     data, name = read_source(source)
     try:
-        return _read(data).read_from(source)
+        motion = _read(data)
     except FormatError as e:
         raise e.at(name) from None
+    return motion.replace(skeleton=settle_length_unit(motion.skeleton, unit)).read_from(source)
 
 
 def _read(data) -> Motion:

@@ -28,11 +28,13 @@ from .asf import write_asf
 from .examples import noisy_rotations
 from .filtering import FILTERS
 from .formats import read_take, take_suffix, write_take
+from .info import as_text, describe, unit_notes
 from .motion import Motion
 from .pipeline import Pipeline
 from .registry import Option, Step, lookup, steps
 from .scene import RECIPE_HELP as SCENE_HELP
 from .scene import read_recipe
+from .units import UNIT_HELP
 
 RECIPE_HELP = """\
 A recipe is a TOML file of [[step]] tables, applied in order; each names a step
@@ -80,9 +82,15 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _take_options(parser: argparse.ArgumentParser) -> None:
-    """How a take is read: the flags every verb that reads AMC takes shares."""
+    """How a take is read: the flags every verb that reads takes shares."""
     parser.add_argument("--asf", help="the AMC's skeleton (default: the ASF beside it, by the CMU/HDM05 naming)")
     parser.add_argument("--frame-rate", type=float, metavar="HZ", help="frames per second when the AMC does not say")
+    parser.add_argument(
+        "--unit",
+        metavar="UNIT",
+        help=f"the takes' length unit: {UNIT_HELP} "
+        "(default: a BVH's is told from its size, an ASF's is its :units length)",
+    )
 
 
 def _output_options(parser: argparse.ArgumentParser, what: str) -> None:
@@ -116,6 +124,8 @@ def _write(motion: Motion, result: Motion, source: str, target: str) -> str:
     """Write a step's result as its suffix says; an AMC of a new skeleton gets its ASF beside it.
     Returns what was written, in words."""
     write_take(result, target)
+    for note in unit_notes(motion, result, target):
+        print(note, file=sys.stderr)
     if result.skeleton.convention == "asf" and result.skeleton is not motion.skeleton:
         skeleton = os.path.splitext(target)[0] + ".asf"
         write_asf(result.skeleton, skeleton)
@@ -130,10 +140,12 @@ def _run_step(args: argparse.Namespace) -> int:
     target = _output(args, source)
     if not step.is_exporter:
         take_suffix(target)
-    motion = read_take(source, asf, args.frame_rate)
+    motion = read_take(source, asf, args.frame_rate, args.unit)
     if step.is_exporter:
         step(motion, target, **options)
         print(f"{step.name}: wrote {motion.frames} frames of {source} to {target}")
+        for note in unit_notes(motion, motion, target):
+            print(note, file=sys.stderr)
         return 0
     result = step(motion, **options)
     written = _write(motion, result, source, target)
@@ -147,7 +159,7 @@ def _apply(args: argparse.Namespace) -> int:
     target = _output(args, source)
     if pipeline.exporter is None:
         take_suffix(target)
-    motion = read_take(source, asf, args.frame_rate)
+    motion = read_take(source, asf, args.frame_rate, args.unit)
     result = pipeline.apply(motion)
     if pipeline.exporter is not None:
         pipeline.write(result, target)
@@ -164,7 +176,7 @@ def _filter(args: argparse.Namespace) -> int:
     source, asf = _inputs(args)
     target = _output(args, source)
     take_suffix(target)
-    motion = read_take(source, asf, args.frame_rate)
+    motion = read_take(source, asf, args.frame_rate, args.unit)
     written = _write(motion, pipeline.apply(motion), source, target)
     entry = pipeline.entries[0]
     which = ", ".join(args.joints) if args.joints else "all joints"
@@ -197,6 +209,18 @@ def _filter_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def _info(args: argparse.Namespace) -> int:
+    import json
+
+    from .formats import skeleton_for
+
+    motion = read_take(args.input, args.asf, args.frame_rate, args.unit)
+    skeleton_file = None if args.input.lower().endswith(".bvh") else skeleton_for(args.input, args.asf)
+    facts = describe(motion, args.input, skeleton_file, frame_rate_given=args.frame_rate is not None)
+    print(json.dumps(facts, indent=2) if args.json else as_text(facts))
+    return 0
+
+
 def _steps(args: argparse.Namespace) -> int:
     for name, step in steps().items():
         kind = f"exporter ({', '.join(step.suffixes)})" if step.is_exporter else "step"
@@ -221,6 +245,7 @@ def _batch(args: argparse.Namespace) -> int:
         pipeline,
         skeleton=args.asf,
         frame_rate=args.frame_rate,
+        unit=args.unit,
         resume=args.resume,
         in_place=args.in_place,
         stream_above=int(args.stream_above * 1e6),
@@ -326,6 +351,157 @@ def _shown(value: Any) -> str:
     return str(value)
 
 
+# --- seeing motions: view, plot, render (issue 16) ----------------------------------------------
+
+
+def _frame_range(text: str) -> tuple[int, int]:
+    try:
+        first, last = (int(part) for part in text.split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected FIRST:LAST frame numbers such as 100:250, got {text!r}") from None
+    return first, last
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        width, height = (int(part) for part in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels such as 480x360, got {text!r}") from None
+    return width, height
+
+
+def _view(args: argparse.Namespace) -> int:
+    import webbrowser
+    from pathlib import Path
+
+    from .view import write_page
+
+    paths = [args.take, *args.more]
+    takes = [read_take(path, args.asf, args.frame_rate) for path in paths]
+    out = Path(args.output or Path(args.take).stem + ".html")
+    write_page(takes, out, names=[Path(p).name for p in paths], max_frames=args.max_frames)
+    print(f"wrote {out} ({out.stat().st_size / 1e6:.2f} MB, {len(takes)} take(s), {takes[0].frames} frames)")
+    if not args.no_open and not webbrowser.open(out.resolve().as_uri()):
+        print(f"no browser could be started: open {out} in one", file=sys.stderr)
+    return 0
+
+
+def _plot(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .plot import plot
+
+    paths = [args.take, *args.compare]
+    plot(
+        [read_take(path, args.asf, args.frame_rate) for path in paths],
+        args.output,
+        joints=args.joints.split(","),
+        dofs=args.dofs.split(",") if args.dofs else None,
+        frames=args.frames,
+        names=[Path(p).name for p in paths],
+        title=args.title,
+        dpi=args.dpi,
+    )
+    print(f"wrote {args.output}")
+    return 0
+
+
+def _render(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .render import render
+
+    paths = [args.take, *args.compare]
+
+    def progress(done: int, total: int) -> None:
+        print(f"\rrendering frame {done} of {total}", end="" if done < total else "\n", file=sys.stderr)
+
+    written = render(
+        [read_take(path, args.asf, args.frame_rate) for path in paths],
+        args.output,
+        fps=args.fps,
+        size=args.size,
+        frames=args.frames,
+        names=[Path(p).name for p in paths],
+        follow=not args.fixed_camera,
+        progress=progress if sys.stderr.isatty() else None,
+    )
+    print(f"wrote {written} frames at {args.fps:g} fps to {args.output}")
+    return 0
+
+
+def _add_seeing_verbs(verbs: Any) -> None:
+    """The parsers of view, plot and render (the C3D markers are the registered exporter c3d)."""
+    view = verbs.add_parser(
+        "view",
+        help="write an offline HTML page that plays, compares and edits takes, and open it",
+        description=(
+            "Write ONE self-contained HTML file (no network needed, ever) and open it in the browser: a 3D "
+            "skeleton player (drag to orbit, wheel to zoom, right-drag to pan; Space plays, arrows step, R "
+            "reverses, D doubles the speed, L loops, F follows the root), the joint tree with the selected "
+            "joint's channels and an axis-angle glyph of its rotation, its curves (click to seek, drag to "
+            "select frames), more takes overlaid for comparison, and an editor that stacks interpolators and "
+            "filters over frame ranges, previews them and exports the stack as a recipe for motiontheater "
+            "apply. Takes longer than --max-frames are shown decimated, with a note, and editing off."
+        ),
+        epilog="Example: motiontheater view 01_01.amc smooth.amc -o compare.html",
+    )
+    view.add_argument("take", help="the take to play and edit (AMC or BVH)")
+    view.add_argument("more", nargs="*", help="takes to compare with it, ghosted and overlaid")
+    view.add_argument("-o", "--output", help="the page to write (default: TAKE's name with .html, here)")
+    view.add_argument("--no-open", action="store_true", help="write the page but do not open a browser")
+    view.add_argument(
+        "--max-frames",
+        type=int,
+        default=30_000,
+        help="longer takes are shown decimated to at most this many frames, editing off (default 30000)",
+    )
+    _take_options(view)
+    view.set_defaults(run=_view)
+
+    plot = verbs.add_parser(
+        "plot",
+        help="draw channel curves of a take, and of takes to compare, to PNG, SVG or PDF",
+        description=(
+            "Draw one panel per channel of the --joints, over frames: the take in black and each --compare "
+            "take in a colour over it (e.g. before and after a filter, as the thesis's figures 4.26-4.39). "
+            "Needs matplotlib: pip install 'motiontheater[plot]'."
+        ),
+        epilog="Example: motiontheater plot 01_01.amc --joints lfemur,ltibia --compare smooth.amc --frames 100:400 "
+        "-o fig.png",
+    )
+    plot.add_argument("take", help="the take (AMC or BVH)")
+    plot.add_argument("--joints", required=True, help="comma-separated joints whose channels to draw")
+    plot.add_argument("--dofs", help="only these dofs, comma-separated (e.g. rx,rz)")
+    plot.add_argument("--compare", action="append", default=[], metavar="OTHER", help="a take to overlay (repeatable)")
+    plot.add_argument("--frames", type=_frame_range, metavar="A:B", help="only frames A to B of the take")
+    plot.add_argument("--title", help="the figure's title (default: the takes' names)")
+    plot.add_argument("--dpi", type=float, default=150.0, help="dots per inch of a PNG (default 150)")
+    plot.add_argument("-o", "--output", required=True, help="the figure: .png, .svg or .pdf")
+    _take_options(plot)
+    plot.set_defaults(run=_plot)
+
+    animation = verbs.add_parser(
+        "render",
+        help="render the skeleton as an animated GIF or MP4",
+        description=(
+            "Render the take's skeleton in motion, in real time at --fps, from the viewer's camera following "
+            "the root (--fixed-camera: one camera over the whole take); --compare takes are ghosted over it. "
+            "GIF needs matplotlib and pillow (pip install 'motiontheater[plot]'); MP4 also ffmpeg on the PATH."
+        ),
+        epilog="Example: motiontheater render 01_01.amc --frames 1:600 -o walk.gif",
+    )
+    animation.add_argument("take", help="the take (AMC or BVH)")
+    animation.add_argument("-o", "--output", required=True, help="the animation: .gif or .mp4")
+    animation.add_argument("--compare", action="append", default=[], metavar="OTHER", help="a take to ghost over it")
+    animation.add_argument("--fps", type=float, default=25.0, help="frames per second of the animation (default 25)")
+    animation.add_argument("--size", type=_size, default=(480, 360), metavar="WxH", help="pixels (default 480x360)")
+    animation.add_argument("--frames", type=_frame_range, metavar="A:B", help="only frames A to B of the take")
+    animation.add_argument("--fixed-camera", action="store_true", help="do not follow the root")
+    _take_options(animation)
+    animation.set_defaults(run=_render)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The parser of every verb: those written here and one per registered step."""
     parser = argparse.ArgumentParser(
@@ -354,6 +530,23 @@ def build_parser() -> argparse.ArgumentParser:
 
     listing = verbs.add_parser("steps", help="list every step and exporter with its options")
     listing.set_defaults(run=_steps)
+
+    about = verbs.add_parser(
+        "info",
+        help="describe a take: frames, rate, units, height, up axis, joint tree and channel ranges",
+        description=(
+            "Describe a take (AMC or BVH): its frames, frame rate, duration and first frame; its length "
+            "unit, how that was chosen (stated by the ASF, detected from the character's size, given with "
+            "--unit, or assumed) and how to set another; the character's height in metres and in file "
+            "units and its up axis; and the joint tree with each channel's range over the take. --json "
+            "prints the same as JSON for programs."
+        ),
+        epilog="Example: motiontheater info walk01.bvh ; motiontheater info 01_01.amc --json",
+    )
+    about.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    about.add_argument("--json", action="store_true", help="print JSON (NaN as null)")
+    _take_options(about)
+    about.set_defaults(run=_info)
 
     smooth = verbs.add_parser(
         "filter",
@@ -460,6 +653,7 @@ def build_parser() -> argparse.ArgumentParser:
     timing.add_argument("--asf", help="the take's skeleton (default: the ASF beside it)")
     timing.add_argument("--quick", action="store_true", help="a 3-minute capture instead of an hour, fewer rounds")
     timing.set_defaults(run=_bench)
+    _add_seeing_verbs(verbs)
     return parser
 
 

@@ -8,18 +8,25 @@ from typing import Annotated, Literal
 
 import numpy as np
 
+from . import units
 from ._io import Source, output
 from .motion import Motion
 from .registry import exporter
 
 FORMATS = ("csv", "npz", "trc")
-_NAMED_UNITS = {1.0: "m", 0.01: "cm", 0.001: "mm", 0.0254: "in"}
 
 
 def length_unit_name(motion: Motion, meters: bool) -> str | None:
-    """ "m" with meters, else the name of the skeleton's unit if it has one (None for
-    the Acclaim convention's inch / L units of CMU and HDM05)."""
-    return "m" if meters else _NAMED_UNITS.get(motion.skeleton.meters_per_unit)
+    """ "m" with meters, else the name of the skeleton's unit (its length unit in effect: a
+    BVH's detected, given or assumed one, a converted motion's carried one) if it has one:
+    m, cm, mm or in; None for the Acclaim convention's inch / L units of CMU and HDM05."""
+    return "m" if meters else units.named(motion.skeleton.length_unit)
+
+
+def length_unit_label(motion: Motion, meters: bool) -> str:
+    """The unit of exported lengths for headers: "m" with meters, else the skeleton's unit,
+    named (m, cm, mm, in) or "in/L" for an Acclaim unit inch / L (CMU and HDM05: "in/0.45")."""
+    return "m" if meters else units.label(motion.skeleton.length_unit)
 
 
 @exporter("positions", (".csv", ".npz", ".trc"), "write every joint's world position per frame (CSV, NPZ or TRC)")
@@ -34,12 +41,16 @@ def write_positions(
     """Write the world position of every joint per frame (``Motion.positions()``) to a file.
 
     The format is the target's suffix unless given.  CSV: one row per frame,
-    columns frame, time, <joint>.x, <joint>.y, <joint>.z in the skeleton's
-    joint order, 10 significant digits.  NPZ: positions (frames, joints, 3)
-    exact, joint_names, frames, times, frame_rate, meters_per_unit.  TRC
-    (OpenSim markers) needs a named unit (m, cm, mm, in): write CMU and HDM05
-    in metres.  Lengths are in the skeleton's units, or in metres.  A path is
-    written atomically.  Returns the format written.
+    columns ``frame``, ``time [s]``, ``<joint>.x [<unit>]``, ``<joint>.y
+    [<unit>]``, ``<joint>.z [<unit>]`` in the skeleton's joint order, 10
+    significant digits, the unit as :func:`length_unit_label` gives it (m,
+    cm, mm, in, or in/0.45 for CMU and HDM05 units).  NPZ: positions
+    (frames, joints, 3) exact, joint_names, frames, times, frame_rate,
+    meters_per_unit, length_unit.  TRC (OpenSim markers) needs a named unit
+    (m, cm, mm, in): write CMU and HDM05 in metres.  Lengths are in the
+    skeleton's length unit (a BVH's detected, given or assumed one:
+    ``skeleton.length_source``), or in metres.  A path is written
+    atomically.  Returns the format written.
     """
     if format is None:
         suffix = os.path.splitext(os.fspath(target) if isinstance(target, (str, os.PathLike)) else "")[1]
@@ -65,12 +76,14 @@ def write_positions(
                 times=motion.times,
                 frame_rate=motion.frame_rate,
                 meters_per_unit=1.0 if meters else motion.skeleton.meters_per_unit,
+                length_unit=length_unit_label(motion, meters),
             )
         else:
             table = np.column_stack([frames, motion.times, positions.reshape(motion.frames, -1)])
             fmt = ["%d", "%.10g"] + ["%.10g"] * (3 * len(names))
             if format == "csv":
-                header = ",".join(["frame", "time", *(f"{n}.{a}" for n in names for a in "xyz")])
+                label = length_unit_label(motion, meters)
+                header = ",".join(["frame", "time [s]", *(f"{n}.{a} [{label}]" for n in names for a in "xyz")])
                 np.savetxt(f, table, delimiter=",", fmt=fmt, header=header, comments="", encoding="utf-8")
             else:
                 assert unit is not None  # refused above

@@ -9,6 +9,7 @@ from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf
 from .bvh import read_bvh, write_bvh
 from .motion import Motion
+from .skeleton import settle_length_unit
 
 TAKE_SUFFIXES = (".amc", ".bvh")
 CONVENTIONS = {".amc": "asf", ".bvh": "bvh"}  # the skeleton convention a take file holds
@@ -29,15 +30,23 @@ def skeleton_for(path: str | os.PathLike, asf: str | os.PathLike | None = None) 
     return skeleton_path_for(path)
 
 
-def read_take(path: str | os.PathLike, asf: str | os.PathLike | None = None, frame_rate: float | None = None) -> Motion:
-    """The motion of an AMC (with its skeleton: ``asf``, or the ASF found beside it) or a BVH file,
-    which must hold at least one frame."""
+def read_take(
+    path: str | os.PathLike,
+    asf: str | os.PathLike | None = None,
+    frame_rate: float | None = None,
+    unit: str | None = None,
+) -> Motion:
+    """The motion of an AMC (with its skeleton: ``asf``, or the ASF found beside it) or a BVH file.
+    ``unit`` is its length unit (m, cm, mm, in, or a number L for inch / L) when given: a BVH's
+    is detected from its size otherwise, an ASF's is its ``:units length``.  The take must hold at
+    least one frame."""
     suffix = take_suffix(path)
     if not os.path.exists(path):
         raise FileNotFoundError(f"{os.fspath(path)}: no such file")
     if suffix == ".bvh":
-        return require_frames(read_bvh(path), path)
-    return require_frames(read_amc(path, read_asf(skeleton_for(path, asf)), frame_rate=frame_rate), path)
+        return require_frames(read_bvh(path, unit=unit), path)
+    skeleton = settle_length_unit(read_asf(skeleton_for(path, asf)), unit)
+    return require_frames(read_amc(path, skeleton, frame_rate=frame_rate), path)
 
 
 def require_frames(motion: Motion, path: str | os.PathLike) -> Motion:

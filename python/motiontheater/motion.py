@@ -150,7 +150,8 @@ class Motion:
         """World positions (frames, joints, 3) by forward kinematics, joints in
         ``skeleton.joint_names`` order: the root's position, then each bone's end
         point (its start point, the end of its parent, with ``start=True``).
-        In file length units, or metres with ``meters=True``.  NaN in a channel
+        In file length units, or metres with ``meters=True`` (by the skeleton's
+        length unit: ``skeleton.length_unit``, ``length_source``).  NaN in a channel
         gives NaN for that joint and the joints below it."""
         tree = self.skeleton.tree
         positions, _, _ = forward_kinematics(self.values, tree, workers=workers)

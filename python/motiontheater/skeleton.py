@@ -23,6 +23,7 @@ import numpy as np
 from mtcore import rotations
 from mtcore.kinematics import DOFS, JointTree, forward_kinematics
 
+from . import units as length_units
 from ._io import PLAIN, Origin, TextStyle
 from .errors import DuplicateError, HierarchyError, UnknownNameError
 
@@ -32,20 +33,6 @@ ROTATIONS = ("rx", "ry", "rz")
 TRANSLATIONS = ("tx", "ty", "tz")
 BONE_DOFS = (*ROTATIONS, *TRANSLATIONS, "l")  # "l": translation along the bone (stretch)
 ROOT_DOFS = (*TRANSLATIONS, *ROTATIONS)
-
-# Length units by name; a number L means the Acclaim convention: file unit = inch / L.
-_METERS_PER_NAMED_UNIT = {
-    "m": 1.0,
-    "meter": 1.0,
-    "meters": 1.0,
-    "metre": 1.0,
-    "metres": 1.0,
-    "cm": 0.01,
-    "mm": 0.001,
-    "in": 0.0254,
-    "inch": 0.0254,
-    "inches": 0.0254,
-}
 
 
 @dataclass(frozen=True)
@@ -112,6 +99,13 @@ class Skeleton:
     sites as channel-less bones named ``<joint>_End``.  Lengths and
     angles are in the file's units (see :attr:`angle_unit` and
     :attr:`meters_per_unit`).
+
+    ``length_choice`` is (unit text, how it was chosen) when the length unit
+    in effect is not the one ``units`` states: a BVH file states none, so its
+    reader detects, assumes or is given one (see :mod:`motiontheater.units`);
+    an ASF's stated unit can be overridden (``--unit``) or, where it makes
+    the character absurdly sized, corrected (:func:`settle_length_unit`).
+    ``units`` keeps the file's text either way, so that writers put it back.
     """
 
     bones: tuple[Bone, ...]
@@ -123,6 +117,7 @@ class Skeleton:
     documentation: tuple[str, ...] = ()
     sections: tuple[tuple[str, tuple[str, ...]], ...] = ()
     convention: str = "asf"  # "asf", or "bvh": a joint's offset turns with its parent, see kinematics
+    length_choice: tuple[str, str] | None = None
     style: TextStyle = field(default=PLAIN, compare=False, repr=False)  # how its ASF file was laid out
     origin: Origin | None = field(default=None, compare=False, repr=False)  # the ASF file it was read from
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
@@ -156,6 +151,11 @@ class Skeleton:
         if self.root.name not in first:  # a BVH root answers to its own name too ("Hips")
             first[self.root.name] = 0
         object.__setattr__(self, "_first_column", first)
+        if self.length_choice is not None:
+            unit, source = self.length_choice
+            length_units.meters_per(unit)  # a clear message for an unknown unit, now rather than later
+            if source not in length_units.SOURCES:
+                raise ValueError(f"length_choice: how the unit was chosen must be one of {length_units.SOURCES}")
 
     @property
     def bone_names(self) -> tuple[str, ...]:
@@ -245,10 +245,23 @@ class Skeleton:
     def rest_positions(self, *, start: bool = False) -> np.ndarray:
         """The calibration pose: (joints, 3) positions in ``joint_names`` order,
         the root at ``:root position`` and each bone's end point (start point
-        with ``start=True``), p = p(parent) + direction * length, in file units."""
+        with ``start=True``), p = p(parent) + direction * length, in file units.
+        A BVH skeleton's is the pose its OFFSETs draw: position channels, which
+        replace offsets in motion, hold their joint's OFFSET here."""
         tree = self.tree
-        positions = forward_kinematics(np.zeros((1, len(self.channels))), tree)[0][0]
+        values = np.zeros((1, len(self.channels)))
+        if self.convention == "bvh":
+            for column, (joint, dof) in enumerate(self.channels):
+                if dof in TRANSLATIONS:
+                    offset = self.root.position if self.is_root(joint) else self.bone(joint).direction
+                    values[0, column] = offset[TRANSLATIONS.index(dof)]
+        positions = forward_kinematics(values, tree)[0][0]
         return positions[np.maximum(tree.parent, 0)] if start else positions
+
+    def sizing(self) -> length_units.Sizing:
+        """What the rest pose says about the length unit: its extents, up axis and the unit that
+        makes the character human-sized (see :func:`motiontheater.units.size_up`)."""
+        return length_units.size_up(self.rest_positions())
 
     @cached_property
     def tree(self) -> JointTree:
@@ -277,32 +290,53 @@ class Skeleton:
         return 2 * math.pi / self.angle_scale
 
     @property
+    def length_unit(self) -> str | None:
+        """The length unit in effect, as text: ``length_choice``'s, else the stated
+        ``:units length``; None when there is neither (the Acclaim default, inch)."""
+        return self.length_choice[0] if self.length_choice else self.unit("length")
+
+    @property
+    def length_source(self) -> str:
+        """How the length unit was chosen: "stated" (by the file's ``:units length``),
+        "default" (an ASF without one: inch), "detected", "given" or "assumed"
+        (see :data:`motiontheater.units.SOURCES`)."""
+        if self.length_choice:
+            return self.length_choice[1]
+        return "stated" if self.unit("length") is not None else "default"
+
+    @property
     def meters_per_unit(self) -> float:
-        """Metres per file length unit.  A number L under ``:units length`` is the
+        """Metres per file length unit (of :attr:`length_unit`).  A number L is the
         Acclaim convention, file unit = inch / L (CMU and HDM05: L = 0.45)."""
-        text = (self.unit("length") or "1").strip().lower()
-        if text in _METERS_PER_NAMED_UNIT:
-            return _METERS_PER_NAMED_UNIT[text]
-        try:
-            return 0.0254 / float(text)
-        except (ValueError, ZeroDivisionError):
-            raise ValueError(f"unknown length unit '{text}'") from None
+        return length_units.meters_per(self.length_unit or "1")
+
+    def with_length_unit(self, unit: str, source: str = "given") -> Skeleton:
+        """The same skeleton (lengths unchanged) read as being in ``unit`` (m, cm, mm, in, or a
+        number L for inch / L), chosen as ``source`` says; the stated ``units`` stay as they were."""
+        relabelled = replace(self, length_choice=(unit.strip(), source))
+        if "tree" in self.__dict__:  # the same geometry: the kinematic tables worked out for the rest pose serve
+            relabelled.__dict__["tree"] = self.tree
+        return relabelled
 
     def with_units(
         self, *, length_factor: float = 1.0, length: str | None = None, angle: str | None = None
     ) -> Skeleton:
         """The same skeleton with lengths multiplied by ``length_factor`` (unit text
-        ``length``) and angles converted to ``angle`` ("deg" or "rad")."""
+        ``length``, which then is the unit in effect) and angles converted to ``angle``
+        ("deg" or "rad").  A BVH joint's OFFSET (its ``direction``) is a length too."""
         factor = angle_factor(self.angle_unit, angle)
         units = dict(self.units)
+        choice = self.length_choice
         if length is not None:
             units["length"] = length
+            choice = None  # the stated unit is now the one in effect
         if angle is not None:
             units["angle"] = angle
         bones = tuple(
             replace(
                 b,
                 length=b.length * length_factor,
+                direction=_scaled(b.direction, length_factor) if self.convention == "bvh" else b.direction,
                 axis=_scaled(b.axis, factor),
                 limits=tuple(
                     (lo * f, hi * f)
@@ -316,7 +350,28 @@ class Skeleton:
             position=_scaled(self.root.position, length_factor),
             orientation=_scaled(self.root.orientation, factor),
         )
-        return replace(self, bones=bones, root=root, units=tuple(units.items()))
+        return replace(self, bones=bones, root=root, units=tuple(units.items()), length_choice=choice)
+
+
+def settle_length_unit(skeleton: Skeleton, unit: str | None = None) -> Skeleton:
+    """The skeleton with its length unit chosen, as the readers do: ``unit`` when given;
+    for a skeleton that states none (a BVH file's), the unit its size tells
+    (:func:`motiontheater.units.size_up`), else :data:`~motiontheater.units.ASSUMED_UNIT`,
+    assumed; a stated unit stands unless it makes the character absurdly sized
+    (:data:`~motiontheater.units.ABSURD_HEIGHT`: an ASF saying ``length m`` of numbers in
+    millimetres) and another unit makes it human-sized.  A unit chosen before stays."""
+    if unit is not None:
+        return skeleton.with_length_unit(unit, "given")
+    if skeleton.length_choice is not None:
+        return skeleton
+    sizing = skeleton.sizing()
+    if skeleton.convention == "bvh" and skeleton.unit("length") is None:
+        if sizing.unit is None:
+            return skeleton.with_length_unit(length_units.ASSUMED_UNIT, "assumed")
+        return skeleton.with_length_unit(sizing.unit, "detected")
+    if sizing.unit is not None and sizing.absurd(skeleton.meters_per_unit):
+        return skeleton.with_length_unit(sizing.unit, "detected")
+    return skeleton
 
 
 def angle_factor(current: str, wanted: str | None) -> float:
@@ -391,10 +446,12 @@ def _joint_tree(skeleton: Skeleton) -> JointTree:
             segment.append(_replaced(d, bone.dofs))
             continue
         axis.append(_axis_frame(bone.axis_order, bone.axis, degrees))
-        norm = np.linalg.norm(d)
-        unit = d / norm if norm > 0 else np.zeros(3)
+        norm = math.hypot(*d)  # no overflow for huge components, unlike the sum of squares
+        # no direction: zero; an infinite one (bad input) has none either, and says so with NaN
+        unit = d / norm if 0 < norm < math.inf else np.full(3, math.nan if norm else 0.0)
         direction.append(unit)
-        segment.append(unit * bone.length)
+        # a direction that is already the bone's vector (converted BVH offsets) is kept exactly
+        segment.append(d if bone.length == norm else unit * bone.length)
     dof_start, dof_kind, dof_column = [0], [], []  # type: list[int], list[int], list[int]
     column = 0
     for name in names:

@@ -1,0 +1,189 @@
+"""The viewer page without a browser: what it holds, how big it is, what it refuses."""
+
+import base64
+import json
+import re
+import zlib
+
+import numpy as np
+import pytest
+
+import motiontheater as mt
+from conftest import real_files
+from motiontheater.view import DEFAULT_MAX_FRAMES, EDIT_STEPS, page, write_page
+
+
+def page_data(html: str) -> dict:
+    return json.loads(
+        re.search(r'<script type="application/json" id="mt-data">(.*?)</script>', html, re.DOTALL).group(1)
+    )
+
+
+def decoded(take: dict) -> np.ndarray:
+    """The twin of the page's decodeValues: (frames, channels)."""
+    frames, channels = take["frames"], len(take["channels"])
+    planes = np.frombuffer(zlib.decompress(base64.b64decode(take["values"]["data"])), np.uint8)
+    words = planes.reshape(4, -1).T.copy().view("<i4").ravel()
+    exceptions = iter(np.frombuffer(base64.b64decode(take["values"]["exceptions"]), "<f8"))
+    values = [next(exceptions) if w & 31 == 31 else (w >> 5) / 10.0 ** (w & 31) for w in words.tolist()]
+    return np.array(values).reshape(channels, frames).T
+
+
+def cmu_take(name: str = "01_01") -> mt.Motion:
+    path = next((p for p in real_files(f"cmu/{name}.amc")), None)
+    if path is None:
+        pytest.skip("CMU 01_01 not in the corpus")
+    return mt.read_amc(path, mt.read_asf(mt.skeleton_path_for(path)))
+
+
+def small_take(frames: int = 40, seed: int = 0) -> mt.Motion:
+    skeleton = mt.Skeleton(
+        bones=(
+            mt.Bone("hip", direction=(0, -1, 0), length=2.0, dofs=("rx", "ry", "rz")),
+            mt.Bone("knee", direction=(0, -1, 0), length=2.0, dofs=("rx",)),
+            mt.Bone("toe", direction=(0, 0, 1), length=0.5),
+        ),
+        hierarchy=(("root", ("hip",)), ("hip", ("knee",)), ("knee", ("toe",))),
+        units=(("mass", "1.0"), ("length", "0.45"), ("angle", "deg")),
+    )
+    rng = np.random.default_rng(seed)
+    values = np.round(rng.normal(scale=30, size=(frames, len(skeleton.channels))), 4)
+    return mt.Motion(skeleton, values)
+
+
+@pytest.mark.parametrize("kind", ["amc", "bvh"])
+def test_values_are_stored_exactly(data_dir, kind):
+    path = data_dir / "cmu" / f"01_01.{kind}"
+    motion = mt.read_bvh(path) if kind == "bvh" else mt.read_amc(path, mt.read_asf(data_dir / "cmu" / "01.asf"))
+    take = page_data(page([motion]))["takes"][0]
+    values = decoded(take)
+    # equal as numbers, bit for bit but for the sign of zero
+    assert np.array_equal(values, motion.values)
+    assert take["frames"] == motion.frames and take["step"] == 1
+
+
+def test_values_that_are_not_short_decimals_survive(rng):
+    motion = small_take()
+    values = motion.values.copy()
+    values[3, 1] = np.nan
+    values[4, 2] = np.pi  # 16 digits
+    values[5, 3] = 1.5e-300
+    values[6, 4] = -123456789.0  # past the word's mantissa
+    values[7, 5] = 3.64024e-15  # exponent notation, as CMU writes near-zeros
+    values[8] = rng.normal(size=values.shape[1])
+    motion = motion.replace(values=values)
+    got = decoded(page_data(page([motion]))["takes"][0])
+    assert np.array_equal(got, motion.values, equal_nan=True)
+
+
+def test_cmu_01_01_page_is_small(data_dir):
+    html = page([cmu_take()], names=["01_01.amc"])
+    assert len(html.encode()) <= 1_500_000
+    assert "http://" not in html and "https://" not in html  # nothing to fetch
+
+
+def test_page_is_self_contained():
+    html = page([small_take()])
+    assert html.count("<script") == 2  # the data and the viewer, both inline
+    assert not re.search(r"<(script|link|img)[^>]+(src|href)=", html)
+    assert "__JS__" not in html and "__DATA__" not in html and "__CSS__" not in html
+
+
+def test_names_cannot_break_out_of_the_data():
+    html = page([small_take()], names=["</script><script>alert(1)</script>"])
+    assert html.count("</script>") == 2
+    assert page_data(html)["takes"][0]["name"] == "</script><script>alert(1)</script>"
+    assert "<title>motiontheater: &lt;/script&gt;" in html
+
+
+def test_long_takes_are_decimated_with_a_note():
+    """One hour at 120 Hz, 62 channels: the page keeps 1 frame in 15 and says so."""
+    frames = 432_000
+    skeleton = small_take().skeleton
+    t = np.arange(frames)[:, None] / 120.0
+    values = np.round(20 * np.sin(t * np.arange(1, len(skeleton.channels) + 1)), 4)
+    motion = mt.Motion(skeleton, values)
+    data = page_data(page([motion], names=["hour"]))
+    take = data["takes"][0]
+    assert take["step"] == 15 and take["frames"] == 28_800 <= DEFAULT_MAX_FRAMES
+    assert np.array_equal(decoded(take), values[::15])
+    assert "1 frame in 15 of its 432,000 is shown (8 Hz)" in data["note"] and "editing is off" in data["note"]
+    assert data["editable"] is False
+
+
+def test_compared_takes_and_footplants():
+    a, b = small_take(seed=1), small_take(frames=30, seed=2)
+    flags = np.zeros(40, bool)
+    flags[5:12] = flags[20:] = True
+    data = page_data(page([a, b], names=["before", "after"], plants=[{"toe": flags}, None]))
+    assert [t["name"] for t in data["takes"]] == ["before", "after"]
+    assert data["takes"][0]["plants"] == {"toe": [[5, 11], [20, 39]]}
+    assert data["takes"][1]["plants"] == {}
+    assert data["editable"] is True
+
+
+def test_editor_steps_are_registered_steps():
+    from motiontheater.registry import lookup
+
+    kinds = [s["kind"] for s in EDIT_STEPS]
+    assert kinds == ["slerp", "euler", "expmap", "aligned_expmap", "median3", "median", "mean", "binomial"]
+    for spec in EDIT_STEPS:
+        options = {o.name for o in lookup(spec["run"]).all_options}
+        assert {"frames", "joints"} <= options
+        assert ("size" in options) == spec["size"]
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(takes=[]), "at least one take"),
+        (dict(max_frames=1), "max_frames"),
+        (dict(names=["a", "b"]), "one name"),
+        (dict(plants=[{"nose": np.zeros(40, bool)}]), "not a point"),
+        (dict(plants=[{"toe": np.zeros(39, bool)}]), "one flag per frame"),
+    ],
+)
+def test_bad_arguments_are_refused(kwargs, message):
+    takes = kwargs.pop("takes", [small_take()])
+    with pytest.raises(ValueError, match=message):
+        page(takes, **kwargs)
+
+
+def test_empty_take_is_refused():
+    motion = small_take()
+    with pytest.raises(ValueError, match="no frames"):
+        page([motion.replace(values=motion.values[:0])])
+
+
+def test_write_page_writes_nothing_on_failure(tmp_path):
+    target = tmp_path / "page.html"
+    with pytest.raises(ValueError):
+        write_page([], target)
+    assert not list(tmp_path.iterdir())
+    write_page([small_take()], target)
+    assert target.read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
+
+
+def test_cli_view_writes_the_page(tmp_path, data_dir, monkeypatch, capsys):
+    from motiontheater.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    take, other = data_dir / "cmu" / "01_01.amc", data_dir / "cmu" / "01_01.bvh"
+    assert main(["view", str(take), str(other), "--no-open"]) == 0
+    assert "wrote 01_01.html" in capsys.readouterr().out
+    data = page_data((tmp_path / "01_01.html").read_text(encoding="utf-8"))
+    assert [t["name"] for t in data["takes"]] == ["01_01.amc", "01_01.bvh"]
+    assert main(["view", str(take), "--no-open", "--max-frames", "1000", "-o", "small.html"]) == 0
+    data = page_data((tmp_path / "small.html").read_text(encoding="utf-8"))
+    assert data["takes"][0]["step"] == 3 and "1 frame in 3 of its 2,751" in data["note"]
+
+
+@pytest.mark.parametrize("verb", ["view", "plot", "render", "c3d"])
+def test_cli_help_teaches(verb, capsys):
+    from motiontheater.cli import main
+
+    with pytest.raises(SystemExit) as exit:
+        main([verb, "--help"])
+    assert exit.value.code == 0
+    text = capsys.readouterr().out
+    assert "Example: motiontheater " + verb in " ".join(text.split())

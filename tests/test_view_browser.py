@@ -1,0 +1,518 @@
+"""The viewer page in a real headless Chromium, driven by selenium and chromedriver.
+
+Skipped, with the reason, only where no Chromium with its driver (Debian: apt-get install chromium
+chromium-driver) or no selenium is installed.
+"""
+
+import io
+import shutil
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import motiontheater as mt
+from conftest import ids, real_files
+from motiontheater.view import write_page
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:
+    import tomli as tomllib
+
+webdriver = pytest.importorskip("selenium.webdriver", reason="selenium is not installed (pip install selenium)")
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
+from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
+from selenium.webdriver.support.ui import Select, WebDriverWait
+
+BROWSER = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
+DRIVER = shutil.which("chromedriver")
+pytestmark = pytest.mark.skipif(
+    BROWSER is None or DRIVER is None,
+    reason="no Chromium with chromedriver here (Debian: apt-get install chromium chromium-driver)",
+)
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory):
+    from selenium.webdriver.chrome.service import Service
+
+    downloads = tmp_path_factory.mktemp("downloads")
+    options = webdriver.ChromeOptions()
+    options.binary_location = BROWSER
+    for flag in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1280,800"):
+        options.add_argument(flag)
+    options.add_experimental_option("prefs", {"download.default_directory": str(downloads)})
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(DRIVER), options=options)
+    driver.execute_cdp_cmd("Browser.setDownloadBehavior", {"behavior": "allow", "downloadPath": str(downloads)})
+    driver.downloads = downloads
+    yield driver
+    driver.quit()
+
+
+def cmu(data_dir, kind="amc"):
+    if kind == "bvh":
+        return mt.read_bvh(data_dir / "cmu" / "01_01.bvh")
+    return mt.read_amc(data_dir / "cmu" / "01_01.amc", mt.read_asf(data_dir / "cmu" / "01.asf"))
+
+
+def open_page(browser, tmp_path, takes, **options):
+    """Write the page of the takes, open it from disk and wait until it is interactive."""
+    path = tmp_path / "page.html"
+    write_page(takes, path, **options)
+    browser.get_log("browser")  # drop what earlier pages logged
+    browser.get(path.as_uri())
+    WebDriverWait(browser, 30).until(
+        lambda d: d.execute_script(
+            "return document.body.dataset.ready === '1' || !document.getElementById('error').hidden"
+        )
+    )
+    error = browser.find_element(By.ID, "error")
+    assert not error.is_displayed(), error.text
+    return browser
+
+
+def console_errors(browser):
+    return [e for e in browser.get_log("browser") if e["level"] in ("SEVERE", "ERROR")]
+
+
+def frame_shown(browser) -> int:
+    return int(browser.execute_script("return document.body.dataset.frame"))
+
+
+def settle(browser) -> None:
+    """Return after two animation frames: the page has drawn what the last input changed."""
+    browser.execute_async_script(
+        "const done = arguments[arguments.length - 1]; requestAnimationFrame(() => requestAnimationFrame(() => done()));"
+    )
+
+
+def wait_frame(browser, frame: int) -> None:
+    """Wait until the page shows this frame number (it draws on the next animation frame)."""
+    WebDriverWait(browser, 5).until(lambda d: frame_shown(d) == frame)
+
+
+def screenshot(browser):
+    image = pytest.importorskip("PIL.Image", reason="pillow is not installed")
+    return np.asarray(image.open(io.BytesIO(browser.get_screenshot_as_png())).convert("RGB")).astype(int)
+
+
+def joints_on_screen(browser, k=0):
+    """Page pixel (x, y) of every joint of take k at the current frame, by the page's own camera."""
+    return browser.execute_script(
+        """
+        const k = arguments[0], S = mtView.state, t = S.takes[k], J = t.joints.length;
+        const i = k === 0 ? S.cur : Math.round(S.time * t.frameRate / t.step);
+        const P = mtView.positions(k, i), r = document.getElementById('view3d').getBoundingClientRect();
+        const dpr = window.devicePixelRatio || 1, out = [];
+        for (let j = 0; j < J; j++) {
+          const s = mtView.project(P[3 * j], P[3 * j + 1], P[3 * j + 2]);
+          if (s) out.push([r.left + s[0] / dpr, r.top + s[1] / dpr]);
+        }
+        return out;""",
+        k,
+    )
+
+
+def inked(picture, x, y, radius=2):
+    """Whether any pixel within radius of (x, y) is not the white background."""
+    x, y = round(x), round(y)
+    patch = picture[max(0, y - radius) : y + radius + 1, max(0, x - radius) : x + radius + 1]
+    return bool((patch.sum(axis=2) < 3 * 235).any())
+
+
+@pytest.mark.parametrize("kind", ["amc", "bvh"])
+def test_real_take_opens_and_its_skeleton_is_drawn(browser, data_dir, tmp_path, kind):
+    motion = cmu(data_dir, kind)
+    open_page(browser, tmp_path, [motion], names=[f"01_01.{kind}"])
+    assert console_errors(browser) == []
+    # the page's forward kinematics reproduce Motion.positions()
+    expected = motion.positions()
+    for frame in (0, 1, 777, motion.frames - 1):
+        got = np.array(browser.execute_script("return mtView.positions(0, arguments[0])", frame))
+        np.testing.assert_allclose(got.reshape(-1, 3), expected[frame], rtol=0, atol=1e-9)
+    picture = screenshot(browser)
+    points = joints_on_screen(browser)
+    assert len(points) == len(motion.skeleton.joint_names)
+    assert all(inked(picture, x, y) for x, y in points)
+    # and the test could fail: the corners of the 3D view are background
+    box = browser.find_element(By.ID, "view3d").rect
+    assert not inked(picture, box["x"] + box["width"] - 6, box["y"] + 30)
+
+
+VARIETY = real_files("bvh/*.bvh") + real_files("edge/*.amc") + real_files("hdm05/HDM_bd_squat1Reps_003_120.amc")
+
+
+@pytest.mark.parametrize("path", VARIETY, ids=ids(VARIETY))
+def test_every_kind_of_file_opens(browser, tmp_path, path):
+    """Every producer's BVH (orders, odd names, a one-frame rest pose), a non-CMU ASF, HDM05."""
+    if path.suffix == ".bvh":
+        motion = mt.read_bvh(path)
+    else:
+        motion = mt.read_amc(path, mt.read_asf(mt.skeleton_path_for(path)))
+    open_page(browser, tmp_path, [motion], names=[path.name])
+    assert console_errors(browser) == []
+    expected = motion.positions()
+    for frame in {0, motion.frames // 2, motion.frames - 1}:
+        got = np.array(browser.execute_script("return mtView.positions(0, arguments[0])", frame))
+        np.testing.assert_allclose(got.reshape(-1, 3), expected[frame], rtol=1e-12, atol=1e-9)
+    browser.execute_script("mtView.play()")
+    time.sleep(0.3)
+    browser.execute_script("mtView.pause()")
+    assert console_errors(browser) == []
+    assert not browser.find_element(By.ID, "error").is_displayed()
+
+
+def test_play_advances_the_frame_and_the_picture(browser, data_dir, tmp_path):
+    open_page(browser, tmp_path, [cmu(data_dir)])
+    first = frame_shown(browser)
+    before = browser.execute_script("return document.getElementById('view3d').toDataURL()")
+    browser.find_element(By.ID, "b-play").click()
+    WebDriverWait(browser, 10).until(lambda d: frame_shown(d) >= first + 30)
+    browser.find_element(By.ID, "b-play").click()
+    assert browser.execute_script("return mtView.state.playing") is False
+    after = browser.execute_script("return document.getElementById('view3d').toDataURL()")
+    assert after != before
+    stats = browser.execute_script("return mtView.state.stats")
+    assert stats["playTicks"] > 0
+    assert console_errors(browser) == []
+
+
+def test_keys_step_and_jump(browser, data_dir, tmp_path):
+    motion = cmu(data_dir)
+    open_page(browser, tmp_path, [motion])
+    body = browser.find_element(By.TAG_NAME, "body")
+    body.send_keys(Keys.ARROW_RIGHT)
+    wait_frame(browser, 2)
+    body.send_keys(Keys.SHIFT, Keys.ARROW_RIGHT)
+    wait_frame(browser, 12)
+    body.send_keys(Keys.ARROW_LEFT)
+    wait_frame(browser, 11)
+    body.send_keys(Keys.END)
+    wait_frame(browser, motion.frames)
+    body.send_keys("r")
+    assert browser.execute_script("return mtView.state.reverse") is True
+    body.send_keys(" ")
+    WebDriverWait(browser, 10).until(lambda d: frame_shown(d) < motion.frames - 20)  # playing backwards
+    body.send_keys(" ")
+    body.send_keys(Keys.HOME)
+    wait_frame(browser, 1)
+    state = "return [mtView.state.speed, mtView.state.loop, mtView.state.follow]"
+    assert browser.execute_script(state) == [1, True, True]
+    body.send_keys("d", "l", "f")
+    assert browser.execute_script(state) == [2, False, False]
+    assert browser.find_element(By.ID, "b-speed").get_attribute("aria-pressed") == "true"
+    body.send_keys(Keys.ARROW_RIGHT * 4, "[")
+    body.send_keys(Keys.SHIFT, Keys.ARROW_RIGHT)
+    body.send_keys("]")
+    assert browser.find_element(By.ID, "e-from").get_attribute("value") == "5"
+    assert browser.find_element(By.ID, "e-to").get_attribute("value") == "15"
+    body.send_keys("?")
+    assert browser.find_element(By.ID, "help").is_displayed()
+    body.send_keys(Keys.ESCAPE)
+    assert not browser.find_element(By.ID, "help").is_displayed()
+
+
+def test_orbit_zoom_and_pan_move_the_camera(browser, data_dir, tmp_path):
+    open_page(browser, tmp_path, [cmu(data_dir)])
+    view = browser.find_element(By.ID, "view3d")
+    camera = "return document.getElementById('view3d').toDataURL()"
+    pictures = [browser.execute_script(camera)]
+    ActionChains(browser).move_to_element(view).click_and_hold().move_by_offset(80, 30).release().perform()
+    settle(browser)
+    pictures.append(browser.execute_script(camera))
+    before = joints_on_screen(browser)
+    ActionChains(browser).scroll_from_origin(ScrollOrigin.from_element(view), 0, 300).perform()  # zoom out
+    settle(browser)
+    after = joints_on_screen(browser)
+    spread = lambda points: np.ptp(np.array(points), axis=0).max()
+    assert spread(after) < spread(before)
+    ActionChains(browser).move_to_element(view).key_down(Keys.SHIFT).click_and_hold().move_by_offset(
+        50, 0
+    ).release().key_up(Keys.SHIFT).perform()
+    settle(browser)
+    moved = joints_on_screen(browser)
+    shift = np.array(moved).mean(axis=0) - np.array(after).mean(axis=0)
+    assert abs(shift[0] - 50) < 10 and abs(shift[1]) < 10  # panned with the pointer
+    pictures.append(browser.execute_script(camera))
+    assert len(set(pictures)) == 3
+
+
+def test_tree_collapses(browser, data_dir, tmp_path):
+    open_page(browser, tmp_path, [cmu(data_dir)])
+    femur = browser.find_element(By.CSS_SELECTOR, ".jname[data-name='lfemur']")
+    foot = browser.find_element(By.CSS_SELECTOR, ".jname[data-name='lfoot']")
+    assert foot.is_displayed()
+    femur.find_element(By.XPATH, "preceding-sibling::button").click()
+    assert not foot.is_displayed() and femur.is_displayed()
+    femur.find_element(By.XPATH, "preceding-sibling::button").click()
+    assert foot.is_displayed()
+
+
+def test_one_hour_take_opens_decimated(browser, data_dir, tmp_path):
+    take = cmu(data_dir)
+    hour = take.replace(values=np.tile(take.values, (432_000 // take.frames + 1, 1))[:432_000])
+    open_page(browser, tmp_path, [hour], names=["hour.amc"])
+    note = browser.find_element(By.ID, "note")
+    assert note.is_displayed() and "1 frame in 15 of its 432,000 is shown (8 Hz)" in note.text
+    assert not browser.find_element(By.ID, "editor").is_displayed()
+    assert browser.execute_script("return mtView.state.takes[0].frames") == 28_800
+    browser.execute_script("mtView.seek(28_799)")
+    wait_frame(browser, 432_000 - 14)  # the last frame kept: 1 + 28,799 x 15
+    got = np.array(browser.execute_script("return mtView.positions(0, 28799)")).reshape(-1, 3)
+    np.testing.assert_allclose(got, hour.replace(values=hour.values[-15:-14]).positions()[0], atol=1e-9)
+    assert console_errors(browser) == []
+
+
+def test_selecting_a_joint_shows_its_values_and_rotation(browser, data_dir, tmp_path):
+    motion = cmu(data_dir)
+    open_page(browser, tmp_path, [motion])
+    browser.find_element(By.CSS_SELECTOR, ".jname[data-name='lfemur']").click()
+    field = browser.find_element(By.ID, "frame")
+    field.send_keys(Keys.CONTROL, "a")
+    field.send_keys("1234", Keys.ENTER)
+    wait_frame(browser, 1234)
+    assert browser.find_element(By.ID, "joint-name").text == "lfemur"
+    cells = browser.find_elements(By.CSS_SELECTOR, "#channels td[data-dof]")
+    shown = {c.get_attribute("data-dof"): float(c.get_attribute("data-value")) for c in cells}
+    expected = {dof: motion.values[1233, col] for dof, col in zip(("rx", "ry", "rz"), motion.columns("lfemur"))}
+    assert shown == expected  # exactly the stored values
+    for cell in cells:
+        assert float(cell.text) == pytest.approx(float(cell.get_attribute("data-value")), rel=1e-7)
+    from mtcore.rotations import quaternions_to_rotvecs
+
+    q = motion.rotations(local=True, quaternions=True)[1233, motion.skeleton.joint_names.index("lfemur")]
+    got = browser.execute_script("return JSON.parse(document.getElementById('axis-angle').dataset.rotvec)")
+    np.testing.assert_allclose(got, quaternions_to_rotvecs(q), atol=1e-9)
+    assert "\u00b0 about (" in browser.find_element(By.ID, "axis-angle").text
+
+
+def test_clicking_a_joint_in_the_view_selects_it(browser, data_dir, tmp_path):
+    motion = cmu(data_dir)
+    open_page(browser, tmp_path, [motion])
+    j = motion.skeleton.joint_names.index("lhand")
+    x, y = joints_on_screen(browser)[j]
+    view = browser.find_element(By.ID, "view3d").rect
+    ActionChains(browser).move_to_element_with_offset(
+        browser.find_element(By.ID, "view3d"), x - view["x"] - view["width"] / 2, y - view["y"] - view["height"] / 2
+    ).click().perform()
+    assert browser.find_element(By.ID, "joint-name").text == "lhand"
+
+
+def curve_x(browser, frame_index):
+    """Page x of a frame index on the curves."""
+    return browser.execute_script(
+        """const t = mtView.state.takes[0], c = document.getElementById('curves'), r = c.getBoundingClientRect();
+        const dpr = window.devicePixelRatio || 1, left = 56, right = 10;
+        const T = Math.max(...mtView.state.takes.map(k => (k.frames - 1) * k.step / k.frameRate));
+        return r.left + left + (r.width - left - right) * (arguments[0] * t.step / t.frameRate) / T;""",
+        frame_index,
+    )
+
+
+def drag_on_curves(browser, a, b):
+    curves = browser.find_element(By.ID, "curves")
+    rect = curves.rect
+    y = rect["height"] / 2 - rect["height"] / 2 + 20  # near the top of the plot, inside it
+    xa, xb = (curve_x(browser, i) - rect["x"] - rect["width"] / 2 for i in (a, b))
+    ActionChains(browser).move_to_element_with_offset(
+        curves, xa, y - rect["height"] / 2 + 20
+    ).click_and_hold().move_by_offset((xb - xa) / 2, 0).move_by_offset((xb - xa) / 2, 0).release().perform()
+
+
+def test_curves_seek_on_click(browser, data_dir, tmp_path):
+    open_page(browser, tmp_path, [cmu(data_dir)])
+    curves = browser.find_element(By.ID, "curves")
+    rect = curves.rect
+    x = curve_x(browser, 1500) - rect["x"] - rect["width"] / 2
+    ActionChains(browser).move_to_element_with_offset(curves, x, 0).click().perform()
+    WebDriverWait(browser, 5).until(lambda d: abs(frame_shown(d) - 1501) <= 3)  # a pixel is about 3 frames wide
+
+
+def test_compared_takes_are_overlaid_and_aligned(browser, data_dir, tmp_path):
+    motion = cmu(data_dir)
+    smooth = motion.filter("median", 9)
+    open_page(browser, tmp_path, [motion, smooth], names=["01_01.amc", "median 9"])
+    legend = browser.find_element(By.ID, "legend").text
+    assert "01_01.amc" in legend and "median 9" in legend
+    browser.execute_script("mtView.select('rhumerus'); mtView.seek(600)")
+    wait_frame(browser, 601)
+    cells = browser.find_elements(By.CSS_SELECTOR, "#channels td[data-take='1']")
+    expected = smooth.values[600, smooth.columns("rhumerus")]
+    assert [float(c.get_attribute("data-value")) for c in cells] == list(expected)
+    # the ghost skeleton is drawn at the same time
+    picture = screenshot(browser)
+    assert sum(inked(picture, x, y) for x, y in joints_on_screen(browser, 1)) >= 25
+    assert console_errors(browser) == []
+
+
+def test_footplants_are_marked_on_the_feet_and_the_timeline(browser, data_dir, tmp_path):
+    motion = cmu(data_dir)
+    flags = np.zeros(motion.frames, bool)
+    flags[:200] = True
+    open_page(browser, tmp_path, [motion], plants=[{"ltoes": flags}])
+    browser.execute_script("mtView.seek(100)")
+    wait_frame(browser, 101)
+    settle(browser)
+    picture = screenshot(browser)
+    j = motion.skeleton.joint_names.index("ltoes")
+    x, y = joints_on_screen(browser)[j]
+    green = (picture[..., 1] > 120) & (picture[..., 0] < 80) & (picture[..., 2] < 110)
+    assert green[int(y) - 3 : int(y) + 4, int(x) - 3 : int(x) + 4].any()
+    # on the timeline strip under the curves: inked where planted, blank after
+    rect = browser.find_element(By.ID, "curves").rect
+    strip_y = int(rect["y"] + rect["height"] - 7)
+    xa, xb = curve_x(browser, 100), curve_x(browser, 1500)
+    assert inked(picture, xa, strip_y, 1) and not inked(picture, xb, strip_y, 1)
+    browser.execute_script("mtView.seek(1000)")
+    wait_frame(browser, 1001)
+    settle(browser)
+    picture = screenshot(browser)
+    x, y = joints_on_screen(browser)[j]
+    green = (picture[..., 1] > 120) & (picture[..., 0] < 80) & (picture[..., 2] < 110)
+    assert not green[int(y) - 3 : int(y) + 4, int(x) - 3 : int(x) + 4].any()
+
+
+def apply_recipe(text: str, motion: mt.Motion, tmp_path) -> mt.Motion:
+    """The recipe applied by the command line (motiontheater apply) to the take, read back."""
+    from motiontheater.cli import main
+
+    recipe, take = (
+        tmp_path / "steps.toml",
+        tmp_path / ("take.bvh" if motion.skeleton.convention == "bvh" else "take.amc"),
+    )
+    recipe.write_text(text, encoding="utf-8")
+    mt.write_take(motion, take)
+    if take.suffix == ".amc":
+        mt.write_asf(motion.skeleton, take.with_suffix(".asf"))
+    out = take.with_name("out" + take.suffix)
+    assert main(["apply", str(take), "--recipe", str(recipe), "-o", str(out)]) == 0
+    return mt.read_take(out, take.with_suffix(".asf") if take.suffix == ".amc" else None)
+
+
+def previewed(browser, shape):
+    return np.array(browser.execute_script("return mtView.values(0)"), float).reshape(shape)
+
+
+STACKS = {
+    "euler": [dict(kind="euler", first=300, last=420, joints=["lfemur", "ltibia"])],
+    "slerp": [dict(kind="slerp", first=100, last=260, joints=None)],
+    "expmap": [dict(kind="expmap", first=1000, last=1200, joints=["root", "rhumerus", "rradius"])],
+    "aligned_expmap": [dict(kind="aligned_expmap", first=2000, last=2700, joints=None)],
+    "median3": [dict(kind="median3", first=1, last=900, joints=None)],
+    "median": [dict(kind="median", first=50, last=1600, joints=None, size=9)],
+    "mean": [dict(kind="mean", first=400, last=2751, joints=["root", "lowerback"], size=7)],
+    "binomial": [dict(kind="binomial", first=1, last=2751, joints=None, size=5)],
+    "stacked": [
+        dict(kind="median3", first=1, last=2751, joints=None),
+        dict(kind="slerp", first=500, last=700, joints=["lhumerus"]),
+        dict(kind="binomial", first=600, last=900, joints=["lhumerus", "lradius"], size=7),
+        dict(kind="aligned_expmap", first=880, last=1400, joints=None),
+    ],
+}
+
+
+@pytest.mark.parametrize("kind", ["amc", "bvh", "radians"])
+@pytest.mark.parametrize("stack", list(STACKS))
+def test_recipe_from_the_page_gives_the_previewed_motion(browser, data_dir, tmp_path, kind, stack):
+    motion = cmu(data_dir, "bvh" if kind == "bvh" else "amc")
+    if kind == "radians":
+        motion = motion.to_radians()
+    names = {"lfemur": "LeftUpLeg", "ltibia": "LeftLeg", "rhumerus": "RightArm", "rradius": "RightForeArm"}
+    names |= {"root": "root", "lhumerus": "LeftArm", "lradius": "LeftForeArm", "lowerback": "LowerBack"}
+    steps = STACKS[stack]
+    if kind == "bvh":
+        steps = [dict(s, joints=None if s["joints"] is None else [names[j] for j in s["joints"]]) for s in steps]
+    open_page(browser, tmp_path, [motion])
+    for step in steps:
+        browser.execute_script("mtView.addStep(arguments[0])", step)
+    recipe = browser.execute_script("return mtView.recipe()")
+    assert recipe.count("[[step]]") == len(steps)
+    expected = apply_recipe(recipe, motion, tmp_path).values
+    got = previewed(browser, motion.values.shape)
+    assert np.abs(got - expected).max() <= 1e-6
+    assert not np.array_equal(expected, motion.values)  # the steps did something
+    assert console_errors(browser) == []
+
+
+def test_preview_over_missing_and_infinite_samples(browser, data_dir, tmp_path):
+    """NaN and inf in the frames edited: the page's steps treat them as the package's do."""
+    motion = cmu(data_dir)
+    values = motion.values.copy()
+    femur, humerus = motion.columns("lfemur"), motion.columns("rhumerus")
+    values[300:304, femur[0]] = np.nan  # a gap inside a filtered range
+    values[310, femur[1]] = np.inf
+    values[500, humerus] = np.nan  # a key of an interpolation
+    values[200:220, humerus[2]] = np.nan  # a gap at the start of a range
+    motion = motion.replace(values=values)
+    open_page(browser, tmp_path, [motion])
+    steps = [
+        dict(kind="median", first=290, last=330, joints=["lfemur"], size=5),
+        dict(kind="mean", first=200, last=260, joints=["rhumerus"], size=7),
+        dict(kind="binomial", first=280, last=320, joints=None, size=5),
+        dict(kind="median3", first=290, last=320, joints=None),
+        dict(kind="slerp", first=480, last=500, joints=["rhumerus"]),
+    ]
+    for step in steps:
+        browser.execute_script("mtView.addStep(arguments[0])", step)
+    expected = mt.Pipeline.from_toml(browser.execute_script("return mtView.recipe()")).apply(motion).values
+    got = np.array(
+        browser.execute_script(
+            "return mtView.values(0).map(v => Number.isNaN(v) ? 'nan' : v === Infinity ? 'inf' : v === -Infinity ? '-inf' : v)"
+        )
+    )
+    got = got.astype(float).reshape(motion.values.shape)
+    assert np.array_equal(np.isnan(got), np.isnan(expected)) and np.array_equal(np.isinf(got), np.isinf(expected))
+    finite = np.isfinite(expected)
+    assert np.array_equal(got[~finite & ~np.isnan(expected)], expected[~finite & ~np.isnan(expected)])
+    assert np.abs(got[finite] - expected[finite]).max() <= 1e-6
+    assert console_errors(browser) == []
+
+
+def test_editing_through_the_controls(browser, data_dir, tmp_path):
+    motion = cmu(data_dir)
+    open_page(browser, tmp_path, [motion], names=["01_01.amc"])
+    browser.find_element(By.CSS_SELECTOR, ".jname[data-name='rfemur']").click()
+    drag_on_curves(browser, 400, 700)
+    first = int(browser.find_element(By.ID, "e-from").get_attribute("value"))
+    last = int(browser.find_element(By.ID, "e-to").get_attribute("value"))
+    assert abs(first - 401) <= 3 and abs(last - 701) <= 3
+    Select(browser.find_element(By.ID, "e-kind")).select_by_value("slerp")
+    browser.find_element(By.ID, "e-add").click()
+    Select(browser.find_element(By.ID, "e-kind")).select_by_value("binomial")
+    size = browser.find_element(By.ID, "e-size")
+    size.clear()
+    size.send_keys("7")
+    Select(browser.find_element(By.ID, "e-joints")).select_by_value("subtree")
+    browser.find_element(By.ID, "e-add").click()
+    recipe = browser.find_element(By.ID, "recipe").get_attribute("value")
+    parsed = tomllib.loads(recipe)["step"]
+    assert parsed[0] == {"run": "slerp", "frames": [first, last], "joints": ["rfemur"]}
+    assert parsed[1] == {
+        "run": "binomial",
+        "size": 7,
+        "frames": [first, last],
+        "joints": ["rfemur", "rtibia", "rfoot", "rtoes"],
+    }
+    expected = apply_recipe(recipe, motion, tmp_path).values
+    assert np.abs(previewed(browser, motion.values.shape) - expected).max() <= 1e-6
+    # a bad step is refused with a message and changes nothing
+    size.clear()
+    size.send_keys("4")
+    browser.find_element(By.ID, "e-add").click()
+    assert "odd" in browser.find_element(By.ID, "e-message").text
+    assert browser.find_element(By.ID, "recipe").get_attribute("value") == recipe
+    # the recipe downloads as a file
+    browser.find_element(By.ID, "e-download").click()
+    target = browser.downloads / "01_01.recipe.toml"
+    WebDriverWait(browser, 10).until(lambda d: target.exists())
+    assert target.read_text(encoding="utf-8") == recipe
+    # removing a step updates the preview
+    browser.find_element(By.CSS_SELECTOR, "#stack li:last-child button").click()
+    recipe = browser.find_element(By.ID, "recipe").get_attribute("value")
+    assert recipe.count("[[step]]") == 1
+    assert np.abs(previewed(browser, motion.values.shape) - apply_recipe(recipe, motion, tmp_path).values).max() <= 1e-6
