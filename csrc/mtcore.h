@@ -438,8 +438,8 @@ enum mt_pad {
  * step (scipy.signal.sosfilt_zi).  Requires padlen < n (padlen is ignored
  * for MT_PAD_NONE, then n >= 1).
  *
- * Computed as scipy computes it, bit for bit, with the input read twice and
- * the output written once (see iir.c).
+ * Computed as scipy computes it, bit for bit, with the input read once and
+ * the forward outputs written to out and read back (see iir.c).
  */
 int mt_sosfiltfilt(const double *sos, size_t sections, const double *zi, const double *in, double *out, size_t n,
                    size_t channels, size_t stride, size_t padlen, int padtype);
