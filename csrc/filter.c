@@ -23,6 +23,7 @@
  * does not fit is MT_ENOMEM, never a short buffer.
  */
 #include "clones.h"
+#include "lines.h"
 #include "mtcore.h"
 
 #include <math.h>
@@ -51,37 +52,6 @@ static void *alloc_array(size_t count, size_t size)
     if (size != 0 && count > SIZE_MAX / size)
         return NULL;
     return malloc(count * size > 0 ? count * size : 1);
-}
-
-/* Index into 0..n-1 of position r of the extended line, or -1 for the fill value. */
-static ptrdiff_t extend_index(ptrdiff_t r, ptrdiff_t n, int mode)
-{
-    if (r >= 0 && r < n)
-        return r;
-    switch (mode) {
-    case MT_MODE_NEAREST:
-        return r < 0 ? 0 : n - 1;
-    case MT_MODE_WRAP: {
-        ptrdiff_t m = r % n;
-        return m < 0 ? m + n : m;
-    }
-    case MT_MODE_REFLECT: {
-        ptrdiff_t period = 2 * n, m = r % period;
-        if (m < 0)
-            m += period;
-        return m < n ? m : period - 1 - m;
-    }
-    case MT_MODE_MIRROR: {
-        if (n == 1)
-            return 0;
-        ptrdiff_t period = 2 * n - 2, m = r % period;
-        if (m < 0)
-            m += period;
-        return m < n ? m : period - m;
-    }
-    default:
-        return -1;
-    }
 }
 
 /*
@@ -123,15 +93,15 @@ static void window_counts(ptrdiff_t lo, size_t size, size_t n, int mode, size_t 
                                                     : 2 * n - 2;
     const size_t whole = size / period, rest = size % period;
     for (size_t p = 0; p < period; p++)
-        counts[extend_index((ptrdiff_t)p, len, mode)] += whole;
+        counts[mt_extend_index((ptrdiff_t)p, len, mode)] += whole;
     for (size_t j = 0; j < rest; j++)
-        counts[extend_index(lo + (ptrdiff_t)j, len, mode)]++;
+        counts[mt_extend_index(lo + (ptrdiff_t)j, len, mode)]++;
 }
 
 /* Sample (or n for the fill value) at position r of the extended line. */
 static size_t sample_at(ptrdiff_t r, size_t n, int mode)
 {
-    const ptrdiff_t i = extend_index(r, (ptrdiff_t)n, mode);
+    const ptrdiff_t i = mt_extend_index(r, (ptrdiff_t)n, mode);
     return i < 0 ? n : (size_t)i;
 }
 

@@ -1,7 +1,7 @@
 /*
- * lines.h - build-internal: helpers of the signal kernels (bands.c, iir.c,
- * resample.c, gaps.c), which walk lines of samples down the rows of a
- * (frames, stride) array.
+ * lines.h - build-internal: helpers of the kernels that walk lines of samples
+ * down the rows of a (frames, stride) array: the smoothing filters (filter.c)
+ * and the signal kernels (bands.c, iir.c, resample.c, gaps.c).
  */
 #ifndef MT_LINES_H
 #define MT_LINES_H

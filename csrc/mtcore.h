@@ -37,7 +37,8 @@ enum mt_status {
     MT_EMISSING = -8,   /* a frame lacks a key that takes numbers */
     MT_EFRAME = -9,     /* a frame number out of sequence, or a key line before any frame */
     MT_ERANGE = -10,    /* more frames than the output holds, or an output buffer too small */
-    MT_EFRAMERANGE = -11 /* a frame number outside 0 .. MT_FRAME_MAX, read or to be written */
+    MT_EFRAMERANGE = -11, /* a frame number outside 0 .. MT_FRAME_MAX, read or to be written */
+    MT_EIO = -12          /* a memory-mapped file shrank while it was read (see mt_guard_install) */
 };
 
 enum mt_dtype {
@@ -71,6 +72,18 @@ enum mt_filter {
 };
 
 const char *mt_strerror(int status);
+
+/*
+ * Reading memory-mapped files safely: a file truncated while it is mapped
+ * and read raises SIGBUS past its new end, which kills the process.  After
+ * mt_guard_install() (once per process; it keeps any handler there was for
+ * a SIGBUS elsewhere), the scanners (mt_scan_frames, mt_scan_table) and
+ * mt_copy_mapped return MT_EIO instead.
+ */
+int mt_guard_install(void);
+
+/* Copies n bytes of a mapping to target; MT_EIO where the mapping's file has shrunk. */
+int mt_copy_mapped(const char *source, size_t n, char *target);
 
 /*
  * One-dimensional filter along the middle axis of (outer, n, inner) arrays of
@@ -479,6 +492,75 @@ int mt_fill_gaps(const double *in, double *out, size_t n, size_t channels, size_
  */
 int mt_nan_runs(const double *in, size_t n, size_t channels, size_t stride, size_t *runs, size_t capacity,
                 size_t *count);
+/*
+ * Retargeting (retarget.c): a motion of a source skeleton as the rotation
+ * channels of a target skeleton.
+ *
+ * A tree is the tables of mt_forward_kinematics (see there) with its joint
+ * and channel counts; parent_frame may be NULL.
+ */
+struct mt_tree {
+    size_t joints, channels;
+    const long long *parent, *order;
+    const double *axis, *direction, *segment;
+    const size_t *dof_start, *dof_column;
+    const int *dof_kind;
+    const unsigned char *parent_frame;
+    double angle_scale;
+};
+
+/*
+ * The plan of a retarget, per target joint j (rows of the arrays):
+ *   follow[j]        the source joint whose world rotation it follows, or -1:
+ *                    it keeps its rest rotation (its channels 0);
+ *   correction[9j..] P: its wanted world rotation is D = A W_s P, W_s the
+ *                    source joint's world rotation, A = align (row-major,
+ *                    source world axes to target world axes);
+ *   key_points[2j..] source points a, b (rows of the source's FK positions)
+ *                    whose direction p_b - p_a is the one the joint's bone
+ *                    should point in, or -1 -1: none;
+ *   key_vector[3j..] that bone at rest, target world axes;
+ *   refit[j]         when set, D is turned each frame by the smallest
+ *                    rotation that takes D key_vector onto A (p_b - p_a),
+ *                    so that the bone points where the source's points lie
+ *                    even when source joints between them turn;
+ *   hinge[j]         a target joint with one rotation channel that hangs
+ *                    from j (unmapped joints between), or -1: a joint with
+ *                    three rotation channels then turns D about its own bone
+ *                    by the smallest angle that lets the hinge aim its bone
+ *                    at its source direction (fading out as their bend
+ *                    nears none, where any such turn serves);
+ *   aim[3j..]        the rest direction (target world axes) that a joint with
+ *                    one or two rotation channels turns as near as it can to
+ *                    where D turns it, or 0 0 0 (then: one channel takes D's
+ *                    twist about its axis, two the Euler angles with the
+ *                    missing axis between, dropped).
+ * Its local rotation L = W_parent^T D, M = C^T L C (C its axis), becomes its
+ * rotation channels (Euler angles of M about their axes, in the order the
+ * tree applies them, about fixed axes: a, c in [-pi, pi], b in [-pi/2, pi/2]),
+ * in units of 1/angle_scale radians; its world rotation is then W_parent
+ * C M' C^T, M' the rotation its channels make.
+ */
+struct mt_retarget_plan {
+    const long long *follow;
+    const double *correction;
+    const long long *key_points;
+    const double *key_vector;
+    const unsigned char *refit;
+    const long long *hinge;
+    const double *aim;
+    double align[9];
+};
+
+/*
+ * Writes, for frames begin .. end-1 of values (frames x source->channels),
+ * the rotation channels of every target joint into out (frames x
+ * target->channels); its other channels are not touched.  MT_EINVAL for
+ * tables out of range or a target joint with more than three rotation
+ * channels, or with two about one axis.
+ */
+int mt_retarget(const double *values, size_t frames, const struct mt_tree *source, const struct mt_tree *target,
+                const struct mt_retarget_plan *plan, size_t begin, size_t end, double *out);
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

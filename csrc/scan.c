@@ -8,6 +8,8 @@
  * (number.c), exact for any length, so that every value equals what Python's float() gives
  * for the same text.
  */
+#define _POSIX_C_SOURCE 200809L /* sigsetjmp, for the guard */
+#include "guard.h"
 #include "mtcore.h"
 #include "number.h"
 
@@ -280,8 +282,8 @@ static int scan_text(const char *text, const char *end, struct scan *s, double *
     return MT_OK;
 }
 
-int mt_scan_table(const char *text, size_t len, size_t rows, size_t columns, double *values,
-                  struct mt_scan_report *report)
+static int scan_table(const char *text, size_t len, size_t rows, size_t columns, double *values,
+                      struct mt_scan_report *report)
 {
     if (report == NULL)
         return MT_EINVAL;
@@ -317,6 +319,14 @@ int mt_scan_table(const char *text, size_t len, size_t rows, size_t columns, dou
     return MT_OK;
 }
 
+int mt_scan_table(const char *text, size_t len, size_t rows, size_t columns, double *values,
+                  struct mt_scan_report *report)
+{
+    int status;
+    MT_GUARDED(status, scan_table(text, len, rows, columns, values, report));
+    return status;
+}
+
 int mt_scan_frames(const char *text, size_t len, const char *const *keys, const size_t *key_lens,
                    const size_t *offsets, const size_t *counts, size_t nkeys, double *values,
                    size_t max_frames, size_t channels, struct mt_scan_report *report)
@@ -337,7 +347,7 @@ int mt_scan_frames(const char *text, size_t len, const char *const *keys, const 
     s.order = malloc((nkeys + 1) * sizeof *s.order);
     int status = MT_ENOMEM;
     if (s.seen_in && s.order)
-        status = scan_text(text, text + len, &s, values, max_frames, channels, report);
+        MT_GUARDED(status, scan_text(text, text + len, &s, values, max_frames, channels, report));
     free(s.seen_in);
     free(s.order);
     return status;

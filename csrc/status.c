@@ -27,6 +27,8 @@ const char *mt_strerror(int status)
         return "output too small";
     case MT_EFRAMERANGE:
         return "frame number outside 0 .. MT_FRAME_MAX";
+    case MT_EIO:
+        return "the file shrank while it was read (written to, or truncated, by another program?)";
     default:
         return "unknown status code";
     }

@@ -2,6 +2,8 @@
 
 import io
 import shutil
+import subprocess
+import sys
 
 import pytest
 
@@ -83,3 +85,74 @@ def test_a_bvh_header_claiming_more_frames_than_the_file_can_hold_allocates_noth
     (tmp_path / "claim.bvh").write_text(text.replace("Frames:\t101", "Frames: 100000000"))
     with pytest.raises(mt.TruncatedError, match=r"claim.bvh, line \d+: the header says 100000000 frames but the"):
         mt.read_bvh(tmp_path / "claim.bvh")
+
+
+def test_a_take_that_shrinks_while_it_is_read_is_an_error_not_a_crash(data_dir, tmp_path):
+    """Takes are memory-mapped: a file truncated meanwhile (SIGBUS at the first page past its new
+    end) ends the read with a clear error; the process lives on, and a whole file reads as before.
+    Both the reader (which copies the head through the guard) and the scanners themselves."""
+    script = f"""
+import mmap, os, shutil
+import motiontheater as mt
+from motiontheater.amc import _layout, _read
+from mtcore.errors import ChangedFileError
+from mtcore.text import scan_frames, scan_table
+original, take = {str(data_dir / "cmu" / "01_01.amc")!r}, {str(tmp_path / "t.amc")!r}
+table = {str(tmp_path / "table.txt")!r}
+with open(table, "w") as f:
+    f.write("1.5 2 3 4 5 6\\n" * 60_000)
+skeleton = mt.read_asf({str(data_dir / "cmu" / "01.asf")!r})
+keys, offsets, counts = _layout(skeleton, skeleton.joint_names)
+body = open(original, "rb").read().index(b"\\n1\\r\\n") + 1
+calls = {{
+    "reader": (original, lambda text: _read(text, take, skeleton, None, 1)),
+    "frames": (original, lambda text: scan_frames(text, keys, offsets, counts, 62, start=body, workers=1)),
+    "table": (table, lambda text: scan_table(text, 60_000, 6, workers=1)),
+}}
+for name, (source, call) in calls.items():
+    for cut in (0, 100, 200_000):
+        shutil.copy(source, take)
+        with open(take, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
+            os.truncate(take, cut)
+            try:
+                call(mapped)
+                print(name, "read")
+            except ChangedFileError as e:
+                print(name, str(e).split(":")[0])
+shutil.copy(original, take)
+print(mt.read_amc(take, skeleton).frames)
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == [
+        *["reader mt_copy_mapped"] * 3,
+        *["frames mt_scan_frames"] * 3,
+        *["table mt_scan_table"] * 3,
+        "2751",
+    ], done.stdout
+
+
+def test_the_error_in_a_bad_take_does_not_depend_on_the_worker_count():
+    """A take scanned in pieces reports the first thing wrong in it, as one piece does: here a frame
+    number out of sequence where a piece begins, and a later one inside that piece."""
+    from mtcore.errors import FormatError
+    from mtcore.text import _piece_count, _pieces, scan_frames
+
+    keys, offsets, counts = [b"root", b"lfemur"], [0, 6], [6, 3]
+    frame = ["{}", "root 1.5 2.5 3.5 0.1 0.2 0.3", "lfemur 10.25 -3.5 7"]
+    lines = [line.format(f) for f in range(1, 60_001) for line in frame]
+    whole = ("\n".join(lines) + "\n").encode()
+    boundaries = [begin for begin, _ in _pieces(whole, 0, _piece_count(4, len(whole)))[1:]]
+    assert boundaries, "the take must be long enough to be cut"
+    for boundary in boundaries:
+        at = whole[:boundary].count(b"\n")
+        lines_bad = list(lines)
+        lines_bad[at] = "5"
+        lines_bad[at + 30] = "root 1 2 x 4 5 6"
+        text = ("\n".join(lines_bad) + "\n").encode()
+        errors = set()
+        for workers in (1, 2, 3, 4):
+            with pytest.raises(FormatError) as caught:
+                scan_frames(text, keys, offsets, counts, 9, workers=workers)
+            errors.add((type(caught.value), str(caught.value)))
+        assert errors == {(mt.SequenceError, f"line {at + 1}: frame number 5 out of sequence: expected {at // 3 + 1}")}

@@ -24,11 +24,18 @@ def test_the_python_examples_run_in_order(data_dir, tmp_path, monkeypatch):
             raise AssertionError(f"README python block {n} fails: {e!r}\n{code}") from e
 
 
-def test_the_recipes_read():
-    """Every TOML example is a recipe of steps that the registry accepts."""
+def test_the_toml_examples_read(tmp_path):
+    """Every TOML example reads: a recipe of steps through the registry, a retargeting map file
+    ([joints]) through the map reader."""
     import motiontheater as mt
+    from motiontheater.rigs import read_map
 
-    recipes = blocks("toml")
-    assert recipes
+    examples = blocks("toml")
+    recipes = [text for text in examples if "[[step]]" in text]
+    maps = [text for text in examples if text.lstrip().startswith("[joints]")]
+    assert recipes and maps and len(recipes) + len(maps) == len(examples)
     for text in recipes:
         assert mt.Pipeline.from_toml(text, "README.md").entries
+    for text in maps:
+        (tmp_path / "map.toml").write_text(text)
+        assert read_map(tmp_path / "map.toml")[0]

@@ -26,6 +26,8 @@ from .interpolators import interpolate, median3
 from .motion import DEFAULT_FRAME_RATE, Motion
 from .pipeline import Pipeline
 from .registry import StepError, steps
+from .retarget import plan_retarget, retarget
+from .rigs import joint_map
 from .scene import Scene, Track, read_recipe
 from .skeleton import Bone, Root, Skeleton
 
@@ -44,14 +46,17 @@ __all__ = [
     "combine",
     "filter_motion",
     "interpolate",
+    "joint_map",
     "median3",
     "median_filter1d",
     "pascal_weights",
+    "plan_retarget",
     "read_amc",
     "read_asf",
     "read_bvh",
     "read_recipe",
     "read_take",
+    "retarget",
     "skeleton_path_for",
     "steps",
     "to_asf",

@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from mtcore import format_frames, format_number, scan_frames
-from mtcore.text import frame_line, line_breaks
+from mtcore.errors import ChangedFileError
+from mtcore.text import copy_text, frame_line, line_breaks
 
 from ._io import LINE_BREAK, Source, Text, TextStyle, decode, encode, mapped_source, output
 from .errors import FormatError, SequenceError
@@ -20,6 +21,7 @@ from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Skeleton
 
 READ_BYTES = 8 << 20  # bytes read at a time when a take is streamed
+HEAD_BYTES = 4 << 20  # the start of a take that holds its header, first frame and style
 
 _RATE_KEYS = (":SAMPLES-PER-SECOND", ":SAMPLES_PER_SECOND", ":FRAME-RATE")
 
@@ -102,7 +104,13 @@ def read_amc(
     ``workers=1`` keeps to the calling thread (as batch jobs in processes should).
     """
     with mapped_source(source) as (data, name):
-        return _read(data, name, skeleton, frame_rate, workers).read_from(source)
+        try:
+            motion = _read(data, name, skeleton, frame_rate, workers)
+        except ChangedFileError:
+            raise ChangedFileError(
+                f"{name}: the file changed while it was read; read it again when it is whole"
+            ) from None
+    return motion.read_from(source)
 
 
 def _read_header(
@@ -123,13 +131,17 @@ def _read_header(
 
 
 def _read(data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | None, workers: int | None) -> Motion:
-    header, body, header_lines, rate = _read_header(data, name, skeleton, frame_rate)
+    # Python reads a copy of the head (header, first frame, style); only the C scanner, which is
+    # guarded against a file that shrinks meanwhile, reads a mapped file itself
+    head = copy_text(data, 0, HEAD_BYTES)
+    header, body, header_lines, rate = _read_header(head, name, skeleton, frame_rate)
     joints = skeleton.joint_names
     keys, offsets, counts = _layout(skeleton, joints)
     try:
         values, first = scan_frames(
             data, keys, offsets, counts, len(skeleton.channels), start=body, noun="bone", workers=workers
         )
+        ends_in_a_break = copy_text(data, len(data) - 1) in (b"", b"\n", b"\r")
     except FormatError as e:
         raise e.at(name, header_lines) from None
     values.flags.writeable = False
@@ -139,8 +151,8 @@ def _read(data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | 
         frame_rate=rate,
         first_frame=first if len(values) else 1,
         header=tuple(text for _, text in header),
-        line_order=_first_frame_order(data, body, set(joints)),
-        style=TextStyle.of(data),
+        line_order=_first_frame_order(head, body, set(joints)),
+        style=dataclasses.replace(TextStyle.of(head), final_newline=ends_in_a_break),
     )
 
 

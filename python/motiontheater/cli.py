@@ -137,6 +137,9 @@ def _run_step(args: argparse.Namespace) -> int:
     step = lookup(args.step)
     options = {o.name: getattr(args, o.name) for o in step.all_options if getattr(args, o.name) is not None}
     source, asf = _inputs(args)
+    if getattr(args, "dry_run", False):
+        print(step.describe(read_take(source, asf, args.frame_rate), **options))
+        return 0
     target = _output(args, source)
     if not step.is_exporter:
         take_suffix(target)
@@ -318,6 +321,8 @@ def _step_verb(verbs: Any, step: Step) -> None:
     parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
     _output_options(parser, what)
     _take_options(parser)
+    if step.dry_run is not None:
+        parser.add_argument("--dry-run", action="store_true", help="print what the step would do; write nothing")
     for option in step.all_options:
         shown = option.required or option.default is None  # the help says what None means
         help_text = option.help + ("" if shown else f" (default: {_shown(option.default)})")

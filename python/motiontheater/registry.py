@@ -176,6 +176,9 @@ class Step:
     "none" (no range: the step changes frames, rate or skeleton).
     ``streamer``, where set, makes the step streamable: it builds the object
     that applies the step chunk by chunk (see motiontheater.amc).
+    ``dry_run``, where set, is ``f(motion, **options) -> str``: what the step
+    would do to the motion, in words, with nothing done (its verb's --dry-run);
+    it takes the step's options, and ``frames`` where the registry splices.
     """
 
     name: str
@@ -187,6 +190,7 @@ class Step:
     streamer: Callable[..., Any] | None = None
     suffixes: tuple[str, ...] = ()  # an exporter's file suffixes; empty for a step
     aliases: tuple[str, ...] = ()  # other names of the step (command-line verbs, recipes)
+    dry_run: Callable[..., str] | None = None
 
     @property
     def is_exporter(self) -> bool:
@@ -219,6 +223,14 @@ class Step:
             else:
                 bound[name] = option.default
         return bound
+
+    def describe(self, motion: Any, **options: Any) -> str:
+        """What the step would do to ``motion`` with ``options``, in words: its ``dry_run`` called
+        with the options checked and completed as :meth:`bind` does; StepError for a step without
+        one, or options it does not take."""
+        if self.dry_run is None:
+            raise StepError(f"step '{self.name}' has no dry run")
+        return self.dry_run(motion, **self.bind(options))
 
     def __call__(self, motion: Any, *args: Any, **options: Any) -> Any:
         """Run the step on ``motion`` (exporters take the target as ``args[0]``)."""
@@ -257,11 +269,13 @@ def step(
     frames: str = "splice",
     streamer: Callable[..., Any] | None = None,
     aliases: tuple[str, ...] = (),
+    dry_run: Callable[..., str] | None = None,
 ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """Register the decorated function as the step ``name`` (see the module docstring)."""
+    """Register the decorated function as the step ``name`` (see the module docstring and
+    :class:`Step` for ``frames``, ``streamer`` and ``dry_run``)."""
 
     def decorate(function: Callable[..., Any]) -> Callable[..., Any]:
-        register(name, function, summary, frames=frames, streamer=streamer, aliases=aliases)
+        register(name, function, summary, frames=frames, streamer=streamer, aliases=aliases, dry_run=dry_run)
         return function
 
     return decorate
@@ -291,6 +305,7 @@ def register(
     suffixes: tuple[str, ...] = (),
     fixed: Mapping[str, Any] | None = None,
     aliases: tuple[str, ...] = (),
+    dry_run: Callable[..., str] | None = None,
 ) -> Step:
     """Register ``function`` as ``name``; ``fixed`` options are bound and hidden (one function serving
     several steps, e.g. each filter kind).  Returns the step; a name registered twice is an error."""
@@ -318,6 +333,7 @@ def register(
         streamer=streamer,
         suffixes=suffixes,
         aliases=aliases,
+        dry_run=dry_run,
     )
     _REGISTRY[name] = registered
     _ALIASES.update((alias, name) for alias in aliases)

@@ -22,6 +22,7 @@ _EXCEPTIONS: dict[int, type[Exception]] = {
     # a table with more rows than its header declares (mt_scan_table); elsewhere an output
     # buffer below its bound, which Python sizes, so a broken invariant
     lib.MT_ERANGE: errors.SequenceError,
+    lib.MT_EIO: errors.ChangedFileError,
 }
 
 

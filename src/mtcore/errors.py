@@ -60,3 +60,7 @@ class SequenceError(FormatError):
 
 class TruncatedError(MissingError):
     """The file ends before its last record is complete."""
+
+
+class ChangedFileError(OSError):
+    """A memory-mapped file that shrank (another program wrote to it or truncated it) while it was read."""

@@ -30,6 +30,8 @@ from ._parallel import run_all, thread_count
 from ._status import check
 from .errors import NumberError, SequenceError
 
+check(lib.mt_guard_install(), "mt_guard_install")  # scanning a mapped file that shrinks: an error, not a crash
+
 Text = bytes | mmap.mmap  # text to scan: read into memory, or mapped from its file
 
 __all__ = [
@@ -98,13 +100,34 @@ class _KeyTable:
         self.n = len(keys)
 
 
-def _line_text(text: Text, offset: int) -> str:
-    end = len(text)
-    for stop in (b"\n", b"\r"):
-        found = text.find(stop, offset)
-        if found != -1:
-            end = min(end, found)
-    return text[offset:end].decode("utf-8", "replace").strip()
+def _line_at(text: Text, offset: int) -> tuple[str, bool]:
+    """The line that begins at ``offset`` (its first 4 KB), and whether a line break ends it
+    (a last line without one is where a file was cut)."""
+    window = copy_text(text, offset, offset + 4096)
+    breaks = [i for i in (window.find(b"\n"), window.find(b"\r")) if i != -1]
+    line = window[: min(breaks)] if breaks else window
+    ended = bool(breaks) or (offset + len(window) < len(text) and _break_after(text, offset + len(window)))
+    return line.decode("utf-8", "replace").strip(), ended
+
+
+def _blank_to_end(text: Text, offset: int) -> bool:
+    """Whether nothing but blanks and line breaks follows ``offset`` (read a window at a time)."""
+    while offset < len(text):
+        window = copy_text(text, offset, offset + _WINDOW)
+        if window.strip():
+            return False
+        offset += len(window)
+    return True
+
+
+def _break_after(text: Text, offset: int) -> bool:
+    """Whether a line break follows ``offset`` anywhere in the text (read a window at a time)."""
+    while offset < len(text):
+        window = copy_text(text, offset, offset + _WINDOW)
+        if b"\n" in window or b"\r" in window:
+            return True
+        offset += len(window)
+    return False
 
 
 def scan_frames(
@@ -160,12 +183,13 @@ def scan_frames(
         statuses = run_all([piece(i) for i in range(len(pieces))])
     frames, first = 0, 0
     for (begin, _), base, report, status in zip(pieces, bases, reports, statuses):
-        check(status, "mt_scan_frames", _describer(text, start, begin, table, report, noun))
+        # the piece's first frame number comes before anything else wrong in it, as in one piece
         if frames and report.frames and report.first_frame != first + frames:
             raise SequenceError(
                 f"frame number {report.first_frame} out of sequence: expected {first + frames}",
                 line_breaks(text, start, begin) + 1,
             )
+        check(status, "mt_scan_frames", _describer(text, start, begin, table, report, noun))
         if not frames:
             first = report.first_frame
         values[frames : frames + report.frames] = values[base : base + report.frames]
@@ -182,10 +206,40 @@ _PIECE_BYTES = 1 << 20  # below this a text is scanned in one piece
 _FRAME_LINE = re.compile(rb"(?:^|(?<=[\r\n]))[ \t]*\d+[ \t]*(?:\r\n|[\r\n]|\Z)")
 
 
+def copy_text(text: Text, begin: int = 0, end: int | None = None) -> bytes:
+    """``text[begin:end]`` as bytes.  From a mapped file the bytes come through a guarded copy, so a
+    file shrunk by another program meanwhile is an OSError here, not a crash (SIGBUS)."""
+    end = len(text) if end is None else min(end, len(text))
+    if not isinstance(text, mmap.mmap):
+        return bytes(text[begin:end])
+    out = bytearray(max(0, end - begin))
+    if out:
+        with ffi.from_buffer(text) as source, ffi.from_buffer(out) as target:
+            check(lib.mt_copy_mapped(source + begin, len(out), target), "mt_copy_mapped")
+    return bytes(out)
+
+
+_WINDOW = 1 << 16  # bytes of a mapped file that Python looks at a time
+
+
 def frame_line(text: Text, start: int = 0, end: int | None = None, *, last: bool = False) -> int:
     """The offset of the first (with ``last``, the last) line that begins within ``text[start:end]``
-    and holds only a frame number, or -1.  Lines end in LF, CRLF or CR."""
+    and holds only a frame number, or -1.  Lines end in LF, CRLF or CR.  A mapped file is read a
+    window at a time through :func:`copy_text`."""
     end = len(text) if end is None else end
+    if isinstance(text, mmap.mmap) and not last:
+        window = _WINDOW
+        while True:  # the byte before start too: whether a line begins at start
+            low = max(0, start - 1)
+            piece = copy_text(text, low, min(end, start + window))
+            found = frame_line(piece, start - low, len(piece))
+            if found != -1 or start + window >= end:
+                return -1 if found == -1 else low + found
+            window *= 4
+    if isinstance(text, mmap.mmap):
+        low = max(start, end - 16 * _WINDOW)
+        found = frame_line(copy_text(text, low, end), 0 if low == start else 1, last=True)
+        return found + low if found != -1 else frame_line(text, start, low, last=True) if low > start else -1
     if not last:
         match = _FRAME_LINE.search(text, start, end)
         return -1 if match is None else match.start()
@@ -222,7 +276,7 @@ def _pieces(text: Text, start: int, count: int) -> list[tuple[int, int]]:
 
 def line_breaks(text: Text, begin: int = 0, end: int | None = None) -> int:
     """The number of line ends (LF, CRLF or CR) in ``text[begin:end]``."""
-    part = text[begin:end]
+    part = copy_text(text, begin, end)
     return part.count(b"\n") + part.count(b"\r") - part.count(b"\r\n")
 
 
@@ -232,12 +286,12 @@ def _describer(
     """What went wrong in the piece of text that starts at ``begin`` (line numbers from ``start``)."""
 
     def describe(status: int) -> tuple[str, int, bool]:
-        line = _line_text(text, begin + report.offset)
+        line, ended = _line_at(text, begin + report.offset)
         key = table.keys[report.key].decode("utf-8", "replace") if report.key >= 0 else None
         frame = report.first_frame + report.frames - 1
-        rest = text[begin + report.offset :]
-        # An error in a last line that has no line break: the file was cut there.
-        truncated = not rest.strip() or not any(c in rest for c in b"\r\n")
+        # An error in a last line that has no line break, or with nothing but blanks after it: the
+        # file was cut there.
+        truncated = not ended or _blank_to_end(text, begin + report.offset)
         if status == lib.MT_ESYNTAX:
             tokens = line.split()
             token = tokens[report.found + 1] if report.found + 1 < len(tokens) else ""
@@ -356,7 +410,7 @@ def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers:
         lines_before = line_breaks(text, start, begin)
 
         def describe(code: int, report=report, begin=begin, lines_before=lines_before) -> tuple[str, int, bool]:
-            line, at = _line_text(text, begin + report.offset), lines_before + report.line
+            line, at = _line_at(text, begin + report.offset)[0], lines_before + report.line
             if code == lib.MT_ESYNTAX:
                 tokens = line.split()
                 token = tokens[report.found] if report.found < len(tokens) else ""

@@ -13,6 +13,7 @@ no input is modified; tests/test_concurrent.py calls every ``fast`` from eight t
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -26,8 +27,9 @@ from mtcore import signal as mt_signal
 from mtcore import text as mt_text
 from mtcore.combine import combine_frames
 from mtcore.kinematics import JointTree, forward_kinematics
+from mtcore.retarget import RetargetPlan, retarget_rotations
 
-from . import combine, filters, kinematics, rotations
+from . import combine, filters, kinematics, retarget, rotations
 from . import signal as signal_twins
 from . import text as text_twins  # binds twins.text too: mtcore's is mt_text
 
@@ -369,6 +371,76 @@ def fast_interpolate_euler(k0, k1, t, order, extrinsic, degrees, blend, start, r
     )
 
 
+# --- retarget -------------------------------------------------------------------------------
+
+
+def rotation_tree(rng: np.random.Generator, joints: int) -> JointTree:
+    """A target tree: each joint with 0 to 3 rotation channels about distinct axes (proper Euler
+    sequences too), among translations now and then, in radians or degrees."""
+    tree = random_tree(rng, joints)
+    dof_start, dof_kind = [0], []
+    for _ in range(joints):
+        count = int(rng.integers(0, 4))
+        axes = rng.permutation(3)[:count].tolist()
+        extra = rng.integers(3, 7, int(rng.integers(0, 2))).tolist()  # translations, in the order anywhere
+        if count == 3 and rng.random() < 0.3:
+            axes[2] = axes[0]  # proper Euler: x y x and the like
+        at = int(rng.integers(0, count + 1))
+        dof_kind += axes[:at] + extra + axes[at:]
+        dof_start.append(len(dof_kind))
+    return dataclasses.replace(
+        tree,
+        dof_start=dof_start,
+        dof_kind=dof_kind,
+        dof_column=rng.permutation(max(len(dof_kind), 1))[: len(dof_kind)],
+    )
+
+
+def retarget_cases(rng: np.random.Generator) -> list[tuple]:
+    """Random source and target trees and plans: joints followed or at rest, bones re-aimed onto
+    random source points, swivels over one-channel joints, aims or none, turns between axes."""
+    out = []
+    for sources, targets, frames in ((1, 1, 0), (2, 1, 1), (4, 5, 8), (6, 7, 9), (5, 9, 70)):
+        source, target = random_tree(rng, sources), rotation_tree(rng, targets)
+        turns = [
+            sum(k <= 2 for k in target.dof_kind[target.dof_start[j] : target.dof_start[j + 1]]) for j in range(targets)
+        ]
+        hinges = [j for j in range(targets) if turns[j] == 1]
+        key_points = rng.integers(0, sources, (targets, 2))
+        key_points[rng.random(targets) < 0.2] = -1
+        plan = RetargetPlan(
+            follow=np.where(rng.random(targets) < 0.2, -1, rng.integers(0, sources, targets)),
+            correction=rotations.matrices(rng.uniform(-3, 3, (targets, 3)), "xyz"),
+            key_points=key_points,
+            key_vector=rng.normal(size=(targets, 3)),
+            refit=rng.integers(0, 2, targets),
+            hinge=[
+                int(rng.choice(hinges)) if hinges and turns[j] == 3 and rng.random() < 0.7 else -1
+                for j in range(targets)
+            ],
+            aim=rng.normal(size=(targets, 3)) * (rng.random((targets, 1)) < 0.7),
+            align=rotations.matrices(rng.uniform(-3, 3, 3), "xyz")
+            if rng.random() < 0.5
+            else np.eye(3)[rng.permutation(3)],
+        )
+        if np.linalg.det(plan.align) < 0:
+            plan = dataclasses.replace(plan, align=-plan.align)
+        values = rng.uniform(-180, 180, (frames, max(len(source.dof_kind), 1)))
+        out.append((values, source, target, max(len(target.dof_kind), 1), plan))
+    return out
+
+
+def turns_close(got, want) -> None:
+    """Angles equal to 1e-9 of a turn (the period: whichever of 2 pi and 360 the values are in)."""
+    got, want = np.asarray(got), np.asarray(want)
+    assert got.shape == want.shape, (got.shape, want.shape)
+    for period in (2 * math.pi, 360.0):
+        difference = np.abs(np.remainder(got - want + period / 2, period) - period / 2)
+        if difference.max(initial=0) <= 1e-9 * period:
+            return
+    raise AssertionError(f"angles differ by up to {np.abs(got - want).max()}")
+
+
 # --- combine --------------------------------------------------------------------------------
 
 
@@ -492,6 +564,23 @@ def parse_cases(rng: np.random.Generator) -> list[tuple]:
     ]
 
 
+def mapped_cases(rng: np.random.Generator) -> list[tuple]:
+    data = rng.integers(0, 256, 70_000, dtype=np.uint8).tobytes()
+    return [(data, begin, end) for begin, end in ((0, 0), (0, 1), (5, 70_000), (65_530, 69_999), (100, 100_000))]
+
+
+def copy_mapped(data: bytes, begin: int, end: int) -> bytes:
+    """The guarded copy from a real mapping of a file holding ``data``."""
+    import mmap
+    import tempfile
+
+    with tempfile.TemporaryFile() as f:
+        f.write(data)
+        f.flush()
+        with mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
+            return mt_text.copy_text(mapped, begin, end)
+
+
 # --- the registry ---------------------------------------------------------------------------
 
 TWINS: dict[str, Twin] = {
@@ -557,6 +646,8 @@ TWINS: dict[str, Twin] = {
         fast_interpolate_euler, rotations.interpolate_euler, interpolate_euler_cases, close(1e-12)
     ),
     "mt_combine": Twin(fast_combine, slow_combine, combine_cases, exact),
+    "mt_copy_mapped": Twin(copy_mapped, lambda data, begin, end: data[begin:end], mapped_cases, exact),
+    "mt_retarget": Twin(retarget_rotations, retarget.retarget_rotations, retarget_cases, turns_close),
     "mt_parse_number": Twin(mt_text.parse_number, float, parse_cases, close(0.0)),
     "mt_equalize": Twin(
         lambda x, g, mode: mt_signal.equalize(x, g, 0, mode), signal_twins.equalize_twin, equalize_cases, close(1e-12)
@@ -579,4 +670,5 @@ EXEMPT = {
     "mt_filter1d_block": "a constant of mt_filter1d's contract (test_filters_layouts checks any split gives the same bits)",
     "mt_format_bound": "a capacity bound for mt_format_frames, which fails with MT_ERANGE below it",
     "mt_format_table_bound": "a capacity bound for mt_format_table, which fails with MT_ERANGE below it",
+    "mt_guard_install": "installs a signal handler once; test_hardening shrinks mapped files under the scanners",
 }

@@ -389,8 +389,8 @@
   }
 
   /* one column's rows a..b filtered with edges held ("nearest"), into out.  The mean is mtcore's
-   * running sum, restarted every max(size, 256) frames as its kernel does: a NaN or inf entering
-   * the sum spoils the rest of its stretch there too. */
+   * running sum, restarted every max(size, 256) frames and summed again over the window where a
+   * NaN or inf leaves it, as its kernel does: a bad sample spoils only the windows that hold it. */
   function filterColumn(src, out, C, c, a, b, kind, size, base) {
     const half = size >> 1, n = b - a + 1;
     const at = (i) => src[(a + Math.min(Math.max(i, 0), n - 1)) * C + c] - base;
@@ -402,7 +402,12 @@
         for (let t = t0; t < Math.min(n, t0 + chunk); t++) {
           const sum = acc + at(t - half + size - 1);
           out[(a + t) * C + c] = sum / size + base;
-          acc = sum - at(t - half);
+          const leave = at(t - half);
+          acc = sum - leave;
+          if (!Number.isFinite(leave)) {
+            acc = 0;
+            for (let j = 1; j < size && !Number.isNaN(acc); j++) acc += at(t - half + j);
+          }
         }
       }
       return;
