@@ -336,6 +336,51 @@ int mt_interpolate_rotvecs(const double *v0, const double *v1, const double *t, 
                            double *out);
 
 /*
+ * The vectorised elementary functions of the rotation kernels, n values at a
+ * time: atan2(y, x) in radians, in [-pi, pi], within 2 ulp of pi of the C
+ * library's (the same at zeros of either sign and infinities, NaN for NaN);
+ * sin and cos of x within about 1e-16 for |x| < 2^30, the C library's beyond.
+ */
+int mt_atan2(const double *y, const double *x, size_t n, double *out);
+int mt_sincos(const double *x, size_t n, double *sin_out, double *cos_out);
+
+/* How mt_interpolate_euler goes from key 0 to key 1. */
+enum mt_blend {
+    MT_BLEND_SLERP = 0,          /* mt_slerp of the keys' quaternions */
+    MT_BLEND_EXPMAP = 1,         /* mt_interpolate_rotvecs of the keys' rotation vectors */
+    MT_BLEND_ALIGNED_EXPMAP = 2  /* the same, aligned */
+};
+
+/* Which of the Euler triples of a rotation mt_interpolate_euler writes. */
+enum mt_continuity {
+    MT_CONTINUITY_NONE = 0,     /* mt_matrices_to_euler's, in scipy's ranges */
+    MT_CONTINUITY_PATH = 1,     /* reference: a start triple per joint; each frame's triple is, as in
+                                   mt_unroll_euler, the nearest the joint's triple of the frame before */
+    MT_CONTINUITY_REFERENCE = 2 /* reference: a triple per frame and joint; each angle plus the whole
+                                   turns that bring it nearest the reference's (ties to even) */
+};
+
+/*
+ * Euler triples between keys, frames x joints of them (out: frames x joints
+ * x 3), in one pass: the key triples k0 and k1 (frames x joints x 3 when
+ * per_frame, else joints x 3, the same for every frame) to quaternions, the
+ * `blend` (a mt_blend) at the frame's fraction t[f] (frames values), back to
+ * Euler angles and the `continuity` (a mt_continuity) chosen.  Angles are in
+ * degrees when `degrees`, else radians, about axes[0..2] (Tait-Bryan or
+ * proper, extrinsic or intrinsic, as mt_matrices_to_euler).  The result is
+ * what those kernels give in turn (mt_euler_to_matrices,
+ * mt_matrices_to_quaternions, mt_slerp or mt_quaternions_to_rotvecs,
+ * mt_interpolate_rotvecs and mt_rotvecs_to_quaternions, mt_quaternions_to_matrices,
+ * mt_matrices_to_euler, then mt_unroll_euler from the start triples or the
+ * nearest turns), to rounding; except that a key a half turn from the
+ * identity has two rotation vectors, and which one rounding picks may differ.
+ * `reference` may be NULL for MT_CONTINUITY_NONE.
+ */
+int mt_interpolate_euler(const double *k0, const double *k1, int per_frame, const double *t, size_t frames,
+                         size_t joints, const int *axes, int intrinsic, int degrees, int blend, int continuity,
+                         const double *reference, double *out);
+
+/*
  * The per-frame loop of the motion combiner: output frame f of `channels`
  * values from rows of an old and a new motion (both frames x channels).
  *
@@ -406,8 +451,8 @@ enum mt_pad {
  * step (scipy.signal.sosfilt_zi).  Requires padlen < n (padlen is ignored
  * for MT_PAD_NONE, then n >= 1).
  *
- * Computed as scipy computes it, bit for bit, with the input read twice and
- * the output written once (see iir.c).
+ * Computed as scipy computes it, bit for bit, with the input read once and
+ * the forward outputs written to out and read back (see iir.c).
  */
 int mt_sosfiltfilt(const double *sos, size_t sections, const double *zi, const double *in, double *out, size_t n,
                    size_t channels, size_t stride, size_t padlen, int padtype);

@@ -359,13 +359,14 @@ def combine_planned(
 
 
 def _slerp_blends(values: np.ndarray, old: Motion, new: Motion, p: Plan, joints: Iterable[str]) -> None:
-    """Cross-faded frames of the joints with three rotation channels, again, by SLERP: whole
-    arrays through the C rotation kernels, a few calls per Euler convention for all joints."""
+    """Cross-faded frames of the joints with three rotation channels, again, by SLERP: one C pass
+    per Euler convention for all joints and frames, each angle then the whole turns nearest the
+    linear blend already in ``values``."""
     frames = p.blend_rows
     if not len(frames):
         return
     skeleton = old.skeleton
-    u = p.weight[frames, None]
+    u = p.weight[frames]
     degrees = skeleton.angle_unit == "deg"
     rows = (slice(None), None, None)  # (frames,) indices against (joints, 3) columns
     for order, extrinsic, columns in skeleton.euler_groups(joints):
@@ -373,10 +374,10 @@ def _slerp_blends(values: np.ndarray, old: Motion, new: Motion, p: Plan, joints:
         b = new.values[p.new_row[frames][rows], columns]
         if p.ramp is not None and p.next_row is not None:
             b = b + p.ramp[frames][rows] * (new.values[p.next_row[frames][rows], columns] - b)
-        q0, q1 = (rot.euler_to_quaternions(k, order, extrinsic=extrinsic, degrees=degrees) for k in (a, b))
-        angles = rot.quaternions_to_euler(rot.slerp(q0, q1, u), order, extrinsic=extrinsic, degrees=degrees)
         where = (frames[rows], columns)
-        values[where] = _nearest_equivalent(angles, values[where], skeleton.period)
+        values[where] = rot.interpolate_euler(
+            a, b, u, order, extrinsic=extrinsic, degrees=degrees, reference=values[where]
+        )
 
 
 def _nearest_equivalent(angle: np.ndarray, reference: np.ndarray, period: float) -> np.ndarray:

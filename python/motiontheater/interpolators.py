@@ -2,8 +2,8 @@
 
 An interpolator replaces the frames strictly between two key frames A and B
 by interpolating the keys.  Rotation interpolators work on joints with three
-rotation channels, through unit quaternions (:mod:`mtcore.rotations`, in C,
-one call per Euler convention for all joints and frames at once); other
+rotation channels, through unit quaternions (:func:`mtcore.rotations.interpolate_euler`,
+one C pass per Euler convention for all joints and frames at once); other
 channels interpolate linearly.  Each is a registered step (``slerp``,
 ``euler``, ``expmap``, ``aligned_expmap``, ``median3``), so they stack in a
 :class:`~motiontheater.pipeline.Pipeline`.
@@ -58,18 +58,11 @@ def interpolate(
     values[a + 1 : b, linear] = values[a, linear] + t[:, None] * (values[b, linear] - values[a, linear])
     degrees = skeleton.angle_unit == "deg"
     for order, extrinsic, cols in groups:
-        keys = rot.euler_to_quaternions(values[[a, b]][:, cols], order, extrinsic=extrinsic, degrees=degrees)
-        if method == "slerp":
-            q = rot.slerp(keys[0], keys[1], t[:, None])
-        else:
-            v = rot.quaternions_to_rotvecs(keys)
-            q = rot.rotvecs_to_quaternions(
-                rot.interpolate_rotvecs(v[0], v[1], t[:, None], aligned=method == "aligned_expmap")
-            )
-        angles = rot.quaternions_to_euler(q, order, extrinsic=extrinsic, degrees=degrees)
+        first = values[a, cols]
         # of the equivalent Euler triples, each frame's nearest the one before, from the first key on
-        path = rot.unroll_euler(np.concatenate([values[a : a + 1, cols], angles]), order, degrees=degrees)
-        values[a + 1 : b, cols] = path[1:]
+        values[a + 1 : b, cols] = rot.interpolate_euler(
+            first, values[b, cols], t, order, extrinsic=extrinsic, degrees=degrees, blend=method, start=first
+        )
     values.flags.writeable = False
     return motion.replace(values=values)
 

@@ -48,6 +48,7 @@ __all__ = [
     "euler_to_matrices",
     "euler_to_quaternions",
     "euler_to_rotvecs",
+    "interpolate_euler",
     "interpolate_rotvecs",
     "matrices_to_euler",
     "matrices_to_quaternions",
@@ -63,6 +64,7 @@ __all__ = [
     "unroll_quaternions",
 ]
 
+BLENDS = {"slerp": lib.MT_BLEND_SLERP, "expmap": lib.MT_BLEND_EXPMAP, "aligned_expmap": lib.MT_BLEND_ALIGNED_EXPMAP}
 ORDERS = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx", "xyx", "xzx", "yxy", "yzy", "zxz", "zyz")
 AXES = {"x": lib.MT_DOF_RX, "y": lib.MT_DOF_RY, "z": lib.MT_DOF_RZ}
 
@@ -288,5 +290,85 @@ def interpolate_rotvecs(v0, v1, t, *, aligned: bool = False) -> np.ndarray:
     check(
         lib.mt_interpolate_rotvecs(c_array(v0), c_array(v1), c_array(t), t.size, aligned, c_array(out)),
         "mt_interpolate_rotvecs",
+    )
+    return out
+
+
+def interpolate_euler(
+    k0,
+    k1,
+    t,
+    order: str,
+    *,
+    extrinsic: bool,
+    degrees: bool = False,
+    blend: str = "slerp",
+    start=None,
+    reference=None,
+) -> np.ndarray:
+    """Euler angles (frames, joints, 3) between the key triples k0 and k1, in one C pass.
+
+    The keys are (joints, 3), the same for every frame, or (frames, joints, 3); ``t`` (frames,)
+    is each frame's fraction of the way from k0 to k1 (0 gives k0's rotation, 1 k1's).  ``blend``
+    is one of :data:`BLENDS`: "slerp" (:func:`slerp` of the keys' quaternions), "expmap" or
+    "aligned_expmap" (:func:`interpolate_rotvecs` of their rotation vectors, plain or aligned).
+    Which of the Euler triples of each rotation is written:
+
+    - neither ``start`` nor ``reference``: :func:`matrices_to_euler`'s, in scipy's ranges;
+    - ``start`` (joints, 3): a path from it, each frame's triple the nearest the joint's triple of
+      the frame before, as :func:`unroll_euler` gives for ``start`` followed by the frames;
+    - ``reference`` (frames, joints, 3): each angle plus the whole turns that bring it nearest the
+      reference's angle (halves to even).
+
+    This is the chain of those functions to rounding (1e-15 or so; near gimbal lock only the
+    rotation is that close), except that a key within rounding of a half turn has two
+    rotation vectors, and the one taken may differ.  NaN in a frame gives NaN there; along
+    a path, the frame after one holding NaN starts afresh.
+    """
+    codes, intrinsic, degrees = _order(order), not _flag(extrinsic, "extrinsic"), _flag(degrees, "degrees")
+    if blend not in BLENDS:
+        raise ValueError(f"blend must be one of {', '.join(BLENDS)}, got {blend!r}")
+    k0, k1 = _real(k0, "k0", (3,)), _real(k1, "k1", (3,))
+    t = _real(t, "t", ())
+    if t.ndim != 1:
+        raise ValueError(f"t must have shape (frames,), got {t.shape}")
+    frames = len(t)
+    if k0.ndim not in (2, 3) or k0.shape != k1.shape or (k0.ndim == 3 and len(k0) != frames):
+        raise ValueError(
+            f"k0 and k1 must both have shape (joints, 3) or (frames, joints, 3) with frames = len(t) = {frames}, "
+            f"got {k0.shape} and {k1.shape}"
+        )
+    joints = k0.shape[-2]
+    continuity, ref = lib.MT_CONTINUITY_NONE, None
+    if start is not None and reference is not None:
+        raise ValueError("give start (a path) or reference (nearest turns), not both")
+    if start is not None:
+        continuity, ref = lib.MT_CONTINUITY_PATH, _real(start, "start", (3,))
+        if ref.shape != (joints, 3):
+            raise ValueError(f"start must have shape (joints, 3) = ({joints}, 3), got {ref.shape}")
+    elif reference is not None:
+        continuity, ref = lib.MT_CONTINUITY_REFERENCE, _real(reference, "reference", (3,))
+        if ref.shape != (frames, joints, 3):
+            raise ValueError(
+                f"reference must have shape (frames, joints, 3) = ({frames}, {joints}, 3), got {ref.shape}"
+            )
+    out = np.empty((frames, joints, 3))
+    check(
+        lib.mt_interpolate_euler(
+            c_array(k0),
+            c_array(k1),
+            k0.ndim == 3,
+            c_array(t),
+            frames,
+            joints,
+            ffi.new("int[]", codes),
+            intrinsic,
+            degrees,
+            BLENDS[blend],
+            continuity,
+            c_array(ref),
+            c_array(out),
+        ),
+        "mt_interpolate_euler",
     )
     return out

@@ -308,6 +308,70 @@ def rotvec_interpolation_cases(rng: np.random.Generator) -> list[tuple]:
     return out + [(np.zeros(3), np.array([0.0, 0, 3.5]), 0.5, True)]
 
 
+def atan2_cases(rng: np.random.Generator) -> list[tuple]:
+    special = np.array([0.0, -0.0, np.inf, -np.inf, np.nan, 1.0, -1.0, 5e-324, 1e308])
+    grid = tuple(g.ravel() for g in np.meshgrid(special, special))
+    sizes = [(rng.standard_normal((2, n)) * 10.0 ** rng.uniform(-300, 300, (2, n))) for n in (0, 1, 31, 32, 33, 100)]
+    return [grid, *((y, x) for y, x in sizes)]
+
+
+def fast_atan2(y, x):
+    from mtcore._cdata import c_array
+    from mtcore._mtcore import lib
+
+    y, x = np.ascontiguousarray(y, float), np.ascontiguousarray(x, float)
+    out = np.empty_like(y)
+    assert lib.mt_atan2(c_array(y), c_array(x), y.size, c_array(out)) == 0
+    return out
+
+
+def sincos_cases(rng: np.random.Generator) -> list[tuple]:
+    special = np.array([0.0, -0.0, np.inf, -np.inf, np.nan, 5e-324, 2.0**30, 1e300])
+    return [(special,), *((rng.uniform(-s, s, n),) for s, n in ((1, 0), (10, 1), (1e4, 33), (1e9, 100)))]
+
+
+def fast_sincos(x):
+    from mtcore._cdata import c_array
+    from mtcore._mtcore import lib
+
+    x = np.ascontiguousarray(x, float)
+    s, c = np.empty_like(x), np.empty_like(x)
+    assert lib.mt_sincos(c_array(x), x.size, c_array(s), c_array(c)) == 0
+    return s, c
+
+
+def interpolate_euler_cases(rng: np.random.Generator) -> list[tuple]:
+    """Keys for every frame or one per joint, 0 to 9 joints (a block of lanes is 8), each blend and
+    continuity, Tait-Bryan and proper, degrees and radians; middle angles kept off gimbal lock,
+    the keys near each other as the frames of a take are."""
+    out = []
+    for frames, joints in ((0, 2), (1, 1), (7, 3), (5, 9), (12, 1)):
+        for order, extrinsic, degrees in (("xyz", True, True), ("zxy", False, False), ("zxz", True, False)):
+            half = 180.0 if degrees else math.pi
+            lo, hi = (0.2, 0.8) if order[0] == order[2] else (-0.3, 0.3)
+            k0 = np.stack([rng.uniform(-1, 1, joints), rng.uniform(lo, hi, joints), rng.uniform(-1, 1, joints)], -1)
+            per_frame = frames % 2 == 1
+            k0 = k0 * half + (rng.normal(size=(frames, joints, 3)) * 0.05 * half if per_frame else 0.0)
+            k1 = k0 + rng.normal(size=k0.shape) * 0.3 * half
+            t = rng.uniform(0, 1, frames)
+            start = k0[0] if per_frame and frames else k0
+            start = np.broadcast_to(start, (joints, 3)) + 2 * half * rng.integers(-2, 3, (joints, 3))
+            reference = rng.uniform(-4 * half, 4 * half, (frames, joints, 3))
+            for blend in rot.BLENDS:
+                out += [(k0, k1, t, order, extrinsic, degrees, blend, None, None)]
+                out += [(k0, k1, t, order, extrinsic, degrees, blend, start, None)]
+                out += [(k0, k1, t, order, extrinsic, degrees, blend, None, reference)]
+    k0 = np.array([[10.0, 20, 30], [np.nan, 0, 0]])
+    t = np.linspace(0, 1, 6)
+    return out + [(k0, k0 + 40, t, "xyz", True, True, "slerp", np.zeros((2, 3)), None)]  # NaN along a path
+
+
+def fast_interpolate_euler(k0, k1, t, order, extrinsic, degrees, blend, start, reference):
+    return rot.interpolate_euler(
+        k0, k1, t, order, extrinsic=extrinsic, degrees=degrees, blend=blend, start=start, reference=reference
+    )
+
+
 # --- retarget -------------------------------------------------------------------------------
 
 
@@ -705,6 +769,11 @@ TWINS: dict[str, Twin] = {
         rotations.interpolate_rotvecs,
         rotvec_interpolation_cases,
         close(1e-14),
+    ),
+    "mt_atan2": Twin(fast_atan2, np.arctan2, atan2_cases, close(4.5e-16)),
+    "mt_sincos": Twin(fast_sincos, rotations.sincos, sincos_cases, close(2.3e-16)),
+    "mt_interpolate_euler": Twin(
+        fast_interpolate_euler, rotations.interpolate_euler, interpolate_euler_cases, close(1e-12)
     ),
     "mt_combine": Twin(fast_combine, slow_combine, combine_cases, exact),
     "mt_copy_mapped": Twin(copy_mapped, lambda data, begin, end: data[begin:end], mapped_cases, exact),

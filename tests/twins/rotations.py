@@ -211,3 +211,38 @@ def interpolate_rotvecs(v0, v1, t, aligned: bool = False) -> np.ndarray:
 def rotvecs_to_matrices(v) -> np.ndarray:
     """Through the quaternion of each rotation vector."""
     return quaternions_to_matrices(rotvecs_to_quaternions(v))
+
+
+def _quaternions(m: np.ndarray) -> np.ndarray:
+    """matrices_to_quaternions, NaN for a matrix holding NaN (which has no eigenvectors)."""
+    bad = np.isnan(m).any(axis=(-2, -1))
+    q = matrices_to_quaternions(np.where(bad[..., None, None], np.eye(3), m))
+    q[bad] = np.nan
+    return q
+
+
+def interpolate_euler(k0, k1, t, order: str, extrinsic: bool, degrees: bool, blend: str, start=None, reference=None):
+    """The chain of the twins above: the keys' quaternions (through matrices), SLERP or rotation
+    vectors interpolated, back through matrices to Euler angles, then the path from ``start``
+    (unroll_euler) or each angle's whole turns nearest ``reference``."""
+    t = np.asarray(t, dtype=float)
+    k0, k1 = (np.broadcast_to(np.asarray(k, dtype=float), (len(t),) + np.shape(k)[-2:]) for k in (k0, k1))
+    q0, q1 = (_quaternions(euler_to_matrices(k, order, extrinsic, degrees)) for k in (k0, k1))
+    if blend == "slerp":
+        q = slerp(q0, q1, t[:, None])
+    else:
+        v0, v1 = quaternions_to_rotvecs(q0), quaternions_to_rotvecs(q1)
+        q = rotvecs_to_quaternions(interpolate_rotvecs(v0, v1, t[:, None], aligned=blend == "aligned_expmap"))
+    angles = matrices_to_euler(quaternions_to_matrices(q), order, extrinsic, degrees)
+    turn = 360.0 if degrees else 2 * np.pi
+    if start is not None:
+        return unroll_euler(np.concatenate([np.asarray(start, dtype=float)[None], angles]), order, 0, degrees)[1:]
+    if reference is not None:
+        return angles + turn * np.round((np.asarray(reference, dtype=float) - angles) / turn)
+    return angles
+
+
+def sincos(x) -> tuple[np.ndarray, np.ndarray]:
+    """numpy's sin and cos (NaN for infinities, quietly)."""
+    with np.errstate(invalid="ignore"):
+        return np.sin(x), np.cos(x)
