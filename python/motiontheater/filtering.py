@@ -131,18 +131,17 @@ class Smoother:
         for columns in (self.rotations, self.others):
             if not columns:
                 continue
-            block = unwrapped[:, columns]
-            if self.kind == "median":
-                values[:, columns] = smooth(block, self.size, axis=0, mode=self.mode, workers=self.workers)
-            else:  # relative to the take's first frame: exact for constants, no loss far from zero
-                base = stats.base[columns]
-                values[:, columns] = (
-                    smooth(block - base, self.size, axis=0, mode=self.mode, workers=self.workers) + base
-                )
-        if self.rotations:
-            values[:, self.rotations] = _wrap_into(
-                values[:, self.rotations], stats.low[self.rotations], stats.high[self.rotations], self.period
-            )
+            block = unwrapped[:, columns]  # a copy, smoothed in place
+            # means relative to the take's first frame: exact for constants, no loss far from zero
+            base = None if self.kind == "median" else stats.base[columns]
+            if base is not None:
+                block -= base
+            smooth(block, self.size, axis=0, output=block, mode=self.mode, workers=self.workers)
+            if base is not None:
+                block += base
+            if columns is self.rotations:
+                _wrap_into(block, stats.low[columns], stats.high[columns], self.period, in_place=True)
+            values[:, columns] = block
         return values
 
 
@@ -157,17 +156,31 @@ def unwrap_angles(raw: np.ndarray, period: float, state: Unwrapping | None = Non
     bad sample spoils only the windows that hold it.  ``state`` is what
     the frames before these left (None at the take's start).
     """
-    finite = np.isfinite(raw)
-    # each sample's last finite value so far, its own where it is finite (a forward fill)
-    last = np.where(finite, np.arange(len(raw))[:, None], -1)
-    np.maximum.accumulate(last, axis=0, out=last)
-    before = raw[:1] if state is None else state.last[None]
-    filled = np.where(last >= 0, np.take_along_axis(raw, np.maximum(last, 0), axis=0), before)
+    # the last finite sample before these frames (NaN for none: the first finite one turns nothing)
+    before = np.where(np.isfinite(raw[:1]), raw[:1], np.nan) if state is None else state.last[None]
+    filled = raw if np.isfinite(raw).all() else _forward_fill(raw, before)
     steps = np.diff(filled, axis=0, prepend=before)
     with np.errstate(invalid="ignore"):  # NaN steps (nothing finite yet) count no turn
-        jumps = np.where(np.abs(steps) > period / 2, -np.round(steps / period), 0.0)
-    counted = np.cumsum(jumps, axis=0) + (0.0 if state is None else state.turns)
-    return raw + counted * period, Unwrapping(filled[-1].copy(), counted[-1].copy())
+        jumping = np.abs(steps) > period / 2
+    turns = np.zeros(raw.shape[1]) if state is None else state.turns.copy()
+    out = raw.copy()
+    # most columns never jump: only those that do count turns frame by frame
+    still = np.flatnonzero((turns != 0) & ~jumping.any(axis=0))
+    out[:, still] += turns[still] * period
+    moving = np.flatnonzero(jumping.any(axis=0))
+    if len(moving):
+        jumps = np.where(jumping[:, moving], -np.round(steps[:, moving] / period), 0.0)
+        counted = np.cumsum(jumps, axis=0) + turns[moving]
+        out[:, moving] = raw[:, moving] + counted * period
+        turns[moving] = counted[-1]
+    return out, Unwrapping(filled[-1].copy(), turns)
+
+
+def _forward_fill(raw: np.ndarray, before: np.ndarray) -> np.ndarray:
+    """Each sample's last finite value so far, its own where it is finite; ``before`` before any."""
+    last = np.where(np.isfinite(raw), np.arange(len(raw))[:, None], -1)
+    np.maximum.accumulate(last, axis=0, out=last)
+    return np.where(last >= 0, np.take_along_axis(raw, np.maximum(last, 0), axis=0), before)
 
 
 def filter_motion(
@@ -203,17 +216,23 @@ def filter_motion(
     return motion.replace(values=values)
 
 
-def _wrap_into(filtered: np.ndarray, low: np.ndarray, high: np.ndarray, period: float) -> np.ndarray:
-    """Each column of filtered in the range its take used: [-P/2, P/2], [0, P], or none."""
+def _wrap_into(
+    filtered: np.ndarray, low: np.ndarray, high: np.ndarray, period: float, *, in_place: bool = False
+) -> np.ndarray:
+    """Each column of filtered in the range its take used: [-P/2, P/2], [0, P], or none (a new
+    array, or ``filtered`` itself changed with ``in_place``)."""
     half = period / 2
     centred = (low >= -half) & (high <= half)
     positive = ~centred & (low >= 0) & (high <= period)
-    out = filtered.copy()
-    c = filtered[:, centred]
-    with np.errstate(invalid="ignore"):  # inf and NaN stay as they are
-        out[:, centred] = np.where(~np.isfinite(c) | (np.abs(c) <= half), c, c - period * np.floor((c + half) / period))
-        p = filtered[:, positive]
-        out[:, positive] = np.where(~np.isfinite(p) | ((p >= 0) & (p <= period)), p, p - period * np.floor(p / period))
+    out = filtered if in_place else filtered.copy()
+    for columns, least, most in ((centred, -half, half), (positive, 0.0, period)):
+        c = out[:, columns]
+        with np.errstate(invalid="ignore"):  # inf and NaN stay as they are
+            outside = ((c < least) | (c > most)) & np.isfinite(c)
+        if outside.any():  # rare (a mean across a wrap): only those samples change
+            v = c[outside]
+            c[outside] = v - period * np.floor((v - least) / period)
+            out[:, columns] = c
     return out
 
 
