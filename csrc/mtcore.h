@@ -310,6 +310,18 @@ int mt_quaternions_to_rotvecs(const double *quaternions, size_t n, double *rotve
 int mt_rotvecs_to_quaternions(const double *rotvecs, size_t n, double *quaternions);
 
 /*
+ * Angle channels made continuous, in place: the `columns` (ncolumns, each < stride) of the
+ * (frames, stride) array `values`.  A step of more than half a `period` between a column's
+ * finite samples counts whole turns (step / period rounded, ties to even), and a sample whose
+ * column has counted turns gets turns * period added: exact multiples, so that any cut of the
+ * frames into calls gives the same values.  NaN and infinities stay as they are and are
+ * stepped over.  last[k] and turns[k] carry column k's last finite sample and its turns from
+ * call to call: NaN and 0 at a take's start.
+ */
+int mt_unwrap_angles(double *values, size_t frames, size_t stride, const size_t *columns, size_t ncolumns,
+                     double period, double *last, double *turns);
+
+/*
  * Continuity along the middle axis of (outer, n, inner) arrays of quaternions
  * (inner quaternions per frame) or Euler triples (inner triples per frame).
  * Frame 0 is copied; each later frame becomes, of the rotations equal to it,

@@ -170,26 +170,11 @@ def test_a_bad_sample_spoils_only_the_windows_that_hold_it(take, kind, bad):
     np.testing.assert_array_equal(spoiled.values[:, others], clean.values[:, others])
 
 
-def _unwrap_twin(raw: np.ndarray, period: float) -> np.ndarray:
-    """Unwrapping sample by sample: each finite sample takes the whole turns that bring it within
-    half a period of the last finite one; a sample that is not finite stays as it is."""
-    out = raw.copy()
-    for c in range(raw.shape[1]):
-        last, turns = None, 0.0
-        for t, v in enumerate(raw[:, c]):
-            if not np.isfinite(v):
-                continue
-            if last is not None and abs(v - last) > period / 2:
-                turns -= np.round((v - last) / period)
-            out[t, c] = v + turns * period
-            last = v
-    return out
-
-
 @pytest.mark.parametrize("frames", [1, 2, 7, 300])
 def test_unwrapping_in_any_chunks_equals_its_twin(frames):
     """Jumps, NaN and inf anywhere (first frames included), cut into chunks of any length."""
     from motiontheater.filtering import unwrap_angles
+    from twins.rotations import unwrap_angles as twin
 
     rng = np.random.default_rng(frames)
     raw = np.cumsum(rng.normal(0, 40, (frames, 6)), axis=0)
@@ -197,7 +182,7 @@ def test_unwrapping_in_any_chunks_equals_its_twin(frames):
     raw[rng.random(raw.shape) < 0.05] = np.nan
     raw[rng.random(raw.shape) < 0.02] = np.inf
     raw[:, 5] = 12.5  # a column that never jumps
-    expected = _unwrap_twin(raw, 360.0)
+    expected = twin(raw, 360.0)[0]
     for cut in sorted({1, 2, 5, frames}):
         state, pieces = None, []
         for start in range(0, frames, cut):

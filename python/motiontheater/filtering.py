@@ -9,7 +9,7 @@ chunks (motiontheater.batch) to the same result, bit for bit, as whole.
 from __future__ import annotations
 
 import functools
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Annotated, Literal
 
@@ -118,11 +118,9 @@ class Smoother:
     def unwrap(self, values: np.ndarray, state: Unwrapping | None) -> tuple[np.ndarray, Unwrapping | None]:
         """(values with rotation channels unwrapped by :func:`unwrap_angles`, the state after the last
         frame).  ``state`` is what the frames before these left (None at the take's start)."""
-        out = values.copy()
         if not self.rotations or not len(values):
-            return out, state
-        out[:, self.rotations], state = unwrap_angles(values[:, self.rotations], self.period, state)
-        return out, state
+            return values.copy(), state
+        return unwrap_angles(values, self.period, state, self.rotations)
 
     def smooth(self, unwrapped: np.ndarray, stats: TakeStats) -> np.ndarray:
         """Smoothed frames (all channels; the chosen ones changed), rotations wrapped back."""
@@ -145,8 +143,11 @@ class Smoother:
         return values
 
 
-def unwrap_angles(raw: np.ndarray, period: float, state: Unwrapping | None = None) -> tuple[np.ndarray, Unwrapping]:
-    """Angle columns (frames, columns, at least one frame) unwrapped, and the state after the last frame.
+def unwrap_angles(
+    raw: np.ndarray, period: float, state: Unwrapping | None = None, columns: Sequence[int] | None = None
+) -> tuple[np.ndarray, Unwrapping]:
+    """Angle columns (all, or ``columns``) of (frames, channels) unwrapped, in a new array, and the
+    state after the last frame.
 
     A jump of more than half a period between frames counts whole turns,
     and the angle gets turns times the period added: exact multiples, so
@@ -154,33 +155,13 @@ def unwrap_angles(raw: np.ndarray, period: float, state: Unwrapping | None = Non
     that is not finite (inf, NaN) stays as it is and is stepped over: the
     next finite one is compared with the last finite one before it, so a
     bad sample spoils only the windows that hold it.  ``state`` is what
-    the frames before these left (None at the take's start).
+    the frames before these left (None at the take's start).  In C
+    (:func:`mtcore.rotations.unwrap_angles`).
     """
-    # the last finite sample before these frames (NaN for none: the first finite one turns nothing)
-    before = np.where(np.isfinite(raw[:1]), raw[:1], np.nan) if state is None else state.last[None]
-    filled = raw if np.isfinite(raw).all() else _forward_fill(raw, before)
-    steps = np.diff(filled, axis=0, prepend=before)
-    with np.errstate(invalid="ignore"):  # NaN steps (nothing finite yet) count no turn
-        jumping = np.abs(steps) > period / 2
-    turns = np.zeros(raw.shape[1]) if state is None else state.turns.copy()
-    out = raw.copy()
-    # most columns never jump: only those that do count turns frame by frame
-    still = np.flatnonzero((turns != 0) & ~jumping.any(axis=0))
-    out[:, still] += turns[still] * period
-    moving = np.flatnonzero(jumping.any(axis=0))
-    if len(moving):
-        jumps = np.where(jumping[:, moving], -np.round(steps[:, moving] / period), 0.0)
-        counted = np.cumsum(jumps, axis=0) + turns[moving]
-        out[:, moving] = raw[:, moving] + counted * period
-        turns[moving] = counted[-1]
-    return out, Unwrapping(filled[-1].copy(), turns)
-
-
-def _forward_fill(raw: np.ndarray, before: np.ndarray) -> np.ndarray:
-    """Each sample's last finite value so far, its own where it is finite; ``before`` before any."""
-    last = np.where(np.isfinite(raw), np.arange(len(raw))[:, None], -1)
-    np.maximum.accumulate(last, axis=0, out=last)
-    return np.where(last >= 0, np.take_along_axis(raw, np.maximum(last, 0), axis=0), before)
+    out, last, turns = mtcore.rotations.unwrap_angles(
+        raw, period, columns, None if state is None else (state.last, state.turns)
+    )
+    return out, Unwrapping(last, turns)
 
 
 def filter_motion(

@@ -62,6 +62,7 @@ __all__ = [
     "slerp",
     "unroll_euler",
     "unroll_quaternions",
+    "unwrap_angles",
 ]
 
 BLENDS = {"slerp": lib.MT_BLEND_SLERP, "expmap": lib.MT_BLEND_EXPMAP, "aligned_expmap": lib.MT_BLEND_ALIGNED_EXPMAP}
@@ -246,6 +247,46 @@ def unroll_euler(angles, order: str, *, axis: int = 0, degrees: bool = False) ->
         "mt_unroll_euler",
     )
     return out
+
+
+def unwrap_angles(
+    values, period: float, columns=None, state: tuple[np.ndarray, np.ndarray] | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Angle channels of ``values`` (frames, channels) made continuous along the frames: a new
+    array (float64), with the state to carry into the frames that follow.
+
+    A step of more than half a ``period`` (360 for degrees, 2 pi for radians) between a
+    column's finite samples counts whole turns, and every later sample gets them added as exact
+    multiples of the period, so any cut of a take into pieces unwraps as the whole.  NaN and
+    infinities stay as they are and are stepped over: a bad sample spoils nothing after it.
+    ``columns`` (default: all) are the angle channels; the others are copied.  ``state`` is
+    (last, turns) as returned for the frames before: each column's last finite sample (NaN for
+    none) and its whole turns counted (None at a take's start).  Returns (out, last, turns).
+    """
+    a = _real(values, "values", ())
+    if a.ndim != 2:
+        raise ValueError(f"values must be (frames, channels), got shape {a.shape}")
+    out = np.array(a, dtype=np.float64, order="C")
+    chosen = np.arange(a.shape[1]) if columns is None else np.asarray(columns, dtype=np.intp).reshape(-1)
+    if chosen.size and (chosen.min() < 0 or chosen.max() >= a.shape[1]):
+        raise ValueError(f"columns must be channels of the {a.shape[1]} there are, got {chosen.tolist()}")
+    period = float(period)
+    if not (math.isfinite(period) and period > 0):
+        raise ValueError(f"period must be a positive number, got {period}")
+    if state is None:
+        last, turns = np.full(chosen.size, np.nan), np.zeros(chosen.size)
+    else:
+        last, turns = (np.array(x, dtype=np.float64).reshape(-1) for x in state)
+        if last.size != chosen.size or turns.size != chosen.size:
+            raise ValueError(f"state must hold {chosen.size} last values and turns, one per column")
+    c_columns = ffi.new("size_t[]", chosen.tolist())
+    check(
+        lib.mt_unwrap_angles(
+            c_array(out), out.shape[0], out.shape[1], c_columns, chosen.size, period, c_array(last), c_array(turns)
+        ),
+        "mt_unwrap_angles",
+    )
+    return out, last, turns
 
 
 def _keys(k0, k1, t, names: tuple[str, str], width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -284,6 +284,20 @@ def unroll_euler_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
+def unwrap_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for frames in (0, 1, 2, 7, 64):
+        for period in (360.0, 2 * math.pi):
+            raw = np.cumsum(rng.normal(0, period / 8, (frames, 5)), axis=0)
+            raw = (raw + period / 2) % period - period / 2  # jumps where it wraps
+            raw[rng.random(raw.shape) < 0.08] = np.nan
+            raw[rng.random(raw.shape) < 0.04] = -np.inf
+            raw[:, 4] = -0.0  # a column that never jumps keeps its zeros' signs
+            state = (rng.normal(0, period, 3), rng.integers(-2, 3, 3).astype(float))
+            out += [(raw, period, None, None), (raw, period, [4, 0, 2], state), (raw, period, [], None)]
+    return out
+
+
 def slerp_cases(rng: np.random.Generator) -> list[tuple]:
     out = []
     for shape in ROTATION_SHAPES:
@@ -763,6 +777,7 @@ TWINS: dict[str, Twin] = {
         unroll_euler_cases,
         close(1e-12),
     ),
+    "mt_unwrap_angles": Twin(rot.unwrap_angles, rotations.unwrap_angles, unwrap_cases, exact),
     "mt_slerp": Twin(rot.slerp, rotations.slerp, slerp_cases, close(1e-12)),
     "mt_interpolate_rotvecs": Twin(
         lambda v0, v1, t, aligned: rot.interpolate_rotvecs(v0, v1, t, aligned=aligned),

@@ -246,3 +246,24 @@ def sincos(x) -> tuple[np.ndarray, np.ndarray]:
     """numpy's sin and cos (NaN for infinities, quietly)."""
     with np.errstate(invalid="ignore"):
         return np.sin(x), np.cos(x)
+
+
+def unwrap_angles(values, period: float, columns=None, state=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unwrapping sample by sample: each finite sample of a chosen column takes the whole turns
+    that bring it within half a period of the last finite one before it; a sample that is not
+    finite stays as it is; a column without turns is copied."""
+    out = np.array(values, dtype=float)
+    chosen = range(out.shape[1]) if columns is None else list(columns)
+    last = np.full(len(chosen), np.nan) if state is None else np.array(state[0], dtype=float)
+    turns = np.zeros(len(chosen)) if state is None else np.array(state[1], dtype=float)
+    for k, c in enumerate(chosen):
+        for t in range(out.shape[0]):
+            v = out[t, c]
+            if not np.isfinite(v):
+                continue
+            if np.isfinite(last[k]) and abs(v - last[k]) > period / 2:
+                turns[k] -= np.round((v - last[k]) / period)
+            last[k] = v
+            if turns[k]:
+                out[t, c] = v + turns[k] * period
+    return out, last, turns

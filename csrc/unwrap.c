@@ -1,0 +1,38 @@
+/*
+ * unwrap.c - angle channels made continuous across wraps (mt_unwrap_angles in mtcore.h), in
+ * place over the rows of a (frames, stride) array, each row's columns side by side.
+ */
+#include "mtcore.h"
+
+#include <math.h>
+#include <stddef.h>
+
+int mt_unwrap_angles(double *values, size_t frames, size_t stride, const size_t *columns, size_t ncolumns,
+                     double period, double *last, double *turns)
+{
+    if (ncolumns == 0)
+        return MT_OK;
+    if (columns == NULL || last == NULL || turns == NULL || (frames > 0 && values == NULL))
+        return MT_EINVAL;
+    if (!(period > 0.0) || !isfinite(period))
+        return MT_EINVAL;
+    for (size_t k = 0; k < ncolumns; k++)
+        if (columns[k] >= stride)
+            return MT_EINVAL;
+    const double half = period / 2;
+    for (size_t t = 0; t < frames; t++) {
+        double *row = values + t * stride;
+        for (size_t k = 0; k < ncolumns; k++) {
+            const double v = row[columns[k]];
+            if (v - v != 0.0) /* NaN or an infinity: stepped over */
+                continue;
+            const double step = v - last[k]; /* NaN while nothing finite came before */
+            if (fabs(step) > half)
+                turns[k] -= nearbyint(step / period); /* ties to even, as numpy's round */
+            last[k] = v;
+            if (turns[k] != 0.0)
+                row[columns[k]] = v + turns[k] * period;
+        }
+    }
+    return MT_OK;
+}
