@@ -712,12 +712,17 @@ def build_parser() -> argparse.ArgumentParser:
         help="measure footskate: sliding, skating ratio, penetration and float of each foot",
         description=(
             "Measure how much a take's planted feet slide (mm from where each plant began), how often "
-            "they skate (the motion-generation papers' ratio, and the same over planted frames), how "
-            "deep they go below the floor and how high planted points float. The plants are detected "
-            "unless --contacts gives a table; the floor is fitted unless --floor gives its level. "
-            "Prints a Markdown table, or JSON."
+            "they skate (the motion-generation papers' ratio: a foot within 5 cm of the floor moving faster "
+            "than 0.5 m/s, which a walk's swing does too), how deep they go below the floor and how high "
+            "planted points float. The plants are detected unless --contacts gives a table; the floor is "
+            "fitted unless --floor gives its level. Prints a Markdown table, or JSON. To measure what a "
+            "cleanup did, give both takes the same table: detection on the cleaned take finds other plants."
         ),
-        epilog="Example: motiontheater skate 07_05-walk.amc --json",
+        epilog=(
+            "Example: motiontheater contacts 07_05-walk.amc -o plants.csv && motiontheater cleanup "
+            "07_05-walk.amc --contacts plants.csv -o clean.amc && motiontheater skate clean.amc --asf "
+            "07-walk.asf --contacts plants.csv"
+        ),
     )
     skating.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
     skating.add_argument("--contacts", metavar="FILE", help="the footplants CSV to measure on (default: detected)")
