@@ -5,6 +5,7 @@ import shutil
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 import motiontheater as mt
@@ -156,3 +157,18 @@ def test_the_error_in_a_bad_take_does_not_depend_on_the_worker_count():
                 scan_frames(text, keys, offsets, counts, 9, workers=workers)
             errors.add((type(caught.value), str(caught.value)))
         assert errors == {(mt.SequenceError, f"line {at + 1}: frame number 5 out of sequence: expected {at // 3 + 1}")}
+
+
+def test_a_bone_of_infinite_length_along_no_direction_reads_without_a_warning(data_dir):
+    """Bad input the grammar accepts (length inf, direction 0 0 0): NaN points, no numpy warning."""
+    import warnings
+
+    text = (data_dir / "cmu" / "01.asf").read_text()
+    at = text.index("direction", text.index(":bonedata"))
+    text = text[:at] + "direction 0 0 0" + text[text.index("\n", at) :]
+    at = text.index("length", at)
+    text = text[:at] + "length inf" + text[text.index("\n", at) :]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rest = mt.read_asf(io.StringIO(text)).rest_positions()
+    assert np.isnan(rest[1]).all() and np.isfinite(rest[0]).all()

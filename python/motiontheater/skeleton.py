@@ -450,8 +450,10 @@ def _joint_tree(skeleton: Skeleton) -> JointTree:
         # no direction: zero; an infinite one (bad input) has none either, and says so with NaN
         unit = d / norm if 0 < norm < math.inf else np.full(3, math.nan if norm else 0.0)
         direction.append(unit)
-        # a direction that is already the bone's vector (converted BVH offsets) is kept exactly
-        segment.append(d if bone.length == norm else unit * bone.length)
+        # a direction that is already the bone's vector (converted BVH offsets) is kept exactly;
+        # an infinite length along no direction (bad input) is NaN, as above, without a warning
+        with np.errstate(invalid="ignore"):
+            segment.append(d if bone.length == norm else unit * bone.length)
     dof_start, dof_kind, dof_column = [0], [], []  # type: list[int], list[int], list[int]
     column = 0
     for name in names:
