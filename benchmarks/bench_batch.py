@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
+from conftest import DATA
 from motiontheater import Pipeline, batch
 
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 COPIES = 75
 
 

@@ -7,14 +7,11 @@ package reading every channel of every frame through its per-channel
 access (no FK at all).  Scanning: 01_01.bvh's frames repeated to about 100 MB.
 """
 
-import os
-from pathlib import Path
-
 import pytest
 
 import motiontheater as mt
+from conftest import DATA
 
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 CASE = "read cmu/01_01.bvh + all positions"
 
 

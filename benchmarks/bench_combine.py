@@ -12,7 +12,6 @@ frame's source and weight as it goes, run on 1/400 of the frames.
 """
 
 import importlib
-import os
 import sys
 from pathlib import Path
 from unittest import mock
@@ -24,10 +23,10 @@ import motiontheater as mt
 from motiontheater.combine import _root_offsets, combine, plan
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from conftest import DATA
 from twins import combine as twin
 from twins import rotations as euler_twin
 
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 FRAMES = 432_000
 CASES = {
     "cut+scale+blend 10": dict(cut=(1_000, 400_000), scale=(5_000, 420_000), blend=10),

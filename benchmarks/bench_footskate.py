@@ -10,7 +10,6 @@ is 01_01 tiled to 432,000 frames (one hour at 120 Hz, 62 channels), on one
 core (the kernels run in the calling thread).
 """
 
-import os
 import sys
 from pathlib import Path
 from unittest import mock
@@ -23,9 +22,9 @@ from motiontheater.footskate import clean_footskate
 from mtcore import footskate as kernels
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from conftest import DATA
 from twins import footskate as footskate_twin
 
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 TAKE = "detect + clean up cmu/01_01 (2751 frames)"
 HOUR = "detect + clean up one hour at 120 Hz (432,000 frames)"
 

@@ -6,7 +6,6 @@ all positions, upc-pymotion's load of the same take's BVH plus its FK, and
 the tests' numpy twin (one numpy call per bone over all frames).
 """
 
-import os
 import sys
 from pathlib import Path
 
@@ -16,9 +15,9 @@ import motiontheater as mt
 from mtcore.kinematics import forward_kinematics
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from conftest import DATA
 from twins.kinematics import motion_kinematics as numpy_fk
 
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 FAST = dict(rounds=30, iterations=1, warmup_rounds=2)
 SLOW = dict(rounds=5, iterations=1, warmup_rounds=1)
 PIPELINE = "read cmu/01_01.amc + all positions"

@@ -10,7 +10,6 @@ pair of skeletons and kept, as for a batch of takes; its own cost is the
 joint over all frames (tests/retarget_twin.py).
 """
 
-import os
 import sys
 from pathlib import Path
 
@@ -21,9 +20,9 @@ import motiontheater as mt
 from motiontheater.retarget import _cached_plan, _rest_channels, _root_positions, _unroll
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from conftest import DATA
 from twins import retarget as retarget_twin
 
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 FAST = dict(rounds=30, iterations=1, warmup_rounds=2)
 SLOW = dict(rounds=5, iterations=1, warmup_rounds=1)
 TAKE = "retarget cmu/01_01 onto walk01's rig, no cleanup (2751 frames)"

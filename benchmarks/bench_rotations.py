@@ -30,12 +30,12 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
+from conftest import DATA
 from motiontheater import interpolate
 from motiontheater.combine import combine, plan
 from mtcore import rotations as rot
 
 combine_module = importlib.import_module("motiontheater.combine")  # the package's `combine` is the function
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 ROOT = Path(__file__).resolve().parents[1]
 PREVIOUS = "814c4eb"
 FAST = dict(rounds=20, iterations=1, warmup_rounds=2)

@@ -8,16 +8,13 @@ so it is timed on the scene only; bottleneck joins the hour's rows of
 bench_filters.py, which time mtcore, scipy and the copy ceiling.
 """
 
-import os
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 import motiontheater as mt
+from conftest import DATA
 from motiontheater import bench
 
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 SIZES = [3, 5, 7]
 PEERS = bench.peers()
 

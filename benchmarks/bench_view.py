@@ -11,7 +11,6 @@ Run: python -m pytest benchmarks/bench_view.py
   and time to interactive of the decimated page (1 frame in 15 kept).
 """
 
-import os
 import re
 import shutil
 import time
@@ -21,11 +20,10 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from conftest import NOTES
+from conftest import DATA, NOTES
 from motiontheater.view import page
 
 webdriver = pytest.importorskip("selenium.webdriver", reason="selenium is not installed")
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 BROWSER = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
 COUNT_TICKS = """
 window.ticks = 0;

@@ -38,14 +38,6 @@ enum {
     SORTED_BUDGET = 1 << 20 /* elements of sorted windows kept at once */
 };
 
-#if defined(__clang__)
-#define MT_IVDEP _Pragma("clang loop vectorize(assume_safety)")
-#elif defined(__GNUC__)
-#define MT_IVDEP _Pragma("GCC ivdep")
-#else
-#define MT_IVDEP
-#endif
-
 /* malloc of count elements of size bytes, NULL when the product does not fit in size_t. */
 static void *alloc_array(size_t count, size_t size)
 {
