@@ -525,9 +525,12 @@ def text_style(data: Text) -> tuple[bytes, int]:
     has a single digit (``1e-5``), else 2 (Python and C on Linux: ``1e-05``).
     """
     head = bytes(memoryview(data)[:_STYLE_SAMPLE])
-    crlf = head.count(b"\r\n")
-    endings = {b"\n": head.count(b"\n") - crlf, b"\r\n": crlf, b"\r": head.count(b"\r") - crlf}
-    newline = max(endings, key=endings.__getitem__)  # the first, LF, of equal counts
+    if b"\r" in head:
+        crlf = head.count(b"\r\n")
+        endings = {b"\n": head.count(b"\n") - crlf, b"\r\n": crlf, b"\r": head.count(b"\r") - crlf}
+        newline = max(endings, key=endings.__getitem__)  # the first, LF, of equal counts
+    else:  # no CR: LF, the count of which need not be taken (also LF where there is no line end)
+        newline = b"\n"
     single = False
     for marker in _EXPONENTS:
         at = head.find(marker, 1)
