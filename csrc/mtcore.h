@@ -181,6 +181,30 @@ enum mt_newline {
 };
 
 /*
+ * How a text is laid out, so that what is written from it looks the same (style.c):
+ *
+ *   lf, crlf, cr     its line ends of each kind (a CR followed by LF is one CRLF).
+ *   exponent_digits  the fewest digits of its exponents: an exponent is 'e' or 'E' right
+ *                    after a digit or '.', then a sign and digits.  The first written with
+ *                    a leading zero in two or more digits gives its count (1.23246e-013:
+ *                    3; at most 3); else 1 where one has a single digit (1e-5); else 2.
+ *   frame_line       the offset of its first line of digits only (blanks around them
+ *                    allowed): a frame-number line; -1 for none.
+ *   frame_newline    that line's ending (enum mt_newline), -1 where the text ends there.
+ */
+struct mt_text_style {
+    size_t lf;
+    size_t crlf;
+    size_t cr;
+    int exponent_digits;
+    long long frame_line;
+    int frame_newline;
+};
+
+/* The style of text[0 .. len-1]; MT_EIO where it is a mapping whose file has shrunk. */
+int mt_text_style(const char *text, size_t len, struct mt_text_style *style);
+
+/*
  * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF}.
  *
  *   digits           0: the shortest text that reads back as exactly the value, of
@@ -320,6 +344,24 @@ int mt_rotvecs_to_quaternions(const double *rotvecs, size_t n, double *quaternio
  */
 int mt_unwrap_angles(double *values, size_t frames, size_t stride, const size_t *columns, size_t ncolumns,
                      double period, double *last, double *turns);
+
+/*
+ * Angle channels put back into a range, in place (the inverse of mt_unwrap_angles once a take
+ * is smoothed): each finite sample of the `columns` of (frames, stride) `values` outside
+ * [low[k], high[k]] becomes v - period floor((v - low[k]) / period).  A column whose bounds
+ * are NaN is left as it is.
+ */
+int mt_wrap_angles(double *values, size_t frames, size_t stride, const size_t *columns, size_t ncolumns,
+                   const double *low, const double *high, double period);
+
+/*
+ * What the frames of a take say about each of its channels, widened call by call (a take
+ * given in pieces): low[c] and high[c] become the least and greatest finite sample of column
+ * c (start them at +inf and -inf), first[c] its first finite sample where it is still NaN
+ * (start it at NaN).  values is (frames, channels).
+ */
+int mt_finite_ranges(const double *values, size_t frames, size_t channels, double *low, double *high,
+                     double *first);
 
 /*
  * Continuity along the middle axis of (outer, n, inner) arrays of quaternions

@@ -101,7 +101,7 @@ def test_an_output_problem_every_take_would_meet_stops_the_batch_once(cmu, tmp_p
 
     out = tmp_path / "out"
     out.mkdir()
-    monkeypatch.setattr(_io.tempfile, "mkstemp", full)
+    monkeypatch.setattr(_io, "_partial", full)
     assert main(["batch", "--median", "3", "--jobs", "1", str(cmu), "-o", str(out)]) == 1
     err = capsys.readouterr().err
     assert "STOPPED: cannot write" in err and "No space left on device" in err

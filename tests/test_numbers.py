@@ -485,13 +485,14 @@ def test_frame_numbers_past_the_range_are_refused():
 
 
 def test_text_style():
-    assert text_style(b"") == (b"\n", 2)
-    assert text_style(b"1\nroot 1 2\n") == (b"\n", 2)
-    assert text_style(b"1\r\nroot 1 2.5e-05\r\n") == (b"\r\n", 2)
-    assert text_style(b"1\rroot 1e-5\r") == (b"\r", 1)
-    assert text_style(b"1\nroot 1.23246e-013 5e-14\r\nx 1\r\n") == (b"\r\n", 3)
-    assert text_style(b"joint_e-01 1e-14\n") == (b"\n", 2)  # a name is no exponent
-    assert text_style(b"e-012 3.5E+007\n") == (b"\n", 3)
+    assert text_style(b"") == (b"\n", 2, b"\n")
+    assert text_style(b"1\nroot 1 2\n") == (b"\n", 2, b"\n")
+    assert text_style(b"1\r\nroot 1 2.5e-05\r\n") == (b"\r\n", 2, b"\r\n")
+    assert text_style(b"1\rroot 1e-5\r") == (b"\r", 1, b"\r")
+    assert text_style(b"1\nroot 1.23246e-013 5e-14\r\nx 1\r\n") == (b"\r\n", 3, b"\n")
+    assert text_style(b"joint_e-01 1e-14\n") == (b"\n", 2, b"\n")  # a name is no exponent
+    assert text_style(b"e-012 3.5E+007\n") == (b"\n", 3, b"\n")
+    assert text_style(b"x 1e-0005\n") == (b"\n", 3, b"\n")  # more than 3 cannot be written: 3
 
 
 @pytest.mark.parametrize("path", ["cmu/01_01.amc", "hdm05/HDM_bd_hopBothLegs1hops_005_120.amc"])
@@ -507,7 +508,7 @@ def test_files_written_back_byte_for_byte(data_dir, path):
     counts = [len(line.split()) - 1 for line in first_frame]
     offsets = np.cumsum([0, *counts[:-1]]).tolist()
     values, first = scan_frames(body, keys, offsets, counts, sum(counts))
-    newline, exponent_digits = text_style(data)
+    newline, exponent_digits, _ = text_style(data)
     assert (newline, exponent_digits) == (b"\r\n", 3)
     out: list[bytes] = []
     format_frames(values, first, keys, offsets, counts, out.append, digits=6, exponent_digits=3, newline=newline)

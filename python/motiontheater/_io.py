@@ -8,14 +8,14 @@ import io
 import mmap
 import os
 import re
+import secrets
 import shutil
-import tempfile
 import typing
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import IO, Any
 
-from mtcore.text import frame_line, text_style
+from mtcore.text import copy_text, text_style
 
 Source = str | os.PathLike | IO[bytes] | IO[str]
 Text = bytes | mmap.mmap  # a file's bytes, read or mapped
@@ -61,13 +61,8 @@ class TextStyle:
     @classmethod
     def of(cls, data: bytes | mmap.mmap) -> TextStyle:
         """The style of a file's text."""
-        newline, exponent_digits = text_style(data)
-        frame = frame_line(data, 0, min(len(data), 1 << 20))
-        frame_newline = newline
-        if frame != -1:
-            match = _LINE_END.search(data, frame)
-            frame_newline = match.group() if match else newline
-        return cls(newline, frame_newline, exponent_digits, not data or data[-1:] in (b"\n", b"\r"))
+        newline, exponent_digits, frame_newline = text_style(data)
+        return cls(newline, frame_newline, exponent_digits, copy_text(data, len(data) - 1) in (b"", b"\n", b"\r"))
 
     def lines(self, lines: list[str]) -> bytes:
         """Header lines as bytes, each ended as the file ends its lines."""
@@ -79,7 +74,6 @@ class TextStyle:
 
 
 PLAIN = TextStyle()  # what this package writes when no file says otherwise
-_LINE_END = re.compile(rb"\r\n|\r|\n")
 
 
 @dataclass(frozen=True)
@@ -142,13 +136,12 @@ def output(target: Source) -> Iterator[IO[bytes]]:
     directory = os.path.dirname(os.path.abspath(path))
     remove_stale_partials(directory)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f"{PARTIAL_PREFIX}{os.getpid()}-", suffix=".tmp", dir=directory)
+        fd, tmp = _partial(directory)
     except OSError as e:
         raise OutputError(e.errno, f"cannot write {path}: {e.strerror}") from None
     try:
         with os.fdopen(fd, "wb") as f:
             yield f
-        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException as e:
         os.unlink(tmp)
@@ -168,15 +161,17 @@ class OutputError(OSError):
         return str(self.strerror)
 
 
-def _umask() -> int:
-    """The process's umask (read without changing it where /proc tells it)."""
-    try:
-        with open("/proc/self/status") as f:
-            return int(next(line for line in f if line.startswith("Umask:")).split()[1], 8)
-    except (OSError, StopIteration, ValueError):
-        mask = os.umask(0o022)
-        os.umask(mask)
-        return mask
+def _partial(directory: str) -> tuple[int, str]:
+    """A new temporary file in ``directory`` (its descriptor and path), named so that a later run
+    can tell its writer has died.  Created with mode 0o666 for the system to apply the umask (and a
+    folder's default ACL) as to any new file: what it becomes keeps those permissions."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0) | getattr(os, "O_CLOEXEC", 0)
+    while True:
+        tmp = os.path.join(directory, f"{PARTIAL_PREFIX}{os.getpid()}-{secrets.token_hex(6)}.tmp")
+        try:
+            return os.open(tmp, flags, 0o666), tmp
+        except FileExistsError:  # a name another writer took: draw again
+            continue
 
 
 _CLEANED: set[str] = set()

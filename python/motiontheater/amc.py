@@ -21,21 +21,24 @@ from .motion import DEFAULT_FRAME_RATE, Motion
 from .skeleton import Skeleton
 
 READ_BYTES = 8 << 20  # bytes read at a time when a take is streamed
-HEAD_BYTES = 4 << 20  # the start of a take that holds its header, first frame and style
+HEAD_BYTES = 4 << 20  # the most of a take read to find its header and first frame
 
 _RATE_KEYS = (":SAMPLES-PER-SECOND", ":SAMPLES_PER_SECOND", ":FRAME-RATE")
 
 
-def skeleton_path_for(amc_path: str | os.PathLike) -> Path:
+def skeleton_path_for(amc_path: str | os.PathLike, folders: dict[Path, list[Path]] | None = None) -> Path:
     """The ASF beside an AMC by the naming conventions of the big databases:
     CMU ``01_02.amc`` -> ``01.asf`` (or ``01-walk.asf``), HDM05
     ``HDM_bd_squat_003_120.amc`` -> ``HDM_bd.asf``, ``take.amc`` -> ``take.asf``.
-    The longest matching name wins; FileNotFoundError when none matches."""
+    The longest matching name wins; FileNotFoundError when none matches.  ``folders`` keeps
+    the ASFs of each folder looked in, for a caller that asks for many takes at once."""
     amc = Path(amc_path)
+    if folders is None:
+        folders = {}
+    if amc.parent not in folders:
+        folders[amc.parent] = [p for p in amc.parent.iterdir() if p.suffix.lower() == ".asf"]
     best = None
-    for asf in amc.parent.iterdir():
-        if asf.suffix.lower() != ".asf":
-            continue
+    for asf in folders[amc.parent]:
         stem = asf.stem.split("-")[0]
         rest = amc.stem[len(stem) :]
         matches = amc.stem.startswith(stem) and (rest == "" or rest[0] in "_-.")
@@ -133,7 +136,7 @@ def _read_header(
 def _read(data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | None, workers: int | None) -> Motion:
     # Python reads a copy of the head (header, first frame, style); only the C scanner, which is
     # guarded against a file that shrinks meanwhile, reads a mapped file itself
-    head = copy_text(data, 0, HEAD_BYTES)
+    head = _head(data)
     header, body, header_lines, rate = _read_header(head, name, skeleton, frame_rate)
     joints = skeleton.joint_names
     keys, offsets, counts = _layout(skeleton, joints)
@@ -141,7 +144,6 @@ def _read(data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | 
         values, first = scan_frames(
             data, keys, offsets, counts, len(skeleton.channels), start=body, noun="bone", workers=workers
         )
-        ends_in_a_break = copy_text(data, len(data) - 1) in (b"", b"\n", b"\r")
     except FormatError as e:
         raise e.at(name, header_lines) from None
     values.flags.writeable = False
@@ -152,8 +154,22 @@ def _read(data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | 
         first_frame=first if len(values) else 1,
         header=tuple(text for _, text in header),
         line_order=_first_frame_order(head, body, set(joints)),
-        style=dataclasses.replace(TextStyle.of(head), final_newline=ends_in_a_break),
+        style=TextStyle.of(data),
     )
+
+
+def _head(data: Text) -> bytes:
+    """The start of a take that holds its header and first frame (the first HEAD_BYTES at most):
+    a take's first kilobytes, as a rule."""
+    size = 1 << 16
+    while True:
+        head = copy_text(data, 0, size)
+        if len(head) == len(data) or size >= HEAD_BYTES:
+            return head
+        body = _split_header(head)[1]
+        if body < len(head) and frame_line(head, body + 1) != -1:
+            return head
+        size *= 4
 
 
 def _check_angle_unit(header: list[tuple[int, str]], skeleton: Skeleton) -> None:

@@ -175,6 +175,7 @@ def plan_jobs(
     unless ``in_place``."""
     jobs, settled = [], []
     manifest = Manifest(out, pipeline.to_toml())
+    folders: dict[Path, list[Path]] = {}  # the ASFs of each folder, listed once
     for take, relative in find_takes(inputs):
         target = Path(out) / relative
         if not in_place and target.exists() and os.path.samefile(take, target):
@@ -183,7 +184,7 @@ def plan_jobs(
                 "or pass --in-place to replace the takes"
             )
         try:
-            asf = None if take.suffix.lower() == ".bvh" else skeleton_for(take, skeleton)
+            asf = None if take.suffix.lower() == ".bvh" else skeleton_for(take, skeleton, folders)
             size = take.stat().st_size
         except FileNotFoundError as e:
             settled.append(Result(str(take), str(target), ok=False, error=str(e)))
@@ -216,7 +217,7 @@ def run_job(job: Job) -> Result:
         except OSError as e:
             raise OutputError(e.errno, f"cannot write {os.path.dirname(job.output)}: {e.strerror}") from None
         if job.skeleton and job.bytes > job.stream_above and streamable(job.pipeline):
-            skeleton = settle_length_unit(_skeleton(job.skeleton, *_stamp(job.skeleton)), job.unit)
+            skeleton = _skeleton(job.skeleton, *_stamp(job.skeleton), job.unit)
             _copy_skeleton(job.skeleton, os.path.dirname(job.output))
             result.frames = stream(
                 job.input, job.output, skeleton, job.pipeline, job.frame_rate, chunk_frames=job.chunk_frames
@@ -240,7 +241,7 @@ def run_job(job: Job) -> Result:
 def _read(job: Job) -> Motion:
     if not job.skeleton:
         return read_bvh(job.input, unit=job.unit)
-    skeleton = settle_length_unit(_skeleton(job.skeleton, *_stamp(job.skeleton)), job.unit)
+    skeleton = _skeleton(job.skeleton, *_stamp(job.skeleton), job.unit)
     return read_amc(job.input, skeleton, job.frame_rate, workers=1)
 
 
@@ -270,10 +271,10 @@ def _stamp(path: str) -> tuple[int, int]:
 
 
 @functools.lru_cache(maxsize=256)
-def _skeleton(path: str, mtime_ns: int, size: int) -> Any:
-    """A worker reads each skeleton once (a database has a few, and thousands of takes);
-    a changed file has a new stamp and is read again."""
-    return read_asf(path)
+def _skeleton(path: str, mtime_ns: int, size: int, unit: str | None) -> Any:
+    """A worker reads each skeleton once (a database has a few, and thousands of takes), its
+    length unit settled; a changed file has a new stamp and is read again."""
+    return settle_length_unit(read_asf(path), unit)
 
 
 def _copy_skeleton(asf: str, folder: str) -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Annotated, Literal
 
 import numpy as np
@@ -42,19 +43,11 @@ class TakeStats:
     @classmethod
     def of(cls, values: np.ndarray) -> TakeStats:
         """The statistics of the first frames of a take."""
-        stats = cls(
-            np.full(values.shape[1], np.inf), np.full(values.shape[1], -np.inf), np.full(values.shape[1], np.nan)
-        )
-        stats.update(values)
-        return stats
+        return cls(*mtcore.rotations.finite_ranges(values))
 
     def update(self, values: np.ndarray) -> None:
         """Widen the ranges by more frames of the same take."""
-        finite = np.isfinite(values)
-        np.minimum(self.low, np.where(finite, values, np.inf).min(axis=0, initial=np.inf), out=self.low)
-        np.maximum(self.high, np.where(finite, values, -np.inf).max(axis=0, initial=-np.inf), out=self.high)
-        missing = np.isnan(self.first) & finite.any(axis=0)
-        self.first[missing] = values[finite[:, missing].argmax(axis=0), np.flatnonzero(missing)]
+        self.low, self.high, self.first = mtcore.rotations.finite_ranges(values, (self.low, self.high, self.first))
 
     @property
     def base(self) -> np.ndarray:
@@ -104,6 +97,11 @@ class Smoother:
             elif translation:
                 self.others.append(column)
         self.period = skeleton.period
+        chosen = sorted(self.rotations + self.others)
+        # the chosen columns as a slice where they run on (all of them, as a rule): no gather
+        runs_on = bool(chosen) and chosen == list(range(chosen[0], chosen[-1] + 1))
+        self._chosen: slice | list[int] = slice(chosen[0], chosen[-1] + 1) if runs_on else chosen
+        self._turning = [chosen.index(c) for c in self.rotations]  # rotations among the chosen
 
     @property
     def halo(self) -> int:
@@ -124,22 +122,23 @@ class Smoother:
 
     def smooth(self, unwrapped: np.ndarray, stats: TakeStats) -> np.ndarray:
         """Smoothed frames (all channels; the chosen ones changed), rotations wrapped back."""
+        chosen = self._chosen
+        every = chosen == slice(0, unwrapped.shape[1])
+        smooth = partial(FILTERS[self.kind], size=self.size, axis=0, mode=self.mode, workers=self.workers)
+        if self.kind == "median":
+            block = smooth(unwrapped[:, chosen])
+        else:  # means relative to the take's first frame: exact for constants, no loss far from zero
+            base = stats.base[chosen]
+            block = unwrapped[:, chosen] - base
+            smooth(block, output=block)
+            block += base
+        if self._turning:
+            turning = self.rotations if every else self._turning
+            block = _wrap_into(block, stats.low[self.rotations], stats.high[self.rotations], self.period, turning)
+        if every:
+            return block
         values = unwrapped.copy()
-        smooth = FILTERS[self.kind]
-        for columns in (self.rotations, self.others):
-            if not columns:
-                continue
-            block = unwrapped[:, columns]  # a copy, smoothed in place
-            # means relative to the take's first frame: exact for constants, no loss far from zero
-            base = None if self.kind == "median" else stats.base[columns]
-            if base is not None:
-                block -= base
-            smooth(block, self.size, axis=0, output=block, mode=self.mode, workers=self.workers)
-            if base is not None:
-                block += base
-            if columns is self.rotations:
-                _wrap_into(block, stats.low[columns], stats.high[columns], self.period, in_place=True)
-            values[:, columns] = block
+        values[:, chosen] = block
         return values
 
 
@@ -198,23 +197,19 @@ def filter_motion(
 
 
 def _wrap_into(
-    filtered: np.ndarray, low: np.ndarray, high: np.ndarray, period: float, *, in_place: bool = False
+    filtered: np.ndarray, low: np.ndarray, high: np.ndarray, period: float, columns: Sequence[int] | None = None
 ) -> np.ndarray:
-    """Each column of filtered in the range its take used: [-P/2, P/2], [0, P], or none (a new
-    array, or ``filtered`` itself changed with ``in_place``)."""
+    """Angle columns (all, or ``columns``) of filtered, each in the range its take used (``low`` ..
+    ``high``, one per column): [-P/2, P/2], [0, P], or none.  Changed in place where it is a
+    writeable C-contiguous float64 array (else a copy is); returned."""
+    if not (filtered.dtype == np.float64 and filtered.flags.c_contiguous and filtered.flags.writeable):
+        filtered = np.array(filtered, dtype=np.float64, order="C")
     half = period / 2
     centred = (low >= -half) & (high <= half)
     positive = ~centred & (low >= 0) & (high <= period)
-    out = filtered if in_place else filtered.copy()
-    for columns, least, most in ((centred, -half, half), (positive, 0.0, period)):
-        c = out[:, columns]
-        with np.errstate(invalid="ignore"):  # inf and NaN stay as they are
-            outside = ((c < least) | (c > most)) & np.isfinite(c)
-        if outside.any():  # rare (a mean across a wrap): only those samples change
-            v = c[outside]
-            c[outside] = v - period * np.floor((v - least) / period)
-            out[:, columns] = c
-    return out
+    least = np.where(centred, -half, np.where(positive, 0.0, np.nan))
+    mtcore.rotations.wrap_angles(filtered, least, least + period, period, columns)
+    return filtered
 
 
 for _kind, _what in (

@@ -23,11 +23,14 @@ def take_suffix(path: str | os.PathLike) -> str:
     return suffix
 
 
-def skeleton_for(path: str | os.PathLike, asf: str | os.PathLike | None = None) -> Path:
-    """The ASF of an AMC take: ``asf`` when given, else the one beside it by the CMU/HDM05 naming."""
+def skeleton_for(
+    path: str | os.PathLike, asf: str | os.PathLike | None = None, folders: dict[Path, list[Path]] | None = None
+) -> Path:
+    """The ASF of an AMC take: ``asf`` when given, else the one beside it by the CMU/HDM05 naming
+    (``folders`` as for :func:`~motiontheater.amc.skeleton_path_for`)."""
     if asf is not None:
         return Path(asf)
-    return skeleton_path_for(path)
+    return skeleton_path_for(path, folders)
 
 
 def read_take(

@@ -261,7 +261,11 @@ class Skeleton:
     def sizing(self) -> length_units.Sizing:
         """What the rest pose says about the length unit: its extents, up axis and the unit that
         makes the character human-sized (see :func:`motiontheater.units.size_up`)."""
-        return length_units.size_up(self.rest_positions())
+        return self._sizing
+
+    @cached_property
+    def _sizing(self) -> length_units.Sizing:
+        return length_units.size_up(self.rest_positions())  # every take of a skeleton asks: worked out once
 
     @cached_property
     def tree(self) -> JointTree:

@@ -48,6 +48,7 @@ __all__ = [
     "euler_to_matrices",
     "euler_to_quaternions",
     "euler_to_rotvecs",
+    "finite_ranges",
     "interpolate_euler",
     "interpolate_rotvecs",
     "matrices_to_euler",
@@ -63,6 +64,7 @@ __all__ = [
     "unroll_euler",
     "unroll_quaternions",
     "unwrap_angles",
+    "wrap_angles",
 ]
 
 BLENDS = {"slerp": lib.MT_BLEND_SLERP, "expmap": lib.MT_BLEND_EXPMAP, "aligned_expmap": lib.MT_BLEND_ALIGNED_EXPMAP}
@@ -267,9 +269,7 @@ def unwrap_angles(
     if a.ndim != 2:
         raise ValueError(f"values must be (frames, channels), got shape {a.shape}")
     out = np.array(a, dtype=np.float64, order="C")
-    chosen = np.arange(a.shape[1]) if columns is None else np.asarray(columns, dtype=np.intp).reshape(-1)
-    if chosen.size and (chosen.min() < 0 or chosen.max() >= a.shape[1]):
-        raise ValueError(f"columns must be channels of the {a.shape[1]} there are, got {chosen.tolist()}")
+    chosen = _columns(columns, a.shape[1])
     period = float(period)
     if not (math.isfinite(period) and period > 0):
         raise ValueError(f"period must be a positive number, got {period}")
@@ -287,6 +287,72 @@ def unwrap_angles(
         "mt_unwrap_angles",
     )
     return out, last, turns
+
+
+def _columns(columns, channels: int) -> np.ndarray:
+    chosen = np.arange(channels) if columns is None else np.asarray(columns, dtype=np.intp).reshape(-1)
+    if chosen.size and (chosen.min() < 0 or chosen.max() >= channels):
+        raise ValueError(f"columns must be channels of the {channels} there are, got {chosen.tolist()}")
+    return chosen
+
+
+def wrap_angles(values: np.ndarray, low, high, period: float, columns=None) -> None:
+    """Angle channels of ``values`` (frames, channels; C-contiguous float64, changed in place)
+    put back into a range: each finite sample of column ``columns[k]`` (default: all) outside
+    ``[low[k], high[k]]`` is moved into it by whole periods, ``v - period floor((v - low) /
+    period)``.  Where low or high is NaN the column is left.  The inverse of
+    :func:`unwrap_angles` once a take is smoothed."""
+    if not (isinstance(values, np.ndarray) and values.dtype == np.float64 and values.flags.c_contiguous):
+        raise TypeError("values must be a C-contiguous float64 array (it is changed in place)")
+    if values.ndim != 2:
+        raise ValueError(f"values must be (frames, channels), got shape {values.shape}")
+    if not values.flags.writeable:
+        raise ValueError("values must be writeable (it is changed in place)")
+    chosen = _columns(columns, values.shape[1])
+    low, high = (np.array(x, dtype=np.float64).reshape(-1) for x in (low, high))
+    if low.size != chosen.size or high.size != chosen.size:
+        raise ValueError(f"low and high must hold {chosen.size} bounds, one per column")
+    period = float(period)
+    if not (math.isfinite(period) and period > 0):
+        raise ValueError(f"period must be a positive number, got {period}")
+    c_columns = ffi.new("size_t[]", chosen.tolist())
+    check(
+        lib.mt_wrap_angles(
+            c_array(values),
+            values.shape[0],
+            values.shape[1],
+            c_columns,
+            chosen.size,
+            c_array(low),
+            c_array(high),
+            period,
+        ),
+        "mt_wrap_angles",
+    )
+
+
+def finite_ranges(
+    values, state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What the frames of ``values`` (frames, channels) say about each channel: (low, high,
+    first), the least and greatest finite sample of each column (+inf and -inf where it has
+    none) and its first finite sample (NaN for none).  ``state`` is that of the frames before
+    (a take given in pieces), widened into new arrays."""
+    a = _real(values, "values", ())
+    if a.ndim != 2:
+        raise ValueError(f"values must be (frames, channels), got shape {a.shape}")
+    channels = a.shape[1]
+    if state is None:
+        low, high, first = np.full(channels, np.inf), np.full(channels, -np.inf), np.full(channels, np.nan)
+    else:
+        low, high, first = (np.array(x, dtype=np.float64).reshape(-1) for x in state)
+        if not low.size == high.size == first.size == channels:
+            raise ValueError(f"state must hold {channels} lows, highs and firsts, one per column")
+    check(
+        lib.mt_finite_ranges(c_array(a), a.shape[0], channels, c_array(low), c_array(high), c_array(first)),
+        "mt_finite_ranges",
+    )
+    return low, high, first
 
 
 def _keys(k0, k1, t, names: tuple[str, str], width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -15,12 +15,13 @@ never depend on the C locale.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import mmap
 import operator
 import re
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -36,6 +37,7 @@ Text = bytes | mmap.mmap  # text to scan: read into memory, or mapped from its f
 
 __all__ = [
     "FRAME_MAX",
+    "TextLayout",
     "format_frames",
     "format_number",
     "format_table",
@@ -100,6 +102,12 @@ class _KeyTable:
         self.n = len(keys)
 
 
+@functools.lru_cache(maxsize=64)
+def _key_table(keys: tuple[bytes, ...], offsets: tuple[int, ...], counts: tuple[int, ...], channels: int) -> _KeyTable:
+    """The key table of a layout, made once: a batch reads and writes thousands of takes of a few."""
+    return _KeyTable(keys, offsets, counts, channels)
+
+
 def _line_at(text: Text, offset: int) -> tuple[str, bool]:
     """The line that begins at ``offset`` (its first 4 KB), and whether a line break ends it
     (a last line without one is where a file was cut)."""
@@ -150,7 +158,7 @@ def scan_frames(
     megabytes are cut at frame lines and scanned on all cores (``workers``
     as for the filters: None for automatic, 1 for the calling thread only).
     """
-    table = _KeyTable(keys, offsets, counts, channels)
+    table = _key_table(tuple(keys), tuple(offsets), tuple(counts), channels)
     if not 0 <= start <= len(text):
         raise ValueError(f"start must be within the text's {len(text)} bytes, got {start}")
     # A frame takes at least a digit and, for each key with numbers, the key and
@@ -357,7 +365,7 @@ def format_frames(
             f"frame numbers {first_frame} .. {first_frame + frames - 1} cannot be written: frame text "
             f"holds 0 .. {FRAME_MAX}"
         )
-    table = _KeyTable(keys, offsets, counts, channels)
+    table = _key_table(tuple(keys), tuple(offsets), tuple(counts), channels)
     chunk = max(1, min(frames, _FORMAT_CHUNK))
     buf = bytearray(lib.mt_format_bound(chunk, table.c_lens, table.c_counts, table.n, style))
     written = ffi.new("size_t *")
@@ -512,38 +520,34 @@ def parse_number(token: str | bytes) -> float:
 
 
 _STYLE_SAMPLE = 1 << 22  # bytes of a file that text_style looks at
-_EXPONENTS = (b"e-", b"e+", b"E-", b"E+")
+_NEWLINE_BYTES = {code: ending for ending, code in _NEWLINES.items()}
 
 
-def text_style(data: Text) -> tuple[bytes, int]:
-    """The line ending and the fewest exponent digits of the numbers of a file's text, for
-    writing it back alike: ``(newline, exponent_digits)`` for :func:`format_frames`.
+class TextLayout(NamedTuple):
+    """How a file's text is laid out (see :func:`text_style`)."""
+
+    newline: bytes
+    exponent_digits: int
+    frame_newline: bytes
+
+
+def text_style(data: Text) -> TextLayout:
+    """The line ending, the fewest exponent digits of the numbers and the ending of the frame
+    lines of a file's text, for writing it back alike (the options of :func:`format_frames`).
 
     The newline is the one most lines of the first 4 MB end in (``b"\\r\\n"``, ``b"\\n"``
-    or ``b"\\r"``; ``b"\\n"`` when there is none).  Exponent digits: 3 where an exponent
-    there is written with a leading zero in three digits (``1.23246e-013``), 1 where one
-    has a single digit (``1e-5``), else 2 (Python and C on Linux: ``1e-05``).
+    or ``b"\\r"``; ``b"\\n"`` where there is none, and of equal counts the first of LF,
+    CRLF, CR).  Exponent digits: 3 where an exponent there is written with a leading zero in
+    three digits (``1.23246e-013``), 1 where one has a single digit (``1e-5``), else 2
+    (Python and C on Linux: ``1e-05``).  The frame newline ends the first line that holds
+    only a frame number (HDM05 ends those in LF and every other line in CRLF); the newline
+    where there is none.  In C, one pass; a mapped file is read under the guard.
     """
-    head = bytes(memoryview(data)[:_STYLE_SAMPLE])
-    if b"\r" in head:
-        crlf = head.count(b"\r\n")
-        endings = {b"\n": head.count(b"\n") - crlf, b"\r\n": crlf, b"\r": head.count(b"\r") - crlf}
-        newline = max(endings, key=endings.__getitem__)  # the first, LF, of equal counts
-    else:  # no CR: LF, the count of which need not be taken (also LF where there is no line end)
-        newline = b"\n"
-    single = False
-    for marker in _EXPONENTS:
-        at = head.find(marker, 1)
-        for _ in range(64):  # enough to see a file's style, few enough to stay cheap
-            if at == -1:
-                break
-            end = at + 2
-            while end < len(head) and 48 <= head[end] <= 57:
-                end += 1
-            exponent = head[at + 2 : end]
-            if exponent and (48 <= head[at - 1] <= 57 or head[at - 1] == 46):  # after a digit or '.'
-                if len(exponent) > 1 and exponent[0] == 48:
-                    return newline, len(exponent)
-                single |= len(exponent) == 1
-            at = head.find(marker, at + 2)
-    return newline, 1 if single else 2
+    style: Any = ffi.new("struct mt_text_style *")  # a struct: fields by name
+    size = min(len(data), _STYLE_SAMPLE)
+    with ffi.from_buffer(data) as c_data:
+        check(lib.mt_text_style(c_data, size, style), "mt_text_style")
+    counts = {b"\n": style.lf, b"\r\n": style.crlf, b"\r": style.cr}
+    newline = max(counts, key=counts.__getitem__)
+    frame_newline = _NEWLINE_BYTES.get(style.frame_newline, newline)
+    return TextLayout(newline, style.exponent_digits, frame_newline)

@@ -298,6 +298,36 @@ def unwrap_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
+def wrap_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for frames in (0, 1, 2, 7, 64):
+        for period in (360.0, 2 * math.pi):
+            raw = np.cumsum(rng.normal(0, period / 4, (frames, 5)), axis=0)  # strays out of range
+            raw[rng.random(raw.shape) < 0.08] = np.nan
+            raw[rng.random(raw.shape) < 0.04] = -np.inf
+            low = np.array([-period / 2, 0.0, np.nan, -period / 2, 0.0])
+            out += [(raw, low, low + period, period, None), (raw, low[:3], low[:3] + period, period, [4, 0, 2])]
+    return out
+
+
+def fast_wrap(values, low, high, period, columns):
+    out = np.array(values, dtype=float)
+    rot.wrap_angles(out, low, high, period, columns)
+    return out
+
+
+def ranges_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for frames in (0, 1, 2, 7, 64):
+        raw = rng.normal(0, 100, (frames, 6))
+        raw[rng.random(raw.shape) < 0.2] = np.nan
+        raw[rng.random(raw.shape) < 0.1] = np.inf
+        raw[:, 5] = np.nan  # a column with nothing finite
+        state = (rng.normal(-50, 10, 6), rng.normal(50, 10, 6), np.where(rng.random(6) < 0.5, np.nan, 1.0))
+        out += [(raw, None), (raw, state)]
+    return out
+
+
 def slerp_cases(rng: np.random.Generator) -> list[tuple]:
     out = []
     for shape in ROTATION_SHAPES:
@@ -584,6 +614,24 @@ def mapped_cases(rng: np.random.Generator) -> list[tuple]:
     return [(data, begin, end) for begin, end in ((0, 0), (0, 1), (5, 70_000), (65_530, 69_999), (100, 100_000))]
 
 
+def style_cases(rng: np.random.Generator) -> list[tuple]:
+    """Texts of AMC-like lines: numbers with exponents of every width, names holding an 'e', frame
+    lines with blanks, each line ended by LF, CRLF or CR at random (or not at all, at the end)."""
+    words = [b"lfemur", b"joint_e-01", b"1e-5", b"2.5E+07", b"1.23246e-013", b"-3.e+0012", b"5e-14", b"7", b"-0.25"]
+    endings = [b"\n", b"\r\n", b"\r"]
+    out = [(b"",), (b"1",), (b"e-012 3.5E+007\n",), (b" 12 \t\r\nroot 1\n",), (b"1\r\r\n\n",)]
+    for _ in range(40):
+        lines = []
+        for _ in range(int(rng.integers(1, 30))):
+            if rng.random() < 0.2:
+                line = b" " * int(rng.integers(3)) + b"%d" % rng.integers(0, 999) + b"\t" * int(rng.integers(2))
+            else:
+                line = b" ".join(words[int(i)] for i in rng.integers(0, len(words), int(rng.integers(0, 6))))
+            lines.append(line + endings[int(rng.integers(3))] * int(rng.integers(0, 2) or rng.random() < 0.9))
+        out.append((b"".join(lines),))
+    return out
+
+
 def copy_mapped(data: bytes, begin: int, end: int) -> bytes:
     """The guarded copy from a real mapping of a file holding ``data``."""
     import mmap
@@ -731,6 +779,7 @@ TWINS: dict[str, Twin] = {
     "mt_filter1d": Twin(fast_filter, slow_filter, filter_cases, filter_same),
     "mt_scan_frames": Twin(mt_text.scan_frames, text_twins.scan_frames, frame_text_cases, exact),
     "mt_scan_table": Twin(mt_text.scan_table, text_twins.scan_table, table_cases, exact),
+    "mt_text_style": Twin(lambda data: tuple(mt_text.text_style(data)), text_twins.text_style, style_cases, exact),
     "mt_format_double": Twin(mtcore.format_number, text_twins.format_number, number_cases, exact),
     "mt_format_table": Twin(
         lambda values: written(lambda w: mt_text.format_table(values, w)), text_twins.format_table, value_cases, exact
@@ -778,6 +827,8 @@ TWINS: dict[str, Twin] = {
         close(1e-12),
     ),
     "mt_unwrap_angles": Twin(rot.unwrap_angles, rotations.unwrap_angles, unwrap_cases, exact),
+    "mt_wrap_angles": Twin(fast_wrap, rotations.wrap_angles, wrap_cases, exact),
+    "mt_finite_ranges": Twin(rot.finite_ranges, rotations.finite_ranges, ranges_cases, exact),
     "mt_slerp": Twin(rot.slerp, rotations.slerp, slerp_cases, close(1e-12)),
     "mt_interpolate_rotvecs": Twin(
         lambda v0, v1, t, aligned: rot.interpolate_rotvecs(v0, v1, t, aligned=aligned),

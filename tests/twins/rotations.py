@@ -3,6 +3,8 @@ quaternion products, an eigenvector for a matrix's quaternion, per-frame loops f
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 AXES = "xyz"
@@ -267,3 +269,33 @@ def unwrap_angles(values, period: float, columns=None, state=None) -> tuple[np.n
             if turns[k]:
                 out[t, c] = v + turns[k] * period
     return out, last, turns
+
+
+def wrap_angles(values, low, high, period: float, columns=None) -> np.ndarray:
+    """Wrapping sample by sample, into a copy: a finite sample outside its column's [low, high]
+    takes the whole turns that bring it to low or above (NaN bounds: the column is left)."""
+    out = np.array(values, dtype=float)
+    for k, c in enumerate(range(out.shape[1]) if columns is None else columns):
+        for t in range(out.shape[0]):
+            v = out[t, c]
+            if math.isfinite(v) and (v < low[k] or v > high[k]):
+                out[t, c] = v - period * math.floor((v - low[k]) / period)
+    return out
+
+
+def finite_ranges(values, state=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each column's least, greatest and first finite sample, sample by sample, from ``state``."""
+    values = np.asarray(values, dtype=float)
+    channels = values.shape[1]
+    low, high, first = (
+        (np.full(channels, np.inf), np.full(channels, -np.inf), np.full(channels, np.nan))
+        if state is None
+        else tuple(np.array(x, dtype=float) for x in state)
+    )
+    for row in values:
+        for c, v in enumerate(row):
+            if math.isfinite(v):
+                low[c], high[c] = min(low[c], v), max(high[c], v)
+                if math.isnan(first[c]):
+                    first[c] = v
+    return low, high, first

@@ -73,3 +73,23 @@ def parse_amc(data: bytes, skeleton) -> tuple[np.ndarray, int]:
     counts = [len(skeleton.dofs(joint)) for joint in names]
     offsets = np.cumsum([0, *counts[:-1]]).tolist()
     return scan_frames(body, [n.encode() for n in names], offsets, counts, sum(counts))
+
+
+EXPONENT = re.compile(rb"(?<=[0-9.])[eE][+-]([0-9]+)")
+FRAME_LINE = re.compile(rb"(?:^|(?<=[\r\n]))[ \t]*[0-9]+[ \t]*(\r\n|[\r\n]|\Z)")
+
+
+def text_style(data: bytes) -> tuple[bytes, int, bytes]:
+    """(newline, exponent digits, frame newline) by regular expressions over the first 4 MB:
+    the most common line end (LF of equal counts, then CRLF); the length of the first exponent
+    with a leading zero in two digits or more (at most 3), else 1 if one has a single digit,
+    else 2; the ending of the first line of digits only (the newline if none or none ends it)."""
+    head = data[: 1 << 22]
+    crlf = head.count(b"\r\n")
+    counts = {b"\n": head.count(b"\n") - crlf, b"\r\n": crlf, b"\r": head.count(b"\r") - crlf}
+    newline = max(counts, key=counts.__getitem__)
+    exponents = [m.group(1) for m in EXPONENT.finditer(head) if m.start() > 0]
+    padded = next((len(e) for e in exponents if len(e) > 1 and e.startswith(b"0")), None)
+    digits = min(padded, 3) if padded else 1 if any(len(e) == 1 for e in exponents) else 2
+    frame = FRAME_LINE.search(head)
+    return newline, digits, frame.group(1) if frame and frame.group(1) else newline
