@@ -144,7 +144,8 @@ def size_up(points: np.ndarray) -> Sizing:
     """
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     finite = points[np.isfinite(points).all(axis=1)]
-    spans = finite.max(axis=0) - finite.min(axis=0) if len(finite) else np.zeros(3)
+    with np.errstate(over="ignore"):  # a pose spanning more than the largest double: inf, no human unit
+        spans = finite.max(axis=0) - finite.min(axis=0) if len(finite) else np.zeros(3)
     extents = (float(spans[0]), float(spans[1]), float(spans[2]))
     up = "z" if extents[2] > extents[1] else "y"
     largest = "xyz"[int(np.argmax(spans))]
