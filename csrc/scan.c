@@ -17,14 +17,25 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* What each byte is to the scanner: a lookup, not four comparisons, per byte. */
+enum { BLANK = 1, EOL = 2 };
+static const unsigned char byte_class[256] = {['\t'] = BLANK, ['\v'] = BLANK, ['\f'] = BLANK, [' '] = BLANK,
+                                              ['\n'] = EOL,   ['\r'] = EOL};
+
 static int is_blank(char c)
 {
-    return c == ' ' || c == '\t' || c == '\v' || c == '\f';
+    return byte_class[(unsigned char)c] & BLANK;
 }
 
 static int is_eol(char c)
 {
-    return c == '\n' || c == '\r';
+    return byte_class[(unsigned char)c] & EOL;
+}
+
+/* A blank or a line end: what ends a token. */
+static int ends_token(char c)
+{
+    return byte_class[(unsigned char)c] != 0;
 }
 
 static int is_digit(char c)
@@ -35,7 +46,7 @@ static int is_digit(char c)
 /* The end of the token starting at p. */
 static const char *token_end(const char *p, const char *end)
 {
-    while (p < end && !is_blank(*p) && !is_eol(*p))
+    while (p < end && !ends_token(*p))
         p++;
     return p;
 }
@@ -54,6 +65,79 @@ static const char *take_digits(const char *p, const char *end, uint64_t *mantiss
     return p;
 }
 
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+/* The count of digits that begin the eight bytes of w (the first byte lowest), 8 if all are. */
+static inline int leading_digits(uint64_t w)
+{
+    const uint64_t x = w ^ UINT64_C(0x3030303030303030); /* a digit becomes its value, 0 .. 9 */
+    const uint64_t other = ((x + UINT64_C(0x0606060606060606)) | x) & UINT64_C(0xf0f0f0f0f0f0f0f0);
+    return other ? __builtin_ctzll(other) >> 3 : 8;
+}
+
+/* The value of the n (1 .. 8) digits that begin w: all eight at once (Lemire's fast_float). */
+static inline uint64_t digits_value(uint64_t w, int n)
+{
+    uint64_t x = (w ^ UINT64_C(0x3030303030303030)) << (8 * (8 - n)); /* leading zeros instead */
+    x = x * 10 + (x >> 8);
+    x = ((x & UINT64_C(0x000000ff000000ff)) * UINT64_C(0x000f424000000064) +
+         ((x >> 16) & UINT64_C(0x000000ff000000ff)) * UINT64_C(0x0000271000000001)) >>
+        32;
+    return x;
+}
+
+static const uint64_t pow10_u64[9] = {1, 10, 100, 1000, 10000, 100000, 1000000, 10000000, 100000000};
+
+/*
+ * The digits of a decimal's whole and fractional parts at *p, eight bytes at a time, where at
+ * least eight bytes are left at each step and there are fewer than 8 whole digits and at most
+ * 19 in all; returns 0 for the byte-wise reading to do it otherwise.
+ */
+static inline int take_decimal(const char **pp, const char *end, uint64_t *mantissa, int *count, int *exp10)
+{
+    const char *p = *pp;
+    if (end - p < 8)
+        return 0;
+    uint64_t w;
+    memcpy(&w, p, 8);
+    int n = leading_digits(w);
+    if (n == 8)
+        return 0;
+    uint64_t m = n ? digits_value(w, n) : 0;
+    int digits = n, e = 0;
+    p += n;
+    if (*p == '.') {
+        for (p++;; p += n) {
+            if (end - p < 8)
+                return 0;
+            memcpy(&w, p, 8);
+            n = leading_digits(w);
+            if (n == 0)
+                break;
+            if (digits + n > 19)
+                return 0;
+            m = m * pow10_u64[n] + digits_value(w, n);
+            digits += n;
+            e -= n;
+            if (n < 8) {
+                p += n;
+                break;
+            }
+        }
+    }
+    *pp = p;
+    *mantissa = m;
+    *count = digits;
+    *exp10 = e;
+    return 1;
+}
+#else
+static inline int take_decimal(const char **pp, const char *end, uint64_t *mantissa, int *count, int *exp10)
+{
+    (void)pp, (void)end, (void)mantissa, (void)count, (void)exp10;
+    return 0;
+}
+#endif
+
 /*
  * Parses the number that starts at p, before end; returns the end of its
  * token, or NULL if the token is not a number.  One pass for the usual
@@ -65,17 +149,27 @@ static const char *parse_number(const char *p, const char *end, double *out)
     int negative = 0;
     if (p < end && (*p == '-' || *p == '+'))
         negative = *p++ == '-';
-    /* Digits go into the mantissa unchecked; more than 19 of them (leading
-       zeros included, which is rare) take the general path below. */
     uint64_t mantissa = 0;
-    const char *first = p;
-    p = take_digits(p, end, &mantissa);
-    int digits = (int)(p - first), exp10 = 0;
-    if (p < end && *p == '.') {
-        const char *fraction = ++p;
+    int digits, exp10 = 0;
+    if (take_decimal(&p, end, &mantissa, &digits, &exp10)) {
+        /* the usual decimal: no exponent, a token's end after it (p is before end here) */
+        if (digits > 0 && ends_token(*p) && mantissa <= ((uint64_t)1 << 53) && exp10 >= -22) {
+            const double v = exact_decimal(mantissa, exp10);
+            *out = negative ? -v : v;
+            return p;
+        }
+    } else {
+        /* Digits go into the mantissa unchecked; more than 19 of them (leading
+           zeros included, which is rare) take the general path below. */
+        const char *first = p;
         p = take_digits(p, end, &mantissa);
-        exp10 = -(int)(p - fraction);
-        digits -= exp10;
+        digits = (int)(p - first);
+        if (p < end && *p == '.') {
+            const char *fraction = ++p;
+            p = take_digits(p, end, &mantissa);
+            exp10 = -(int)(p - fraction);
+            digits -= exp10;
+        }
     }
     const int exact = digits <= 19;
     if (p < end && (*p == 'e' || *p == 'E') && digits > 0) {
@@ -91,7 +185,7 @@ static const char *parse_number(const char *p, const char *end, double *out)
             p = e;
         }
     }
-    if (digits > 0 && exact && (p == end || is_blank(*p) || is_eol(*p))) {
+    if (digits > 0 && exact && (p == end || ends_token(*p))) {
         if (mantissa <= ((uint64_t)1 << 53) && exp10 >= -22 && exp10 <= 22) {
             const double v = exact_decimal(mantissa, exp10);
             *out = negative ? -v : v;
@@ -178,7 +272,45 @@ struct scan {
     size_t *seen_in;  /* frame (1-based) in which each key was last seen */
     size_t *order;    /* keys in the order of the first frame, to guess the next key */
     size_t norder;
+    uint64_t *words;  /* per key: its first 16 bytes, zero-padded, and the masks of its bytes */
 };
+
+/* The words of each key of at most 16 bytes, for expected_key; NULL where malloc fails. */
+static uint64_t *key_words(const char *const *keys, const size_t *key_lens, size_t nkeys)
+{
+    uint64_t *words = calloc(4 * nkeys + 1, sizeof *words);
+    if (words == NULL)
+        return NULL;
+    for (size_t k = 0; k < nkeys; k++) {
+        if (key_lens[k] > 16)
+            continue; /* a mask of zeros: never found this way */
+        unsigned char bytes[16] = {0}, mask[16] = {0};
+        memcpy(bytes, keys[k], key_lens[k]);
+        memset(mask, 0xff, key_lens[k]);
+        memcpy(words + 4 * k, bytes, 16);
+        memcpy(words + 4 * k + 2, mask, 16);
+    }
+    return words;
+}
+
+/*
+ * The key that frame lines hold at `position` in the first frame, if the line at p begins with
+ * it (followed by a blank or the line's end); else -1, for find_key to look.  Two words
+ * compared, where the text has 16 bytes left: most lines of a frame come in the first's order.
+ */
+static long long expected_key(const struct scan *s, const char *p, const char *end, size_t position)
+{
+    if (position >= s->norder || end - p < 17)
+        return -1;
+    const size_t k = s->order[position], n = s->key_lens[k];
+    const uint64_t *w = s->words + 4 * k;
+    uint64_t t0, t1;
+    memcpy(&t0, p, 8);
+    memcpy(&t1, p + 8, 8);
+    if (((t0 & w[2]) ^ w[0]) | ((t1 & w[3]) ^ w[1]) || n > 16 || !ends_token(p[n]))
+        return -1;
+    return (long long)k;
+}
 
 /* Keys are a few bytes long: an inline loop beats a call to memcmp. */
 static int same_key(const struct scan *s, size_t k, const char *tok, size_t n)
@@ -223,9 +355,10 @@ static int scan_text(const char *text, const char *end, struct scan *s, double *
         while (p < end && is_blank(*p))
             p++;
         if (p < end && !is_eol(*p) && *p != '#') {
-            const char *tok = p, *tok_stop = token_end(p, end);
+            long long k = frames > 0 && !is_digit(*p) ? expected_key(s, p, end, position) : -1;
+            const char *tok = p, *tok_stop = k >= 0 ? p + s->key_lens[k] : token_end(p, end);
             long long number;
-            if (frame_line(tok, tok_stop, tok_stop, end, &number)) {
+            if (k < 0 && frame_line(tok, tok_stop, tok_stop, end, &number)) {
                 if (number < 0)
                     return MT_EFRAMERANGE;
                 if (frames > 0 && (r->key = missing_key(s, frames)) >= 0)
@@ -250,8 +383,7 @@ static int scan_text(const char *text, const char *end, struct scan *s, double *
                     r->expected = -1; /* a frame number */
                     return MT_EFRAME;
                 }
-                long long k = find_key(s, tok, (size_t)(tok_stop - tok), position);
-                if (k < 0)
+                if (k < 0 && (k = find_key(s, tok, (size_t)(tok_stop - tok), position)) < 0)
                     return MT_EUNKNOWN;
                 r->key = k;
                 if (s->seen_in[k] == frames)
@@ -342,13 +474,15 @@ int mt_scan_frames(const char *text, size_t len, const char *const *keys, const 
         if (keys[k] == NULL || key_lens[k] == 0 || offsets[k] > channels ||
             counts[k] > channels - offsets[k])
             return MT_EINVAL;
-    struct scan s = {keys, key_lens, offsets, counts, nkeys, NULL, NULL, 0};
+    struct scan s = {keys, key_lens, offsets, counts, nkeys, NULL, NULL, 0, NULL};
     s.seen_in = calloc(nkeys + 1, sizeof *s.seen_in);
     s.order = malloc((nkeys + 1) * sizeof *s.order);
+    s.words = key_words(keys, key_lens, nkeys);
     int status = MT_ENOMEM;
-    if (s.seen_in && s.order)
+    if (s.seen_in && s.order && s.words)
         MT_GUARDED(status, scan_text(text, text + len, &s, values, max_frames, channels, report));
     free(s.seen_in);
     free(s.order);
+    free(s.words);
     return status;
 }

@@ -263,9 +263,11 @@ def test_bounds_saturate():
 
 
 def check_reads_as_float(tokens: list[str]) -> None:
-    """Each token reads as float() gives, through parse_number and through the scanner."""
+    """Each token reads as float() gives, through parse_number (text, and bytes: C's parser) and
+    through the scanner."""
     want = [float(t) for t in tokens]
     assert_same_bits([parse_number(t) for t in tokens], want, tokens)
+    assert_same_bits([parse_number(t.encode()) for t in tokens], want, tokens)
     assert_same_bits(read_back(tokens), want, tokens)
 
 
@@ -371,6 +373,8 @@ def test_the_grammar_accepts():
 def test_the_grammar_refuses(token):
     with pytest.raises(NumberError, match="expected a number .*, found"):
         parse_number(token)
+    with pytest.raises(NumberError, match="expected a number .*, found"):
+        parse_number(token.encode())
     if not token:
         return  # no empty token in a line of text
     with pytest.raises(NumberError, match="expected a number as value 1"):

@@ -54,10 +54,14 @@ def skeleton_path_for(amc_path: str | os.PathLike, folders: dict[Path, list[Path
 
 def _layout(skeleton: Skeleton, joints) -> tuple[list[bytes], list[int], list[int]]:
     """Keys, first columns and channel counts of the given joints in the canonical layout."""
-    return (
-        [encode(j) for j in joints],
-        [skeleton.first_column(j) for j in joints],
-        [len(skeleton.dofs(j)) for j in joints],
+    joints = tuple(joints)
+    return skeleton.derived(
+        ("amc layout", joints),
+        lambda: (
+            [encode(j) for j in joints],
+            [skeleton.first_column(j) for j in joints],
+            [len(skeleton.dofs(j)) for j in joints],
+        ),
     )
 
 
@@ -181,17 +185,25 @@ def _check_angle_unit(header: list[tuple[int, str]], skeleton: Skeleton) -> None
 
 
 def _first_frame_order(data: Text, body: int, joints: set[str]) -> tuple[str, ...]:
-    """The bone lines of the first frame, in order."""
-    following = frame_line(data, body + 1)
-    block = decode(data[body : following if following != -1 else len(data)])
-    order = []
-    for line in LINE_BREAK.split(block)[1:]:
-        words = line.split(None, 1)
-        if words and not words[0].startswith("#"):
-            name = words[0]
-            if name in joints:
-                order.append(name)
-    return tuple(order)
+    """The bone lines of the first frame, in order: up to the next line of digits only."""
+    window = 1 << 10  # a frame of 31 bones takes about 700 bytes
+    while True:
+        lines = LINE_BREAK.split(decode(data[body : body + window]))
+        whole = body + window >= len(data)
+        if not whole:
+            lines.pop()  # it may be cut short
+        order: list[str] = []
+        for line in lines[1:]:
+            words = line.split(None, 1)
+            if not words or words[0].startswith("#"):
+                continue
+            if len(words) == 1 and words[0].isascii() and words[0].isdigit():
+                return tuple(order)  # the next frame
+            if words[0] in joints:
+                order.append(words[0])
+        if whole:
+            return tuple(order)
+        window *= 4
 
 
 def write_amc(motion: Motion, target: Source) -> None:

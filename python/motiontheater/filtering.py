@@ -89,19 +89,12 @@ class Smoother:
         if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or size < 1 or size % 2 == 0:
             raise ValueError(f"filter size must be an odd number of frames (3, 5, 7, ...), got {size!r}")
         self.kind, self.size, self.mode, self.workers = kind, int(size), mode, workers
-        self.rotations: list[int] = []
-        self.others: list[int] = []
-        for column in skeleton.columns_of(joints):
-            if skeleton.channels[column][1] in ROTATIONS:
-                self.rotations.append(column)
-            elif translation:
-                self.others.append(column)
         self.period = skeleton.period
-        chosen = sorted(self.rotations + self.others)
-        # the chosen columns as a slice where they run on (all of them, as a rule): no gather
-        runs_on = bool(chosen) and chosen == list(range(chosen[0], chosen[-1] + 1))
-        self._chosen: slice | list[int] = slice(chosen[0], chosen[-1] + 1) if runs_on else chosen
-        self._turning = [chosen.index(c) for c in self.rotations]  # rotations among the chosen
+        chosen_joints = None if joints is None else tuple(joints)
+        self.rotations, self.others, self._chosen, self._turning = skeleton.derived(
+            ("smoothed columns", chosen_joints, translation),
+            lambda: _smoothed_columns(skeleton, chosen_joints, translation),
+        )
 
     @property
     def halo(self) -> int:
@@ -140,6 +133,24 @@ class Smoother:
         values = unwrapped.copy()
         values[:, chosen] = block
         return values
+
+
+def _smoothed_columns(
+    skeleton: Skeleton, joints: Iterable[str] | None, translation: bool
+) -> tuple[list[int], list[int], slice | list[int], list[int]]:
+    """The rotation and other columns that a smoothing of ``joints`` changes, all of them (as a
+    slice where they run on, as a rule: no gather), and where the rotations are among them."""
+    rotations: list[int] = []
+    others: list[int] = []
+    for column in skeleton.columns_of(joints):
+        if skeleton.channels[column][1] in ROTATIONS:
+            rotations.append(column)
+        elif translation:
+            others.append(column)
+    chosen = sorted(rotations + others)
+    runs_on = bool(chosen) and chosen == list(range(chosen[0], chosen[-1] + 1))
+    where = {c: i for i, c in enumerate(chosen)}
+    return rotations, others, slice(chosen[0], chosen[-1] + 1) if runs_on else chosen, [where[c] for c in rotations]
 
 
 def unwrap_angles(

@@ -14,9 +14,10 @@ last first.  :attr:`Skeleton.tree` holds the tables the C kernel takes.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Hashable, Iterable
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from typing import TypeVar
 
 import numpy as np
 
@@ -26,6 +27,8 @@ from mtcore.kinematics import DOFS, JointTree, forward_kinematics
 from . import units as length_units
 from ._io import PLAIN, Origin, TextStyle
 from .errors import DuplicateError, HierarchyError, UnknownNameError
+
+T = TypeVar("T")
 
 Vec3 = tuple[float, float, float]
 
@@ -157,12 +160,12 @@ class Skeleton:
             if source not in length_units.SOURCES:
                 raise ValueError(f"length_choice: how the unit was chosen must be one of {length_units.SOURCES}")
 
-    @property
+    @cached_property
     def bone_names(self) -> tuple[str, ...]:
         """The bones in ``:bonedata`` order."""
         return tuple(b.name for b in self.bones)
 
-    @property
+    @cached_property
     def joint_names(self) -> tuple[str, ...]:
         """The root followed by the bones in ``:bonedata`` order; the root is called "root"."""
         return ("root", *self.bone_names)
@@ -266,6 +269,14 @@ class Skeleton:
     @cached_property
     def _sizing(self) -> length_units.Sizing:
         return length_units.size_up(self.rest_positions())  # every take of a skeleton asks: worked out once
+
+    def derived(self, key: Hashable, make: Callable[[], T]) -> T:
+        """What ``make()`` works out from this skeleton, made once per ``key``: a batch asks for
+        the same tables (layouts, column lists) on each of thousands of takes."""
+        memo = self.__dict__.setdefault("_derived", {})  # as cached_property keeps its values
+        if key not in memo:
+            memo[key] = make()
+        return memo[key]
 
     @cached_property
     def tree(self) -> JointTree:
@@ -439,17 +450,20 @@ def _joint_tree(skeleton: Skeleton) -> JointTree:
         queue.extend(skeleton.children(name))
     root = skeleton.root
     bvh = skeleton.convention == "bvh"
-    axis = [_axis_frame(root.axis, root.orientation, degrees)]
+    if bvh:  # a BVH joint's frame is its parent's
+        axis = np.concatenate(
+            [_axis_frames([(root.axis, root.orientation)], degrees), np.tile(np.eye(3), (len(skeleton.bones), 1, 1))]
+        )
+    else:
+        axis = _axis_frames([(root.axis, root.orientation)] + [(b.axis_order, b.axis) for b in skeleton.bones], degrees)
     direction = [np.zeros(3)]
     segment = [_replaced(root.position, root.order) if bvh else np.asarray(root.position)]
     for bone in skeleton.bones:
         d = np.asarray(bone.direction, float)
         if bvh:  # the OFFSET itself, turned by the parent; position channels replace its components
-            axis.append(np.eye(3))
             direction.append(np.zeros(3))
             segment.append(_replaced(d, bone.dofs))
             continue
-        axis.append(_axis_frame(bone.axis_order, bone.axis, degrees))
         norm = math.hypot(*d)  # no overflow for huge components, unlike the sum of squares
         # no direction: zero; an infinite one (bad input) has none either, and says so with NaN
         unit = d / norm if 0 < norm < math.inf else np.full(3, math.nan if norm else 0.0)
@@ -474,7 +488,7 @@ def _joint_tree(skeleton: Skeleton) -> JointTree:
     return JointTree(
         parent=np.array(parent),
         order=np.array(order),
-        axis=np.array(axis),
+        axis=axis,
         direction=np.array(direction),
         segment=np.array(segment),
         dof_start=np.array(dof_start),
@@ -485,10 +499,17 @@ def _joint_tree(skeleton: Skeleton) -> JointTree:
     )
 
 
-def _axis_frame(order: str, angles: Vec3, degrees: bool) -> np.ndarray:
-    """C of an ASF ``axis``: the angles are about x, y and z, applied in ``order`` (e.g. "ZYX")."""
-    in_order = [angles["XYZ".index(letter)] for letter in order.upper()]
-    return rotations.euler_to_matrices(in_order, order.lower(), extrinsic=True, degrees=degrees)
+def _axis_frames(frames: list[tuple[str, Vec3]], degrees: bool) -> np.ndarray:
+    """(n, 3, 3): C of each ASF ``axis`` (order, angles): the angles are about x, y and z,
+    applied in ``order`` (e.g. "ZYX"); one call per order."""
+    out = np.empty((len(frames), 3, 3))
+    by_order: dict[str, list[int]] = {}
+    for i, (order, _) in enumerate(frames):
+        by_order.setdefault(order.upper(), []).append(i)
+    for order, rows in by_order.items():
+        in_order = [[frames[i][1]["XYZ".index(letter)] for letter in order] for i in rows]
+        out[rows] = rotations.euler_to_matrices(in_order, order.lower(), extrinsic=True, degrees=degrees)
+    return out
 
 
 def _replaced(offset: Vec3 | np.ndarray, dofs: tuple[str, ...]) -> np.ndarray:

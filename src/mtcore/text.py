@@ -52,8 +52,9 @@ __all__ = [
 FRAME_MAX: int = lib.MT_FRAME_MAX
 """The largest frame number that frame text can hold (18 digits); the smallest is 0."""
 
-_FORMAT_CHUNK = 2048  # frames per C call when writing: bounds the text buffer
+_FORMAT_CHUNK = 256  # frames per C call when writing: a text buffer that stays in cache
 _NEWLINES = {b"\n": lib.MT_NEWLINE_LF, b"\r\n": lib.MT_NEWLINE_CRLF, b"\r": lib.MT_NEWLINE_CR}
+_DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")  # the grammar's decimals
 _GRAMMAR = "a number (optional sign, digits with an optional '.' and exponent, as 17.8693 or -1.2e-05; or inf, nan)"
 
 
@@ -100,6 +101,13 @@ class _KeyTable:
         self.c_offsets = ffi.new("size_t[]", list(offsets))
         self.c_counts = ffi.new("size_t[]", list(counts))
         self.n = len(keys)
+        # A frame takes at least a digit and, for each key with numbers, the key and a digit and a
+        # blank per number: how many frames a text can hold at most.
+        self.least_frame_bytes = 1 + sum(len(k) + 2 * c for k, c in zip(keys, counts) if c > 0)
+        covered = np.zeros(channels, bool)
+        for offset, count in zip(offsets, counts):
+            covered[offset : offset + count] = True
+        self.uncovered = np.flatnonzero(~covered)  # columns no key fills
 
 
 @functools.lru_cache(maxsize=64)
@@ -161,12 +169,10 @@ def scan_frames(
     table = _key_table(tuple(keys), tuple(offsets), tuple(counts), channels)
     if not 0 <= start <= len(text):
         raise ValueError(f"start must be within the text's {len(text)} bytes, got {start}")
-    # A frame takes at least a digit and, for each key with numbers, the key and
-    # a digit and a blank per number.  Pages past the frames found are never
-    # touched, so the excess costs address space, not memory.
-    least = 1 + sum(len(k) + 2 * c for k, c in zip(keys, counts) if c > 0)
+    # Pages past the frames found are never touched, so room for the most frames a text can hold
+    # costs address space, not memory.
     pieces = _pieces(text, start, _piece_count(workers, len(text) - start))
-    capacities = [(stop - begin) // least + 1 for begin, stop in pieces]
+    capacities = [(stop - begin) // table.least_frame_bytes + 1 for begin, stop in pieces]
     bases = np.cumsum([0, *capacities]).tolist()
     values = np.empty((bases[-1], channels))
     reports: list[Any] = [ffi.new("struct mt_scan_report *") for _ in pieces]  # structs: fields by name
@@ -200,13 +206,12 @@ def scan_frames(
         check(status, "mt_scan_frames", _describer(text, start, begin, table, report, noun))
         if not frames:
             first = report.first_frame
-        values[frames : frames + report.frames] = values[base : base + report.frames]
+        if base != frames:
+            values[frames : frames + report.frames] = values[base : base + report.frames]
         frames += report.frames
     values.resize((frames, channels), refcheck=False)  # in place: realloc
-    covered = np.zeros(channels, bool)
-    for offset, count in zip(offsets, counts):
-        covered[offset : offset + count] = True
-    values[:, ~covered] = np.nan
+    if len(table.uncovered):
+        values[:, table.uncovered] = np.nan
     return values, int(first) if frames else 0
 
 
@@ -507,8 +512,11 @@ def parse_number(token: str | bytes) -> float:
     equal to ``float(token)`` wherever this accepts the token.
 
     Raises :class:`~mtcore.errors.NumberError` (a ValueError) saying what was expected, for
-    anything else: hexadecimal, ``1_0``, ``nan(...)``, blanks, the empty string.
+    anything else: hexadecimal, ``1_0``, ``nan(...)``, blanks, the empty string.  Bytes are read
+    by the C parser of the scanners; text in the usual decimal forms by ``float()``, the same value.
     """
+    if isinstance(token, str) and _DECIMAL.fullmatch(token):
+        return float(token)  # the grammar's value, as the C parser's (headers parse thousands of these)
     data = token.encode("ascii", "replace") if isinstance(token, str) else bytes(token)
     value = ffi.new("double *")
     with ffi.from_buffer(data) as c_data:

@@ -844,7 +844,7 @@ TWINS: dict[str, Twin] = {
     "mt_combine": Twin(fast_combine, slow_combine, combine_cases, exact),
     "mt_copy_mapped": Twin(copy_mapped, lambda data, begin, end: data[begin:end], mapped_cases, exact),
     "mt_retarget": Twin(retarget_rotations, retarget.retarget_rotations, retarget_cases, turns_close),
-    "mt_parse_number": Twin(mt_text.parse_number, float, parse_cases, close(0.0)),
+    "mt_parse_number": Twin(lambda t: mt_text.parse_number(t.encode()), float, parse_cases, close(0.0)),  # bytes: C
     "mt_equalize": Twin(
         lambda x, g, mode: mt_signal.equalize(x, g, 0, mode), signal_twins.equalize_twin, equalize_cases, close(1e-12)
     ),
