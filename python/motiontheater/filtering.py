@@ -126,8 +126,7 @@ class Smoother:
             smooth(block, output=block)
             block += base
         if self._turning:
-            turning = self.rotations if every else self._turning
-            block = _wrap_into(block, stats.low[self.rotations], stats.high[self.rotations], self.period, turning)
+            block = _wrap_into(block, stats.low[self.rotations], stats.high[self.rotations], self.period, self._turning)
         if every:
             return block
         values = unwrapped.copy()
