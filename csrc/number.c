@@ -49,9 +49,12 @@ static inline int clz64(uint64_t x)
 #endif
 }
 
-/* floor(x / 2^s); a right shift of a negative number is implementation-defined in C. */
+/* floor(x / 2^s).  A right shift of a negative number is implementation-defined in C: where
+   it is arithmetic (every compiler this builds with), it is the floor; else it is computed. */
 static inline int floor_shift(int64_t x, int s)
 {
+    if ((INT64_C(-1) >> 1) == INT64_C(-1))
+        return (int)(x >> s);
     return x >= 0 ? (int)(x >> s) : -(int)((-x + ((int64_t)1 << s) - 1) >> s);
 }
 
