@@ -340,7 +340,8 @@ int mt_rotvecs_to_quaternions(const double *rotvecs, size_t n, double *quaternio
  * column has counted turns gets turns * period added: exact multiples, so that any cut of the
  * frames into calls gives the same values.  NaN and infinities stay as they are and are
  * stepped over.  last[k] and turns[k] carry column k's last finite sample and its turns from
- * call to call: NaN and 0 at a take's start.
+ * call to call: NaN and 0 at a take's start.  MT_ENOMEM where ncolumns + 1 words of scratch
+ * (where the columns run on) cannot be allocated; so for mt_wrap_angles.
  */
 int mt_unwrap_angles(double *values, size_t frames, size_t stride, const size_t *columns, size_t ncolumns,
                      double period, double *last, double *turns);

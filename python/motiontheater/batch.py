@@ -273,8 +273,18 @@ def _stamp(path: str) -> tuple[int, int]:
 @functools.lru_cache(maxsize=256)
 def _skeleton(path: str, mtime_ns: int, size: int, unit: str | None) -> Any:
     """A worker reads each skeleton once (a database has a few, and thousands of takes), its
-    length unit settled; a changed file has a new stamp and is read again."""
-    return settle_length_unit(read_asf(path), unit)
+    length unit settled; a changed file has a new stamp and is read again.  Files of the same
+    bytes (a subject's ASF copied into each session's folder) are parsed once."""
+    with open(path, "rb") as f:
+        key = (hashlib.sha256(f.read()).digest(), unit)
+    if key not in _PARSED:
+        if len(_PARSED) >= 256:
+            _PARSED.pop(next(iter(_PARSED)))  # the oldest
+        _PARSED[key] = settle_length_unit(read_asf(path), unit)
+    return _PARSED[key]
+
+
+_PARSED: dict[tuple[bytes, str | None], Any] = {}  # skeletons by the digest of their file's bytes
 
 
 def _copy_skeleton(asf: str, folder: str) -> None:
