@@ -372,9 +372,9 @@ def format_frames(
         )
     table = _key_table(tuple(keys), tuple(offsets), tuple(counts), channels)
     chunk = max(1, min(frames, _FORMAT_CHUNK))
-    buf = bytearray(lib.mt_format_bound(chunk, table.c_lens, table.c_counts, table.n, style))
+    buf = np.empty(lib.mt_format_bound(chunk, table.c_lens, table.c_counts, table.n, style), np.uint8)  # not zeroed
     written = ffi.new("size_t *")
-    with c_array(values) as c_values, ffi.from_buffer(buf) as c_buf:
+    with c_array(values) as c_values, c_array(buf, "char[]") as c_buf:
         for f0 in range(0, frames, chunk):
             n = min(chunk, frames - f0)
             status = lib.mt_format_frames(
@@ -393,7 +393,7 @@ def format_frames(
                 written,
             )
             check(status, "mt_format_frames")
-            write(bytes(memoryview(buf)[: written[0]]))
+            write(buf[: written[0]].tobytes())
 
 
 def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers: int | None = None) -> np.ndarray:
@@ -488,14 +488,14 @@ def format_table(
         raise ValueError(f"values must be (rows, columns), got shape {values.shape}")
     rows, columns = values.shape
     chunk = max(1, min(rows, _FORMAT_CHUNK))
-    buf = bytearray(lib.mt_format_table_bound(chunk, columns, style))
+    buf = np.empty(lib.mt_format_table_bound(chunk, columns, style), np.uint8)  # not zeroed
     written = ffi.new("size_t *")
-    with c_array(values) as c_values, ffi.from_buffer(buf) as c_buf:
+    with c_array(values) as c_values, c_array(buf, "char[]") as c_buf:
         for r0 in range(0, rows, chunk):
             n = min(chunk, rows - r0)
             status = lib.mt_format_table(c_values + r0 * columns, n, columns, style, c_buf, len(buf), written)
             check(status, "mt_format_table")
-            write(bytes(memoryview(buf)[: written[0]]))
+            write(buf[: written[0]].tobytes())
 
 
 def format_number(value: float, *, digits: int | None = None, exponent_digits: int = 2) -> str:
