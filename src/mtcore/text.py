@@ -549,7 +549,7 @@ def text_style(data: Text) -> TextLayout:
     three digits (``1.23246e-013``), 1 where one has a single digit (``1e-5``), else 2
     (Python and C on Linux: ``1e-05``).  The frame newline ends the first line that holds
     only a frame number (HDM05 ends those in LF and every other line in CRLF); the newline
-    where there is none.  In C, one pass; a mapped file is read under the guard.
+    where there is none.  In C, straight passes over the bytes; a mapped file is read under the guard.
     """
     style: Any = ffi.new("struct mt_text_style *")  # a struct: fields by name
     size = min(len(data), _STYLE_SAMPLE)
