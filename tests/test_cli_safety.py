@@ -1,6 +1,7 @@
 """Files are sacred, messages are for people: what the command line does around the work itself."""
 
 import errno
+import json
 import os
 import shutil
 import stat
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater import _io, registry
+from motiontheater import _io, batch, registry
 from motiontheater.cli import main
 
 
@@ -69,6 +70,25 @@ def test_resume_redoes_takes_made_by_another_recipe_or_from_changed_inputs(cmu, 
     (out / "02_01.amc").unlink()
     assert main(["batch", "--mean", "3", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
     assert "1 processed, 1 skipped" in capsys.readouterr().out
+
+
+def test_resume_trusts_the_manifest_lines_a_killed_run_wrote_whole(cmu, tmp_path, capsys):
+    """The manifest gets a line as each take finishes: cut in the middle of its last line (a kill as
+    it was written), the lines before still count, and the take of the cut line is done again."""
+    out = tmp_path / "out"
+    assert main(["batch", "--median", "5", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
+    manifest = out / batch.MANIFEST
+    lines = manifest.read_bytes().splitlines(keepends=True)
+    assert len(lines) == 2 and all(json.loads(line)["output"].endswith(".amc") for line in lines)
+    manifest.write_bytes(lines[0] + lines[1][: len(lines[1]) // 2])
+    capsys.readouterr()
+    assert main(["batch", "--median", "5", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
+    assert "1 processed, 1 skipped" in capsys.readouterr().out
+    assert len(manifest.read_bytes().splitlines()) == 2  # compacted: one whole line per output
+    entries = [json.loads(line) for line in lines]
+    manifest.write_text(json.dumps({"version": 1, "outputs": {e.pop("output"): e for e in entries}}))  # as it was
+    assert main(["batch", "--median", "5", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
+    assert "0 processed, 2 skipped" in capsys.readouterr().out
 
 
 def test_the_output_suffix_decides_the_format(cmu, tmp_path, capsys):

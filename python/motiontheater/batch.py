@@ -107,17 +107,19 @@ def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
 class Manifest:
     """What made each output of a folder: the recipe, and the stamps of the take and its skeleton.
 
-    Kept as JSON beside the outputs; ``--resume`` trusts an output only when the
-    manifest says the same recipe made it from inputs that have not changed since.
+    Kept beside the outputs as JSON lines, one per output, each appended as its take finishes (a
+    run killed at any moment keeps every line it wrote whole; a later line for an output replaces
+    an earlier one); ``--resume`` trusts an output only when the manifest says the same recipe
+    made it from inputs that have not changed since.
     """
 
     def __init__(self, folder: str | os.PathLike, recipe: str):
         self.path = Path(folder) / MANIFEST
         self.recipe = hashlib.sha256(recipe.encode()).hexdigest()
         self.entries: dict[str, dict[str, Any]] = {}
-        self.saved = time.monotonic()
-        with contextlib.suppress(OSError, ValueError):
-            self.entries = dict(json.loads(self.path.read_text()).get("outputs", {}))
+        self._log: Any = None
+        with contextlib.suppress(OSError, UnicodeDecodeError):
+            self.entries = _manifest_entries(self.path.read_text())
 
     def _key(self, job: Job) -> str:
         return os.path.relpath(job.output, self.path.parent)
@@ -141,20 +143,44 @@ class Manifest:
         return written.exists() and written.stat().st_size == entry["size"]
 
     def record(self, job: Job, result: Result) -> None:
-        """Note a finished job (saved now and then, and by :meth:`save`)."""
-        self.entries[self._key(job)] = {
+        """Note a finished job: a line appended to the manifest now."""
+        key = self._key(job)
+        self.entries[key] = entry = {
             **self._stamps(job),
             "written": os.path.relpath(result.output, self.path.parent),
             "size": os.path.getsize(result.output),
         }
-        if time.monotonic() - self.saved > 2:
-            self.save()
+        if self._log is None:  # the manifest as found, compacted (atomically, like every output), then appended to
+            with output(self.path) as f:
+                f.write(b"".join(_manifest_line(k, e) for k, e in self.entries.items() if k != key))
+            self._log = open(self.path, "ab")  # closed by close()
+        self._log.write(_manifest_line(key, entry))
+        self._log.flush()
 
-    def save(self) -> None:
-        """Write the manifest (atomically, like every output)."""
-        self.saved = time.monotonic()
-        with output(self.path) as f:
-            f.write(json.dumps({"version": 1, "outputs": self.entries}, indent=1).encode())
+    def close(self) -> None:
+        """Stop appending (the lines written are all there already)."""
+        if self._log is not None:
+            self._log.close()
+            self._log = None
+
+
+def _manifest_line(key: str, entry: dict[str, Any]) -> bytes:
+    return json.dumps({"output": key, **entry}).encode() + b"\n"
+
+
+def _manifest_entries(text: str) -> dict[str, dict[str, Any]]:
+    """The entries of a manifest's text: JSON lines, the last for an output counting; a line that is
+    not whole JSON (a run killed as it wrote it) is skipped.  (Version 1 was one JSON object.)"""
+    with contextlib.suppress(ValueError):
+        whole = json.loads(text)
+        if isinstance(whole, dict) and whole.get("version") == 1:
+            return dict(whole.get("outputs", {}))
+    entries = {}
+    for line in text.splitlines():
+        with contextlib.suppress(ValueError, TypeError, KeyError, AttributeError):  # not an entry: skipped
+            entry = json.loads(line)
+            entries[entry.pop("output")] = entry
+    return entries
 
 
 def plan_jobs(
@@ -416,8 +442,8 @@ def run(
     finally:
         results.close()
         progress.close()
-        if manifest is not None and manifest.entries:
-            manifest.save()
+        if manifest is not None:
+            manifest.close()
         remove_stale_partials(out, recursive=True)
     summary.seconds = time.perf_counter() - start
     return summary
