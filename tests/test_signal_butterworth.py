@@ -53,7 +53,7 @@ def test_sosfiltfilt_is_scipys_bit_for_bit(rng, order, btype, wn):
 
 
 @pytest.mark.parametrize("padtype", ["odd", "even", "constant", None])
-@pytest.mark.parametrize("channels", [1, 3, 4, 5, 63, 64, 65, 130])
+@pytest.mark.parametrize("channels", [1, 2, 3, 4, 5, 17, 19, 62, 63, 64, 65, 130])
 def test_sosfiltfilt_padtypes_and_widths(rng, padtype, channels):
     sos = ss.butter(4, [0.05, 0.3], "band", output="sos")
     x = signal(rng, 700, channels)
@@ -96,6 +96,15 @@ def test_sosfiltfilt_any_axis_layout_and_dtype(rng):
     big = rng.standard_normal((20_000, 70))
     np.testing.assert_array_equal(sg.sosfiltfilt(sos, big, axis=0), sg.sosfiltfilt(sos, big, axis=0, workers=1))
     np.testing.assert_array_equal(sg.sosfiltfilt(sos, big, axis=0, workers=3), ss.sosfiltfilt(sos, big, axis=0))
+
+
+@pytest.mark.parametrize("order", [2, 4])  # one section (its tile copied out) and two
+def test_sosfiltfilt_thread_slabs_of_any_width(rng, order):
+    """Three threads take 57 channels as slabs of 16, 24 and 17 (the last group of quads of 17 ends at its last
+    channel and borrows channels of the group before); each slab writes its own channels only."""
+    sos = ss.butter(order, 0.2, output="sos")
+    x = signal(rng, 3000, 57)
+    np.testing.assert_array_equal(sg.sosfiltfilt(sos, x, axis=0, workers=3), ss.sosfiltfilt(sos, x, axis=0))
 
 
 def test_sosfiltfilt_keeps_scipys_nan_and_inf(rng):
