@@ -50,20 +50,25 @@
  * Memory.  The forward pass reads each input row once and writes its
  * output row; the backward pass reads the output rows back from the last
  * and overwrites them in place.  While the sections run, they ask for the
- * lines of the rows a tile ahead (software prefetch, a few at each row), so
+ * lines of the rows AHEAD further on (software prefetch, a few at each row), so
  * that memory works while the arithmetic does: the hardware prefetchers do
  * not follow a group's 128 bytes in every 496.
  *
- * Measured on (432000, 62), one core, 4th-order low pass, into an output
- * written before: the former design (the rows copied whole into a tile of
- * 64 lanes and back, 505 M instructions) took 80-85 ms; sections reading
- * and writing the rows themselves (452 M) 90-110 ms without the prefetch
- * and 55-57 ms with it.  Storing each quad only after all four are loaded
- * (the order that would let overlapping quads read and write the same rows)
- * spills the state from registers and costs 40%.  Streaming stores of the
- * forward outputs (through a stage of whole rows) saved 4 ms into an output
- * written before but cost 6-8 ms into a new one, whose pages the kernel has
- * just cleared into the cache, and sosfiltfilt's outputs are new.
+ * Measured on (432000, 62), one core, 4th-order low pass, the best of
+ * many calls on a shared machine, into an output written before (and into
+ * a new one): the former design (the rows copied whole into a tile of 64
+ * lanes and back, 506 M instructions) took 79 ms (91); sections reading and
+ * writing the rows themselves, in tiles of 32 rows (454 M), 90-110 ms
+ * without the prefetch and 59 ms (67) with it; in tiles of 8 rows (493 M:
+ * the states go in and out of registers four times as often) 48 ms (59),
+ * as a tile's rows in and out no longer spill from L1 before the last
+ * group is done with their shared lines.  Storing each quad only after all
+ * four are loaded (the order that would let overlapping quads read and
+ * write the same rows) spills the state from registers and costs 40%.
+ * Streaming stores of the forward outputs (through a stage of whole rows)
+ * saved 4 ms into an output written before but cost 6-8 ms into a new one,
+ * whose pages the kernel has just cleared into the cache, and
+ * sosfiltfilt's outputs are new.
  */
 #include "clones.h"
 #include "mtcore.h"
@@ -79,7 +84,8 @@ enum {
     QUADS = 4,          /* vectors of channels that one section filters side by side */
     GROUP = 4 * QUADS,  /* their channels */
     LANES = 64,         /* channels of a chunk, at most */
-    TILE = 32,          /* rows a section runs down at a time */
+    TILE = 8,           /* rows a section runs down at a time: a chunk's 8 rows in and out stay in L1 */
+    AHEAD = 16,         /* rows ahead whose lines the sections ask for */
     LINE = 64           /* bytes of a cache line */
 };
 
@@ -126,7 +132,7 @@ static MT_INLINE void prefetch(const double *row, const ptrdiff_t *off, size_t k
 /*
  * Runs m rows of a group from src (quads of sk real lanes) through the section of coefficients c to dst (dk),
  * never the same rows, from the state z (z0 of each quad, then z1), which it updates; the state stays in
- * registers.  For its first ahead_src rows it asks for the row of src a tile further on, for its first
+ * registers.  For its first ahead_src rows it asks for the row of src AHEAD further on, for its first
  * ahead_dst that of dst.
  */
 static MT_INLINE void section(const double *c, struct rows src, size_t sk, struct rows dst, size_t dk, size_t m,
@@ -141,9 +147,9 @@ static MT_INLINE void section(const double *c, struct rows src, size_t sk, struc
     double *d = dst.p;
     for (size_t t = 0; t < m; t++, s += src.step, d += dst.step) {
         if (t < ahead_src)
-            prefetch(s + TILE * src.step, src.off, sk);
+            prefetch(s + AHEAD * src.step, src.off, sk);
         if (t < ahead_dst)
-            prefetch(d + TILE * dst.step, dst.off, dk);
+            prefetch(d + AHEAD * dst.step, dst.off, dk);
         for (int j = 0; j < QUADS; j++) {
             quad x;
             load(&x, s + src.off[j], sk);
@@ -163,7 +169,7 @@ static MT_INLINE void untile(const double *tile, struct rows dst, size_t k, size
     double *d = dst.p;
     for (size_t t = 0; t < m; t++, d += dst.step, tile += GROUP) {
         if (t < ahead_dst)
-            prefetch(d + TILE * dst.step, dst.off, k);
+            prefetch(d + AHEAD * dst.step, dst.off, k);
         for (int j = 0; j < QUADS; j++) {
             quad y;
             load(&y, tile + 4 * j, 4);
@@ -184,7 +190,7 @@ struct line {
 };
 
 /* m rows of one group from src through every section to dst (quads of k real lanes), by way of its tile
-   (TILE x GROUP), asking for the rows a tile further on for the first ahead[0] of src and ahead[1] of dst. */
+   (TILE x GROUP), asking for the rows AHEAD further on for the first ahead[0] of src and ahead[1] of dst. */
 static MT_INLINE void cascade_group(const struct line *l, quad *state, struct rows src, struct rows dst, size_t k,
                                     double *tile, size_t m, const size_t ahead[2])
 {
@@ -199,8 +205,8 @@ static MT_INLINE void cascade_group(const struct line *l, quad *state, struct ro
         untile(tile, dst, k, m, ahead[1]);
 }
 
-/* m rows of the chunk, every group, from src to dst (rows sstep and dstep values apart), asking for the rows a
-   tile further on as cascade_group. */
+/* m rows of the chunk, every group, from src to dst (rows sstep and dstep values apart), asking for the rows
+   AHEAD further on as cascade_group. */
 static MT_CLONES void cascade(const struct line *l, quad *state, double *tile, const double *src, ptrdiff_t sstep,
                               double *dst, ptrdiff_t dstep, size_t m, const size_t ahead[2])
 {
@@ -264,10 +270,10 @@ static void extension(const struct line *l, int right, double *ext)
     }
 }
 
-/* Rows of a tile of m whose row a tile further is still in the line of n rows, r rows (this tile's) before. */
+/* Rows of a tile of m whose row AHEAD further is still in the line of n rows, r rows (this tile's) before. */
 static size_t ahead_of(size_t n, size_t r, size_t m)
 {
-    return r + TILE >= n ? 0 : n - r - TILE < m ? n - r - TILE : m;
+    return r + AHEAD >= n ? 0 : n - r - AHEAD < m ? n - r - AHEAD : m;
 }
 
 /* Scratch of one call. */
