@@ -53,7 +53,7 @@ def test_sosfiltfilt_is_scipys_bit_for_bit(rng, order, btype, wn):
 
 
 @pytest.mark.parametrize("padtype", ["odd", "even", "constant", None])
-@pytest.mark.parametrize("channels", [1, 2, 3, 4, 5, 17, 19, 62, 63, 64, 65, 130])
+@pytest.mark.parametrize("channels", [1, 2, 3, 4, 5, 17, 19, 62, 63, 64, 65, 130, 301])
 def test_sosfiltfilt_padtypes_and_widths(rng, padtype, channels):
     sos = ss.butter(4, [0.05, 0.3], "band", output="sos")
     x = signal(rng, 700, channels)
