@@ -13,6 +13,7 @@ from twins.signal import sosfilt_zi_twin, sosfiltfilt_twin
 
 KINDS = [("low", 0.1), ("low", 0.004), ("low", 0.9), ("high", 0.05), ("high", 0.8), ("band", (0.02, 0.2))]
 KINDS += [("band", (0.4, 0.45)), ("band", (0.005, 0.99))]
+KINDS += [("band", (1 / 120, 1 / 30)), ("high", 1 / 600)]  # the steep ones: 0.5-2 Hz and 0.1 Hz at 120 Hz
 
 
 @pytest.mark.parametrize("order", range(1, 9))
