@@ -462,9 +462,9 @@ def sosfiltfilt(
             workers,
             lambda src, dst, width: lib.mt_sosfiltfilt(sp, len(s), zp, src, dst, n, width, channels, pad, pad_code),
             # Memory-bound, so a thread takes whole rows where it can: on (432000, 62) one thread took 62 ms of CPU,
-            # two slabs of 31 channels 46-55 ms each, and while a task ran on the other core (as on a shared
-            # machine most of the time) the slab sharing it took two to four times as long.  On (108000, 248)
-            # two slabs of 124 took 45 ms each against 75 ms.
+            # two slabs of 31 channels 46-55 ms each; but whenever another task ran (on a shared machine, most of
+            # the time) the pair took 84-124 ms against 60-73 ms for one thread, 564 against 127-144 ms with a
+            # load on the other core.  On (108000, 248) two slabs of 124 took 45 ms of CPU each against 75 ms.
             idle_only=True,
             min_width=_SLAB_MIN_CHANNELS,
         )
