@@ -66,6 +66,9 @@
  * group is done with their shared lines.  Storing each quad only after all
  * four are loaded (the order that would let overlapping quads read and
  * write the same rows) spills the state from registers and costs 40%.
+ * A bare read-and-write pass down the rows takes 23-26 ms, up them 13-15
+ * ms, down them asking for each block of 128 rows ahead in rising order
+ * 16-20 ms; in the backward pass that last gained nothing measurable.
  * With the channels filtered in chunks of at most 64, one chunk's passes
  * after the other's (so that the scratch stayed small), (108000, 248) took
  * 64-81 ms against 45-54 ms in one pass for all.
