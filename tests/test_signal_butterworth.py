@@ -13,6 +13,7 @@ from twins.signal import sosfilt_zi_twin, sosfiltfilt_twin
 
 KINDS = [("low", 0.1), ("low", 0.004), ("low", 0.9), ("high", 0.05), ("high", 0.8), ("band", (0.02, 0.2))]
 KINDS += [("band", (0.4, 0.45)), ("band", (0.005, 0.99))]
+KINDS += [("band", (1 / 120, 1 / 30)), ("high", 1 / 600)]  # the steep ones: 0.5-2 Hz and 0.1 Hz at 120 Hz
 
 
 @pytest.mark.parametrize("order", range(1, 9))
@@ -53,7 +54,7 @@ def test_sosfiltfilt_is_scipys_bit_for_bit(rng, order, btype, wn):
 
 
 @pytest.mark.parametrize("padtype", ["odd", "even", "constant", None])
-@pytest.mark.parametrize("channels", [1, 3, 4, 5, 63, 64, 65, 130])
+@pytest.mark.parametrize("channels", [1, 2, 3, 4, 5, 17, 19, 62, 63, 64, 65, 130, 301])
 def test_sosfiltfilt_padtypes_and_widths(rng, padtype, channels):
     sos = ss.butter(4, [0.05, 0.3], "band", output="sos")
     x = signal(rng, 700, channels)
@@ -96,6 +97,35 @@ def test_sosfiltfilt_any_axis_layout_and_dtype(rng):
     big = rng.standard_normal((20_000, 70))
     np.testing.assert_array_equal(sg.sosfiltfilt(sos, big, axis=0), sg.sosfiltfilt(sos, big, axis=0, workers=1))
     np.testing.assert_array_equal(sg.sosfiltfilt(sos, big, axis=0, workers=3), ss.sosfiltfilt(sos, big, axis=0))
+
+
+@pytest.mark.parametrize("order", [2, 4])  # one section (its tile copied out) and two
+def test_sosfiltfilt_thread_slabs_of_any_width(rng, order):
+    """Three threads take 57 channels as slabs of 16, 24 and 17 (the last group of quads of 17 ends at its last
+    channel and borrows channels of the group before); each slab writes its own channels only."""
+    sos = ss.butter(order, 0.2, output="sos")
+    x = signal(rng, 3000, 57)
+    np.testing.assert_array_equal(sg.sosfiltfilt(sos, x, axis=0, workers=3), ss.sosfiltfilt(sos, x, axis=0))
+
+
+def test_sosfiltfilt_takes_the_idle_cores_by_default(monkeypatch):
+    """workers=None splits a large x over the cores no other task is running on (a slab on a busy core would
+    hold the whole call back), in slabs of 64 channels at least.  Explicit workers stay as given."""
+    from mtcore import _parallel
+
+    assert _parallel._running_elsewhere() >= 0
+    monkeypatch.setattr(_parallel, "cpu_count", lambda: 4)
+    lines = np.zeros((20_000, 256))
+    for running, threads in ((0, 4), (1, 3), (3, 1), (9, 1)):
+        monkeypatch.setattr(_parallel, "_running_elsewhere", lambda running=running: running)
+        assert len(sg._channel_bounds(None, lines, idle_only=True, min_width=64)) - 1 == threads
+        assert len(sg._channel_bounds(None, lines)) - 1 == 4
+        assert len(sg._channel_bounds(2, lines, idle_only=True, min_width=64)) - 1 == 2
+    monkeypatch.setattr(_parallel, "_running_elsewhere", lambda: 0)
+    assert len(sg._channel_bounds(None, lines[:, :130], idle_only=True, min_width=64)) - 1 == 2
+    assert len(sg._channel_bounds(None, lines[:, :62], idle_only=True, min_width=64)) - 1 == 1
+    assert len(sg._channel_bounds(5, lines[:, :62], idle_only=True, min_width=64)) - 1 == 5
+    assert len(sg._channel_bounds(None, lines[:10], idle_only=True)) - 1 == 1  # small: one thread
 
 
 def test_sosfiltfilt_keeps_scipys_nan_and_inf(rng):

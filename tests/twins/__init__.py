@@ -552,10 +552,14 @@ def equalize_cases(rng: np.random.Generator) -> list[tuple]:
 
 
 def sosfiltfilt_cases(rng: np.random.Generator) -> list[tuple]:
+    # and wider lines: whole groups of 16 channels, a last group ending at the last channel (62), one borrowing
+    # from the group before (17), two chunks (65)
+    wide = [rng.normal(size=(frames, channels)).cumsum(axis=0) for frames, channels in ((97, 17), (80, 62), (60, 65))]
     out = []
     for order, cut, kind in ((1, 0.2, "low"), (4, 0.1, "low"), (3, 0.3, "high"), (2, (0.1, 0.4), "band")):
         sos = mt_signal.butter_sos(order, cut, kind)
-        out += [(sos, x, padtype) for x in signal_lines(rng)[1:] for padtype in ("odd", "even", "constant")]
+        lines = signal_lines(rng)[1:] + wide
+        out += [(sos, x, padtype) for x in lines for padtype in ("odd", "even", "constant")]
         out = [c for c in out if len(c[1]) > 3 * (2 * len(c[0]) + 1)]  # scipy's padding needs a long enough line
     return out
 
