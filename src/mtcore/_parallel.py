@@ -30,21 +30,6 @@ def cpu_count() -> int:
         return os.cpu_count() or 1
 
 
-def _running_elsewhere() -> int:
-    """Tasks the system is running at this moment besides the caller (Linux: the count in /proc/loadavg, which
-    includes the reader); 0 where the system does not tell."""
-    try:
-        with open("/proc/loadavg", "rb") as f:
-            return max(0, int(f.read().split()[3].split(b"/")[0]) - 1)
-    except (OSError, ValueError, IndexError):
-        return 0
-
-
-def idle_count() -> int:
-    """Cores free at this moment: cpu_count() less the tasks running elsewhere, at least 1."""
-    return max(1, cpu_count() - _running_elsewhere())
-
-
 def _get_pool() -> ThreadPoolExecutor:
     global _pool
     with _lock:
@@ -73,14 +58,11 @@ def run_all(tasks: Sequence[Callable[[], R]]) -> list[R]:
     return [first, *(f.result() for f in futures)]
 
 
-def thread_count(workers: int | None, large: bool, *, idle_only: bool = False) -> int:
+def thread_count(workers: int | None, large: bool) -> int:
     """Threads a call may use: ``workers`` threads, every core for -1, and for
-    None every core when the job is ``large`` enough to gain, else one.  With
-    ``idle_only``, None takes only the cores idle now: for a call split into
-    equal parts that waits for its slowest, a part on a core shared with
-    another task runs at half speed or less."""
+    None every core when the job is ``large`` enough to gain, else one."""
     if workers is None:
-        return (idle_count() if idle_only else cpu_count()) if large else 1
+        return cpu_count() if large else 1
     try:
         wanted = operator.index(workers)
     except TypeError:

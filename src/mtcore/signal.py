@@ -138,11 +138,11 @@ def _unlines(lines: np.ndarray, a: np.ndarray, axis: int) -> np.ndarray:
     return np.moveaxis(lines.reshape((lines.shape[0], *moved)), 0, axis)
 
 
-def _channel_bounds(workers: int | None, lines: np.ndarray, idle_only: bool = False, min_width: int = 1) -> list[int]:
+def _channel_bounds(workers: int | None, lines: np.ndarray, min_width: int = 1) -> list[int]:
     """Channel bounds of the slabs the threads take, at multiples of a cache line (see thread_count); for
     workers=None no slab narrower than ``min_width`` channels."""
     channels = lines.shape[1]
-    wanted = thread_count(workers, lines.size >= _PARALLEL_MIN_VALUES, idle_only=idle_only)
+    wanted = thread_count(workers, lines.size >= _PARALLEL_MIN_VALUES)
     if workers is None:
         wanted = min(wanted, max(1, channels // min_width))
     grains = -(-channels // _CHANNEL_GRAIN)
@@ -155,12 +155,11 @@ def _run_slabs(
     out: np.ndarray,
     workers: int | None,
     call: Callable[..., int],
-    idle_only: bool = False,
     min_width: int = 1,
 ) -> None:
     """``call(in_pointer, out_pointer, channels)`` for each thread's slab of channels (see _channel_bounds)."""
     src, dst = c_array(lines), c_array(out)
-    bounds = _channel_bounds(workers, lines, idle_only, min_width)
+    bounds = _channel_bounds(workers, lines, min_width)
     run_ranges(lambda c0, c1: call(src + c0, dst + c0, c1 - c0), bounds, name)
 
 
@@ -430,8 +429,7 @@ def sosfiltfilt(
     float64 input gives scipy's result bit for bit; other input is converted
     to float64 first (scipy extends float32 input in float32).  ``workers``:
     threads, each taking a slab of the channels (-1: every core; None: for a
-    large ``x``, the cores idle at the time of the call, with slabs of 64
-    channels at least, else one).
+    large ``x``, every core in slabs of 64 channels at least, else one).
     """
     s = _sos(sos)
     a = _float_array(x)
@@ -465,7 +463,6 @@ def sosfiltfilt(
             # two slabs of 31 channels 46-55 ms each; but whenever another task ran (on a shared machine, most of
             # the time) the pair took 84-124 ms against 60-73 ms for one thread, 564 against 127-144 ms with a
             # load on the other core.  On (108000, 248) two slabs of 124 took 45 ms of CPU each against 75 ms.
-            idle_only=True,
             min_width=_SLAB_MIN_CHANNELS,
         )
     return _unlines(out, a, axis)
