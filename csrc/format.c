@@ -102,8 +102,8 @@ static inline char *put_newline(const struct line_end *end, char *out)
  * as it, a = d 10^e, returning 1; else 0.  a 10^k is below 10^9 for the k taken, where a decimal
  * step of 10^-k is a thousandth of a's ulp at most: at most one integer m has m 10^-k reading
  * back as a, and the nearest to a 10^k it is, if any is.  m 10^-k is the shortest decimal then
- * (any with fewer digits is one too, with trailing zeros): Schubfach's answer, at the cost of a
- * product, a quotient and a test.  The quotient m / 10^k is what reading m e-k gives (one
+ * (any with fewer digits is one too, with trailing zeros): number_shortest's answer, at the
+ * cost of a product, a quotient and a test.  The quotient m / 10^k is what reading m e-k gives (one
  * correctly rounded operation on exact doubles, Clinger 1990), so the test is exact.
  */
 static inline int short_decimal(double a, uint64_t bits, uint64_t *d, int *e)

@@ -8,6 +8,10 @@ r = floor(log2(10^p)) - 125, so that 2^125 < g(p) <= 2^126: a 126-bit overestima
 for 0 <= p <= POW10_EXACT_MAX.  The range serves the shortest writer (p from -292 to 324),
 the n-digit writer (-308 to 340) and the reader (-342 to 308).
 
+A second table serves the shortest writer's common case (Jeon's Dragonbox): for every k in
+[CACHE_MIN, CACHE_MAX], phi(k) = ceil(10^k / 2^s), s = floor(log2(10^k)) - 127, so that
+2^127 <= phi(k) < 2^128, as two 64-bit halves.
+
 The C code computes floor(log2(10^p)) and floor(log10(2^q)) by fixed-point products; this
 script checks them against exact integer arithmetic over the ranges used, and fails if one
 is off anywhere.
@@ -18,6 +22,7 @@ import sys
 from fractions import Fraction
 
 POW10_MIN, POW10_MAX = -342, 340
+CACHE_MIN, CACHE_MAX = -292, 326  # 10^k for the doubles' binary exponents -1074 .. 971
 Q_MIN, Q_MAX = -1140, 1100  # binary exponents the formulas are used for
 
 
@@ -55,6 +60,13 @@ def g(p: int) -> tuple[int, bool]:
     return value, x.denominator == 1
 
 
+def phi(k: int) -> int:
+    x = Fraction(10) ** k / Fraction(2) ** (floor_log(Fraction(10) ** k, 2) - 127)
+    value = -(-x.numerator // x.denominator)
+    assert 2**127 <= value < 2**128, k
+    return value
+
+
 def main() -> None:
     check_formulas()
     rows, exact = [], []
@@ -71,7 +83,16 @@ def main() -> None:
     out.write(f"#define POW10_EXACT_MAX {exact[-1]} /* g(p) - 1 == 10^p / 2^r for 0 <= p <= this */\n\n")
     out.write("/* g(p) = floor(10^p / 2^r) + 1, r = floor(log2(10^p)) - 125, as {g >> 63, g mod 2^63} */\n")
     out.write("static const uint64_t pow10_g[POW10_MAX - POW10_MIN + 1][2] = {\n")
-    out.write("\n".join(rows) + "\n};\n\n#endif\n")
+    out.write("\n".join(rows) + "\n};\n\n")
+    out.write(f"#define CACHE_MIN ({CACHE_MIN})\n#define CACHE_MAX {CACHE_MAX}\n\n")
+    out.write("/* phi(k) = ceil(10^k / 2^s), s = floor(log2(10^k)) - 127, as {phi >> 64, phi mod 2^64} */\n")
+    out.write("static const uint64_t pow10_phi[CACHE_MAX - CACHE_MIN + 1][2] = {\n")
+    cache = [
+        f"    {{0x{v >> 64:016x}, 0x{v & (2**64 - 1):016x}}}, /* {k} */"
+        for k in range(CACHE_MIN, CACHE_MAX + 1)
+        for v in [phi(k)]
+    ]
+    out.write("\n".join(cache) + "\n};\n\n#endif\n")
 
 
 if __name__ == "__main__":

@@ -43,7 +43,7 @@ int number_decimal(uint64_t w, int64_t q, uint64_t *bits);
 int number_parse(const char *p, const char *end, double *out);
 
 /*
- * The shortest decimal that reads back as a (finite, > 0): its digits D, without trailing
+ * The shortest decimal that reads back as a (finite, > 0): its digits D, maybe followed by
  * zeros, and exponent, a ~ D * 10^*exp10; of several shortest, the nearest to a (ties to an
  * even last digit).  These are the digits of Python's repr().
  */
