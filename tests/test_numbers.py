@@ -123,6 +123,14 @@ def test_every_binary_exponent(rng):
     check_writes_repr(values)
 
 
+def test_small_and_full_significands_at_every_exponent():
+    """c 2^q for the smallest and the largest significands c at every binary exponent q: where
+    the interval's ends and middle fall exactly on decimals (integers, halves, small multiples of
+    powers of two), the cases the shortest writer settles by exact tests rather than its product."""
+    values = [math.ldexp(c, q) for q in range(-1074, 972) for c in (*range(1, 41), *range(2**53 - 40, 2**53))]
+    check_writes_repr([v for v in values if 0 < v < math.inf])
+
+
 def test_subnormals(rng):
     smallest = [from_bits(b) for b in range(1, 20_000)]
     check_writes_repr(smallest + [from_bits(int(b)) for b in rng.integers(1, 2**52, 20_000)])
