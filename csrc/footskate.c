@@ -1258,3 +1258,48 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
     free(lift_by);
     return MT_OK;
 }
+
+/* ---------------------------------------------------------------- the channels */
+
+int mt_footskate_write(size_t legs, size_t frames, size_t channels, const double *values, const double *angles,
+                       const double *solved, const long long *columns, double angle_scale, const double *root,
+                       const long long *root_columns, double *out)
+{
+    if (legs > 2 || !columns || !root_columns || !(angle_scale != 0 && isfinite(angle_scale)))
+        return MT_EINVAL;
+    /* the slots written, as (leg, slot) and column: each column once */
+    size_t slot[24], column[27], count = 0;
+    for (size_t i = 0; i < 12 * legs; i++) {
+        if (columns[i] < -1 || columns[i] >= (long long)channels)
+            return MT_EINVAL;
+        if (columns[i] >= 0)
+            slot[count] = i, column[count++] = (size_t)columns[i];
+    }
+    for (int e = 0; e < 3; e++) {
+        if (root_columns[e] < 0 || root_columns[e] >= (long long)channels)
+            return MT_EINVAL;
+        column[count + (size_t)e] = (size_t)root_columns[e];
+    }
+    for (size_t a = 0; a < count + 3; a++)
+        for (size_t b = 0; b < a; b++)
+            if (column[a] == column[b])
+                return MT_EINVAL;
+    if (frames == 0)
+        return MT_OK;
+    if (!values || !out || (count > 0 && (!angles || !solved)) || !root)
+        return MT_EINVAL;
+    for (size_t t = 0; t < frames; t++) {
+        const double *in = values + t * channels;
+        double *row = out + t * channels;
+        memcpy(row, in, channels * sizeof *row);
+        for (size_t k = 0; k < count; k++) {
+            const size_t at = ((slot[k] / 12) * frames + t) * 12 + slot[k] % 12;
+            if (solved[at] != angles[at])
+                row[column[k]] = solved[at] / angle_scale;
+        }
+        for (int e = 0; e < 3; e++)
+            if (root[3 * t + e] != 0)
+                row[column[count + (size_t)e]] = in[column[count + (size_t)e]] + root[3 * t + e];
+    }
+    return MT_OK;
+}

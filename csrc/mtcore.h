@@ -616,6 +616,21 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
                        const double *goal, const double *turn, const double *weight, const double *knee,
                        const double *root, const double *clearance, const struct mt_footskate *opt,
                        double *out);
+
+/*
+ * The cleanup written back to the channels of a motion (values, out: frames
+ * x channels; out may not alias values): out is values but where a leg's
+ * solved angle differs from its input angle (angles, solved: legs x frames x
+ * 12, as mt_footskate_solve takes and gives them), written to its column as
+ * solved / angle_scale (columns: legs x 12, the column of each slot or -1
+ * for none), and in the root's translation columns (root_columns, 3), to
+ * which root (frames x 3) is added where it is not 0 (so that a -0.0 stays).
+ * Every other value is copied bit for bit.  The columns given must be
+ * distinct and below channels, else MT_EINVAL.
+ */
+int mt_footskate_write(size_t legs, size_t frames, size_t channels, const double *values, const double *angles,
+                       const double *solved, const long long *columns, double angle_scale, const double *root,
+                       const long long *root_columns, double *out);
 /*
  * Retargeting (retarget.c): a motion of a source skeleton as the rotation
  * channels of a target skeleton.

@@ -40,6 +40,7 @@ __all__ = [
     "leg_points",
     "plan_leg",
     "solve_leg",
+    "write_channels",
 ]
 
 POINTS = ("knee", "ankle", "ball", "heel", "tip")
@@ -170,6 +171,26 @@ class LegPlan:
     knee: np.ndarray
 
 
+def _plan_shapes(frames: int) -> dict[str, tuple[int, ...]]:
+    return {"enforced": (frames, 2, 3), "goal": (frames, 3), "turn": (frames, 3), "weight": (frames,),
+            "reach": (frames,), "knee": (4,)}  # fmt: skip
+
+
+def _new_plans(legs: int, frames: int) -> tuple[dict[str, np.ndarray], list[LegPlan]]:
+    """Plans of ``legs`` legs whose fields are views of arrays over the legs (returned by name), so
+    that the phase after them takes the legs' arrays without stacking copies."""
+    fields = {name: np.empty((legs, *shape)) for name, shape in _plan_shapes(frames).items()}
+    return fields, [LegPlan(**{name: a[i] for name, a in fields.items()}) for i in range(legs)]
+
+
+def _output(a, name: str, shape: tuple[int, ...]) -> None:
+    """Check an output array given: float64, C-contiguous, writeable, of the shape the kernel fills."""
+    if not (isinstance(a, np.ndarray) and a.dtype == np.float64 and a.flags.c_contiguous and a.flags.writeable):
+        raise ValueError(f"{name} must be a writeable C-contiguous float64 array")
+    if a.shape != shape:
+        raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
+
+
 def _leg_struct(chains: tuple[LegChain, ...]):
     legs = ffi.new("struct mt_leg[]", max(len(chains), 1))
     for leg, chain in zip(legs, chains):
@@ -247,7 +268,9 @@ def _points(points, frames: int) -> np.ndarray:
     return _doubles(points, "points", (frames, 5, 3))
 
 
-def plan_leg(chain, angles, points, planted, targets, clearance, options: CleanupOptions) -> LegPlan:
+def plan_leg(
+    chain, angles, points, planted, targets, clearance, options: CleanupOptions, *, out: LegPlan | None = None
+) -> LegPlan:
     """Phases 1 and 2 for one leg (``mt_footskate_plan``), of its angles (frames, 4, 3) and
     points (frames, 5, 3) as :func:`leg_points` gives them.
 
@@ -261,7 +284,8 @@ def plan_leg(chain, angles, points, planted, targets, clearance, options: Cleanu
     goal rotation is the turn times its rotation now), each frame's blend
     weight (1 constrained, 0 untouched), the knee's reach (the longest
     hip-to-ankle distance the root must keep it within) and the knee's hinge
-    axis in the thigh's frame with the side it bends to, (4,).
+    axis in the thigh's frame with the side it bends to, (4,).  ``out``: a plan to write into
+    (C-contiguous float64 arrays of those shapes), e.g. views of arrays of both legs.
     """
     if not isinstance(chain, LegChain):
         raise TypeError(f"chain must be a LegChain, got {type(chain).__name__}")
@@ -274,14 +298,9 @@ def plan_leg(chain, angles, points, planted, targets, clearance, options: Cleanu
     targets = _doubles(targets, "targets", (frames, 2, 3))
     if not np.isfinite(targets[planted.astype(bool)]).all():
         raise ValueError("targets must be finite where planted")
-    plan = LegPlan(
-        np.empty((frames, 2, 3)),
-        np.empty((frames, 3)),
-        np.empty((frames, 3)),
-        np.empty(frames),
-        np.empty(frames),
-        np.empty(4),
-    )
+    plan = _new_plans(1, frames)[1][0] if out is None else out
+    for name, shape in _plan_shapes(frames).items():
+        _output(getattr(plan, name), f"out.{name}", shape)
     check(
         lib.mt_footskate_plan(
             _leg_struct((chain,)),
@@ -333,11 +352,23 @@ def adjust_root(hips, goals, reaches, weights, options: CleanupOptions) -> np.nd
 
 
 def solve_leg(
-    chain, hips, parents, angles, points, planted, plan: LegPlan, root, clearance, options: CleanupOptions
+    chain,
+    hips,
+    parents,
+    angles,
+    points,
+    planted,
+    plan: LegPlan,
+    root,
+    clearance,
+    options: CleanupOptions,
+    *,
+    out: np.ndarray | None = None,
 ) -> np.ndarray:
     """Phases 4 and 5 for one leg (``mt_footskate_solve``): the new angles (frames, 4, 3),
     the input's bit for bit in frames that need no change.  ``points`` as for :func:`plan_leg`;
-    ``root`` (frames, 3) is the root's translation from :func:`adjust_root`."""
+    ``root`` (frames, 3) is the root's translation from :func:`adjust_root`; ``out``: an array to
+    write them into (C-contiguous float64)."""
     hips, parents, angles, frames = _leg_frames(chain, hips, parents, angles)
     points = _points(points, frames)
     planted = _planted(planted, frames)
@@ -346,7 +377,9 @@ def solve_leg(
     turn = _doubles(plan.turn, "plan.turn", (frames, 3))
     weight = _doubles(plan.weight, "plan.weight", (frames,))
     knee = _doubles(plan.knee, "plan.knee", (4,))
-    out = np.empty_like(angles)
+    if out is None:
+        out = np.empty_like(angles)
+    _output(out, "out", angles.shape)
     check(
         lib.mt_footskate_solve(
             _leg_struct((chain,)),
@@ -398,25 +431,84 @@ def cleanup(
     chains = tuple(chains)
     if len(chains) not in (1, 2):
         raise ValueError(f"cleanup takes one or two legs, got {len(chains)}")
-    threads = thread_count(workers, len(hips[0]) >= _PARALLEL_MIN_FRAMES if len(hips) else False)
+    hips = np.ascontiguousarray(hips, dtype=np.float64)
+    if hips.ndim != 3 or hips.shape[0] != len(chains) or hips.shape[2] != 3:
+        raise ValueError(f"hips must have shape ({len(chains)}, frames, 3), got {hips.shape}")
+    frames = hips.shape[1]
+    threads = thread_count(workers, frames >= _PARALLEL_MIN_FRAMES)
 
     def each_leg(task):
         calls = [lambda i=i: task(i) for i in range(len(chains))]
         return run_all(calls) if threads > 1 else [call() for call in calls]
 
-    plans = each_leg(lambda i: plan_leg(chains[i], angles[i], points[i], planted[i], targets[i], clearance[i], options))
-    root = adjust_root(
-        hips,
-        np.stack([p.goal for p in plans]),
-        np.stack([p.reach for p in plans]),
-        np.stack([p.weight for p in plans]),
-        options,
+    fields, plans = _new_plans(len(chains), frames)
+    each_leg(
+        lambda i: plan_leg(chains[i], angles[i], points[i], planted[i], targets[i], clearance[i], options, out=plans[i])
     )
-    out = np.stack(
-        each_leg(
-            lambda i: solve_leg(
-                chains[i], hips[i], parents[i], angles[i], points[i], planted[i], plans[i], root, clearance[i], options
-            )
+    root = adjust_root(hips, fields["goal"], fields["reach"], fields["weight"], options)
+    out = np.empty((len(chains), frames, 4, 3))
+    each_leg(
+        lambda i: solve_leg(
+            chains[i],
+            hips[i],
+            parents[i],
+            angles[i],
+            points[i],
+            planted[i],
+            plans[i],
+            root,
+            clearance[i],
+            options,
+            out=out[i],
         )
     )
-    return out, root, np.stack([p.enforced for p in plans])
+    return out, root, fields["enforced"]
+
+
+def write_channels(values, angles, solved, columns, angle_scale: float, root, root_columns) -> np.ndarray:
+    """A cleanup written back to a motion's channels (``mt_footskate_write``): a new (frames,
+    channels) array, ``values`` but where a leg's solved angle (``solved``, (legs, frames, 4, 3)
+    as :func:`cleanup` gives them) differs from its input angle (``angles``, the same shape),
+    written to its column as solved / ``angle_scale`` (``columns`` (legs, 4, 3): the column of each
+    angle, -1 for none), and in the root's translation columns ``root_columns`` (3,), to which
+    ``root`` (frames, 3) is added where it is not 0.  Every other value is the input's, bit for
+    bit.  The columns must be distinct columns of values."""
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    if values.ndim != 2:
+        raise ValueError(f"values must have shape (frames, channels), got {values.shape}")
+    frames, width = values.shape
+    solved = np.ascontiguousarray(solved, dtype=np.float64)
+    if solved.ndim != 4 or solved.shape[0] not in (1, 2) or solved.shape[1:] != (frames, 4, 3):
+        raise ValueError(f"solved must have shape (1 or 2 legs, {frames}, 4, 3), got {solved.shape}")
+    legs = solved.shape[0]
+    angles = _doubles(angles, "angles", solved.shape)
+    root = _doubles(root, "root", (frames, 3))
+    cols = np.ascontiguousarray(columns, dtype=np.int64)
+    where = np.ascontiguousarray(root_columns, dtype=np.int64)
+    if cols.shape != (legs, 4, 3) or where.shape != (3,):
+        raise ValueError(
+            f"columns must have shape ({legs}, 4, 3) and root_columns (3,), got {cols.shape}, {where.shape}"
+        )
+    used = np.concatenate([cols[cols >= 0], where])
+    if (cols < -1).any() or (where < 0).any() or (used >= width).any() or len(np.unique(used)) < len(used):
+        raise ValueError(f"columns and root_columns must be distinct columns of the {width} channels (-1: none)")
+    if not (math.isfinite(angle_scale) and angle_scale != 0):
+        raise ValueError(f"angle_scale must be finite and not 0, got {angle_scale}")
+    out = np.empty_like(values)
+    check(
+        lib.mt_footskate_write(
+            legs,
+            frames,
+            width,
+            c_array(values),
+            c_array(angles),
+            c_array(solved),
+            c_array(cols, "long long[]"),
+            angle_scale,
+            c_array(root),
+            c_array(where, "long long[]"),
+            c_array(out),
+        ),
+        "mt_footskate_write",
+    )
+    return out

@@ -725,6 +725,24 @@ def slow_solve(chain, *args):
     return joint_rotations(chain, footskate.solve_leg(chain, *args))
 
 
+def write_cases(rng: np.random.Generator) -> list[tuple]:
+    """Motions of one or two legs, some angles solved anew (NaN among them), the root moved in some
+    frames (by -0.0 too), channels at -0.0 and the root's columns anywhere among the legs'."""
+    out = []
+    for legs, frames, width in ((1, 0, 15), (1, 1, 20), (2, 7, 31), (2, 40, 62)):
+        values = rng.normal(0, 90, (frames, width))
+        values[rng.random(values.shape) < 0.1] = -0.0
+        picked = rng.permutation(width)[: 12 * legs + 3]
+        columns = np.where(rng.random((legs, 4, 3)) < 0.7, picked[: 12 * legs].reshape(legs, 4, 3), -1)
+        scale = float(rng.choice([np.pi / 180, 1.0]))
+        angles = np.where(columns[:, None] >= 0, values[:, np.maximum(columns, 0)].transpose(1, 0, 2, 3) * scale, 0.0)
+        solved = np.where(rng.random(angles.shape) < 0.4, angles + rng.normal(0, 0.1, angles.shape), angles)
+        solved[rng.random(angles.shape) < 0.05] = np.nan
+        root = np.where(rng.random((frames, 3)) < 0.5, rng.normal(0, 1, (frames, 3)), rng.choice([0.0, -0.0]))
+        out.append((values, angles, solved, columns, scale, root, picked[12 * legs :]))
+    return out
+
+
 # --- the registry ---------------------------------------------------------------------------
 
 TWINS: dict[str, Twin] = {
@@ -819,6 +837,7 @@ TWINS: dict[str, Twin] = {
     "mt_footskate_plan": Twin(fast_plan, footskate.plan_leg, plan_cases, close(1e-9)),
     "mt_footskate_root": Twin(fs.adjust_root, footskate.adjust_root, root_cases, close(1e-9)),
     "mt_footskate_solve": Twin(fast_solve, slow_solve, solve_cases, close(1e-6)),
+    "mt_footskate_write": Twin(fs.write_channels, footskate.write_channels, write_cases, exact),
 }
 
 EXEMPT = {

@@ -1,7 +1,7 @@
 """Footskate cleanup in vectorised numpy: the slow twin of mtcore.footskate's C kernels.
 
-Same signatures and results (to rounding) as :func:`mtcore.footskate.leg_points`
-and :func:`mtcore.footskate.cleanup`; every phase is written over all frames
+Same signatures and results (to rounding) as :func:`mtcore.footskate.leg_points`,
+:func:`mtcore.footskate.cleanup` and :func:`mtcore.footskate.write_channels`; every phase is written over all frames
 at once, the plants' targets frame by frame as the method states them.
 """
 
@@ -686,3 +686,17 @@ def cleanup(chains, hips, parents, angles, points, planted, targets, clearance, 
         ]
     )
     return out, root, np.stack([p[0] for p in plans])
+
+
+def write_channels(values, angles, solved, columns, angle_scale, root, root_columns):
+    """The cleanup's angles and root written back to the channels (see mtcore.footskate.write_channels)."""
+    out = np.array(values, dtype=float)
+    for i in range(len(solved)):
+        used = np.asarray(columns[i]).reshape(12) >= 0
+        new = np.asarray(solved[i]).reshape(len(out), 12)[:, used]
+        old = np.asarray(angles[i]).reshape(len(out), 12)[:, used]
+        cols = np.asarray(columns[i]).reshape(12)[used]
+        out[:, cols] = np.where(new != old, new / angle_scale, out[:, cols])  # unchanged angles keep their bits
+    cols = list(root_columns)
+    out[:, cols] = np.where(root != 0, out[:, cols] + root, out[:, cols])  # -0.0 + 0.0 would be +0.0
+    return out
