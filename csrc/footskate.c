@@ -4,12 +4,14 @@
  *
  * A leg is four joints turning thigh, shin, foot and toes.  Per frame and leg
  * the kernels rebuild the leg from its hip point, its hip's parent rotation
- * and its channels (leg_fk), and solve it analytically; frames interact only
+ * and its channels (pose_block), and solve it analytically; frames interact only
  * through the plants' targets (phase 1, in frame order), the blending of
  * adjustments around constraints (phase 2), the root's smoothing (phase 3)
  * and the lifting of a sinking foot (phase 5).  The Python twin in
  * tests/footskate_twin.py computes the same, phase by phase, in numpy.
  */
+#include "blocks.h"
+#include "clones.h"
 #include "mtcore.h"
 
 #include <math.h>
@@ -420,32 +422,80 @@ struct leg_pose {
     double point[5][3]; /* knee, ankle, ball, heel, tip */
 };
 
-static void leg_fk(const struct mt_leg *leg, const double *hip, const double *parent, const double *angles,
-                   struct leg_pose *pose)
+/* The poses of up to BLOCK consecutive frames, each quantity an array over them (see blocks.h). */
+struct pose_block {
+    double local[4][9][BLOCK];
+    double foot[9][BLOCK];
+    double point[5][3][BLOCK];
+};
+
+/*
+ * The poses of frames 0 .. n-1 (n <= BLOCK) of hips, parents and angles
+ * (lanes past n repeat the last frame), so that the loops over frames, sin
+ * and cos included, vectorise: L = C M C^T as forward kinematics builds it
+ * (M turned from the identity, channel by channel).
+ */
+static MT_CLONES void pose_block(const struct mt_leg *leg, size_t n, const double *hips, const double *parents,
+                                 const double *angles, struct pose_block *out)
 {
-    const double(*s)[3] = leg->segment;
-    double thigh[9], shin[9], toes[9], v[3];
-    for (int j = 0; j < 4; j++)
-        local_rotation(leg, j, angles + 3 * j, pose->local[j]);
-    mat_mul(parent, pose->local[0], thigh);
-    mat_mul(thigh, pose->local[1], shin);
-    mat_mul(shin, pose->local[2], pose->foot);
-    mat_mul(pose->foot, pose->local[3], toes);
-    mat_vec(thigh, s[0], v);
+    size_t row[BLOCK];
+    for (size_t f = 0; f < BLOCK; f++)
+        row[f] = f < n ? f : n - 1;
+    for (int j = 0; j < 4; j++) {
+        double m[9][BLOCK], v[BLOCK], sn[BLOCK], cs[BLOCK];
+        for (int e = 0; e < 9; e++)
+            for (int f = 0; f < BLOCK; f++)
+                m[e][f] = identity[e];
+        for (int c = 0; c < 3 && leg->axes[j][c] >= 0; c++) {
+            for (int f = 0; f < BLOCK; f++)
+                v[f] = angles[12 * row[f] + 3 * (size_t)j + (size_t)c];
+            sincos_block(v, sn, cs);
+            rotate_left_block(m, leg->axes[j][c], sn, cs);
+        }
+        if (memcmp(leg->axis[j], identity, sizeof identity) == 0)
+            memcpy(out->local[j], m, sizeof m);
+        else
+            conjugate_block(leg->axis[j], m, out->local[j]);
+    }
+    double parent[9][BLOCK], thigh[9][BLOCK], shin[9][BLOCK], toes[9][BLOCK];
+    for (int e = 0; e < 9; e++)
+        for (int f = 0; f < BLOCK; f++)
+            parent[e][f] = parents[9 * row[f] + (size_t)e];
+    multiply_block(parent, out->local[0], thigh);
+    multiply_block(thigh, out->local[1], shin);
+    multiply_block(shin, out->local[2], out->foot);
+    multiply_block(out->foot, out->local[3], toes);
+    /* each point: the one it hangs from plus its segment turned by the rotation that turns it (the
+     * segments and points local, so that the compiler need not fear they alias) */
+    double s[5][3], p[5][3][BLOCK];
+    memcpy(s, leg->segment, sizeof s);
     for (int e = 0; e < 3; e++)
-        pose->point[0][e] = hip[e] + v[e];
-    mat_vec(shin, s[1], v);
-    for (int e = 0; e < 3; e++)
-        pose->point[1][e] = pose->point[0][e] + v[e];
-    mat_vec(pose->foot, s[2], v);
-    for (int e = 0; e < 3; e++)
-        pose->point[2][e] = pose->point[1][e] + v[e];
-    mat_vec(pose->foot, s[3], v);
-    for (int e = 0; e < 3; e++)
-        pose->point[3][e] = pose->point[1][e] + v[e];
-    mat_vec(toes, s[4], v);
-    for (int e = 0; e < 3; e++)
-        pose->point[4][e] = pose->point[2][e] + v[e];
+        for (int f = 0; f < BLOCK; f++) {
+            p[0][e][f] = hips[3 * row[f] + (size_t)e] + thigh[3 * e][f] * s[0][0] + thigh[3 * e + 1][f] * s[0][1] +
+                         thigh[3 * e + 2][f] * s[0][2];
+            p[1][e][f] = p[0][e][f] + shin[3 * e][f] * s[1][0] + shin[3 * e + 1][f] * s[1][1] +
+                         shin[3 * e + 2][f] * s[1][2];
+            p[2][e][f] = p[1][e][f] + out->foot[3 * e][f] * s[2][0] + out->foot[3 * e + 1][f] * s[2][1] +
+                         out->foot[3 * e + 2][f] * s[2][2];
+            p[3][e][f] = p[1][e][f] + out->foot[3 * e][f] * s[3][0] + out->foot[3 * e + 1][f] * s[3][1] +
+                         out->foot[3 * e + 2][f] * s[3][2];
+            p[4][e][f] = p[2][e][f] + toes[3 * e][f] * s[4][0] + toes[3 * e + 1][f] * s[4][1] +
+                         toes[3 * e + 2][f] * s[4][2];
+        }
+    memcpy(out->point, p, sizeof p);
+}
+
+/* frame f of a block */
+static void pose_at(const struct pose_block *block, size_t f, struct leg_pose *pose)
+{
+    for (int e = 0; e < 9; e++) {
+        for (int j = 0; j < 4; j++)
+            pose->local[j][e] = block->local[j][e][f];
+        pose->foot[e] = block->foot[e][f];
+    }
+    for (int k = 0; k < 5; k++)
+        for (int e = 0; e < 3; e++)
+            pose->point[k][e] = block->point[k][e][f];
 }
 
 static int check_leg(const struct mt_leg *leg)
@@ -479,13 +529,18 @@ int mt_leg_points(const struct mt_leg *legs, size_t nlegs, size_t frames, const 
         if (check_leg(legs + i) != MT_OK)
             return MT_EINVAL;
     for (size_t i = 0; i < nlegs; i++)
-        for (size_t t = 0; t < frames; t++) {
-            const size_t f = i * frames + t;
-            struct leg_pose pose;
-            leg_fk(legs + i, hips + 3 * f, parents + 9 * f, angles + 12 * f, &pose);
-            memcpy(points + 15 * f, pose.point, sizeof pose.point);
-            if (feet)
-                memcpy(feet + 9 * f, pose.foot, sizeof pose.foot);
+        for (size_t t0 = 0; t0 < frames; t0 += BLOCK) {
+            const size_t n = frames - t0 < BLOCK ? frames - t0 : BLOCK, f0 = i * frames + t0;
+            struct pose_block block;
+            pose_block(legs + i, n, hips + 3 * f0, parents + 9 * f0, angles + 12 * f0, &block);
+            for (size_t f = 0; f < n; f++) {
+                for (int k = 0; k < 5; k++)
+                    for (int e = 0; e < 3; e++)
+                        points[15 * (f0 + f) + 3 * (size_t)k + (size_t)e] = block.point[k][e][f];
+                if (feet)
+                    for (int e = 0; e < 9; e++)
+                        feet[9 * (f0 + f) + (size_t)e] = block.foot[e][f];
+            }
         }
     return MT_OK;
 }
@@ -1201,59 +1256,75 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
     double aim[3];
     for (int e = 0; e < 3; e++)
         aim[e] = leg->segment[2][e] - leg->segment[3][e]; /* heel -> ball: what a two-channel ankle keeps */
-    for (size_t t = 0; t < frames; t++) {
-        const unsigned char *now = planted + 2 * t;
-        const int some = now[HEEL] || now[BALL];
-        const double *r = root + 3 * t;
-        double *result = out + 12 * t, foot_now[9], ball_now[3];
-        memcpy(result, angles + 12 * t, 12 * sizeof *result);
-        const int todo = some || weight[t] > 0 || r[0] != 0 || r[1] != 0 || r[2] != 0 || lift_by[t] > 0;
-        if (!todo && !(height(opt, points + 15 * t + 12) < clearance[2]))
-            continue; /* untouched, toes above the floor */
-        struct leg_pose pose;
-        leg_fk(leg, hips + 3 * t, parents + 9 * t, angles + 12 * t, &pose);
-        memcpy(foot_now, pose.foot, sizeof foot_now);
-        memcpy(ball_now, pose.point[2], sizeof ball_now);
-        if (todo) {
-            double hip[3], q[9], foot_goal[9], first[3], target[3];
-            for (int e = 0; e < 3; e++) {
-                hip[e] = hips[3 * t + e] + r[e];
-                first[e] = goal[3 * t + e] + lift_by[t] * opt->up[e];
-            }
-            rotvec_exp(turn + 3 * t, q);
-            mat_mul(q, pose.foot, foot_goal);
-            struct solved solved;
-            const struct hinge h = hinge_of(leg, pose.local[1], knee);
-            two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, first, foot_goal,
-                     aim, &solved);
-            memcpy(target, first, sizeof target);
-            if (channels(leg, 2) < 3 && some) { /* the ankle cannot roll: re-aim it so that the pivot lands */
-                const double *pivot = leg->segment[now[HEEL] ? 3 : 2];
-                double want[3], got[3]; /* once: the miss after it is a few micrometres */
-                mat_vec(foot_goal, pivot, want);
-                mat_vec(solved.foot, pivot, got);
-                for (int e = 0; e < 3; e++)
-                    target[e] = first[e] + want[e] - got[e];
-                two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, target,
-                         foot_goal, aim, &solved);
-            }
-            /* what the leg could not quite reach is lifted frame by frame */
-            const double low = foot_low(leg, solved.ankle, solved.foot, clearance, opt);
-            if (!some && low < 0) {
-                for (int e = 0; e < 3; e++)
-                    target[e] -= low * opt->up[e];
-                two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, target,
-                         foot_goal, aim, &solved);
-            }
-            finish_angles(leg, angles + 12 * t, aim, &solved);
-            memcpy(result, solved.angles, sizeof solved.angles);
-            memcpy(foot_now, solved.foot, sizeof foot_now);
-            double v[3];
-            mat_vec(solved.foot, leg->segment[2], v);
-            for (int e = 0; e < 3; e++)
-                ball_now[e] = solved.ankle[e] + v[e];
+    memcpy(out, angles, 12 * frames * sizeof *out);
+    for (size_t t0 = 0; t0 < frames; t0 += BLOCK) {
+        const size_t n = frames - t0 < BLOCK ? frames - t0 : BLOCK;
+        int todo_at[BLOCK], low_toes[BLOCK], any = 0; /* frames to solve; frames with the toe tip below the floor */
+        for (size_t f = 0; f < n; f++) {
+            const size_t t = t0 + f;
+            const double *r = root + 3 * t;
+            todo_at[f] = planted[2 * t] || planted[2 * t + 1] || weight[t] > 0 || r[0] != 0 || r[1] != 0 ||
+                         r[2] != 0 || lift_by[t] > 0;
+            low_toes[f] = height(opt, points + 15 * t + 12) < clearance[2];
+            any |= todo_at[f] || low_toes[f];
         }
-        bend_toes(leg, foot_now, ball_now, pose.local[3], clearance[2], opt, result + 9);
+        if (!any)
+            continue; /* untouched, toes above the floor */
+        struct pose_block block;
+        pose_block(leg, n, hips + 3 * t0, parents + 9 * t0, angles + 12 * t0, &block);
+        for (size_t f = 0; f < n; f++) {
+            if (!todo_at[f] && !low_toes[f])
+                continue;
+            const size_t t = t0 + f;
+            const unsigned char *now = planted + 2 * t;
+            const int some = now[HEEL] || now[BALL], todo = todo_at[f];
+            const double *r = root + 3 * t;
+            double *result = out + 12 * t, foot_now[9], ball_now[3];
+            struct leg_pose pose;
+            pose_at(&block, f, &pose);
+            memcpy(foot_now, pose.foot, sizeof foot_now);
+            memcpy(ball_now, pose.point[2], sizeof ball_now);
+            if (todo) {
+                double hip[3], q[9], foot_goal[9], first[3], target[3];
+                for (int e = 0; e < 3; e++) {
+                    hip[e] = hips[3 * t + e] + r[e];
+                    first[e] = goal[3 * t + e] + lift_by[t] * opt->up[e];
+                }
+                rotvec_exp(turn + 3 * t, q);
+                mat_mul(q, pose.foot, foot_goal);
+                struct solved solved;
+                const struct hinge h = hinge_of(leg, pose.local[1], knee);
+                two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, first,
+                         foot_goal, aim, &solved);
+                memcpy(target, first, sizeof target);
+                if (channels(leg, 2) < 3 && some) { /* the ankle cannot roll: re-aim it so that the pivot lands */
+                    const double *pivot = leg->segment[now[HEEL] ? 3 : 2];
+                    double want[3], got[3]; /* once: the miss after it is a few micrometres */
+                    mat_vec(foot_goal, pivot, want);
+                    mat_vec(solved.foot, pivot, got);
+                    for (int e = 0; e < 3; e++)
+                        target[e] = first[e] + want[e] - got[e];
+                    two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, target,
+                             foot_goal, aim, &solved);
+                }
+                /* what the leg could not quite reach is lifted frame by frame */
+                const double low = foot_low(leg, solved.ankle, solved.foot, clearance, opt);
+                if (!some && low < 0) {
+                    for (int e = 0; e < 3; e++)
+                        target[e] -= low * opt->up[e];
+                    two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, target,
+                             foot_goal, aim, &solved);
+                }
+                finish_angles(leg, angles + 12 * t, aim, &solved);
+                memcpy(result, solved.angles, sizeof solved.angles);
+                memcpy(foot_now, solved.foot, sizeof foot_now);
+                double v[3];
+                mat_vec(solved.foot, leg->segment[2], v);
+                for (int e = 0; e < 3; e++)
+                    ball_now[e] = solved.ankle[e] + v[e];
+            }
+            bend_toes(leg, foot_now, ball_now, pose.local[3], clearance[2], opt, result + 9);
+        }
     }
     free(lift_by);
     return MT_OK;
