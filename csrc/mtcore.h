@@ -618,6 +618,19 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
                        double *out);
 
 /*
+ * Speeds of points over frames, in their unit per second (rate: frames per
+ * second).  points: tracks x frames x per_frame x 3, of which the points
+ * which[0 .. count-1] (< per_frame) of each frame are measured; speed
+ * (tracks x count x frames): the larger of the distances to the frames
+ * before and after, times rate (so that neither difference quotient finds
+ * the point faster); central (the same, or NULL): the length of the central
+ * difference (p[t+1] - p[t-1]) / 2, one-sided at the ends, times rate.  A
+ * single frame has speed 0; NaN in, NaN out.
+ */
+int mt_point_speeds(const double *points, size_t tracks, size_t frames, size_t per_frame, const size_t *which,
+                    size_t count, double rate, double *speed, double *central);
+
+/*
  * The cleanup written back to the channels of a motion (values, out: frames
  * x channels; out may not alias values): out is values but where a leg's
  * solved angle differs from its input angle (angles, solved: legs x frames x

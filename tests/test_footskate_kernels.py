@@ -233,6 +233,10 @@ def test_bad_arguments_raise_before_any_c_call():
         fs.cleanup([], arrays.hips, arrays.parents, arrays.angles, arrays.points, masks, masks, [], opt)
     with pytest.raises(TypeError, match="chains must be one or more LegChain"):
         fs.leg_points(["leg"], arrays.hips[:1], arrays.parents[:1], arrays.angles[:1])
+    with pytest.raises(ValueError, match="which must list points below 5"):
+        fs.point_speeds(arrays.points, [3, 5], 120.0)
+    with pytest.raises(ValueError, match=r"points must have shape \(tracks, frames, per_frame, 3\)"):
+        fs.point_speeds(arrays.points[0], [0], 120.0)
     values, solved, root = np.zeros((f, 62)), arrays.angles, np.zeros((f, 3))
     columns = np.where(arrays.columns >= 0, arrays.columns, -1)
     with pytest.raises(ValueError, match="columns and root_columns must be distinct columns of the 62 channels"):
@@ -260,6 +264,8 @@ def test_the_c_kernels_check_their_arguments_again():
     assert lib.mt_footskate_root(3, 1, buf, buf, buf, buf, opt, buf) == lib.MT_EINVAL
     opt.up = [0, 0, 0]
     assert lib.mt_footskate_root(1, 1, buf, buf, buf, buf, opt, buf) == lib.MT_EINVAL
+    assert lib.mt_point_speeds(buf, 1, 2, 5, [5], 1, 1.0, buf, ffi.NULL) == lib.MT_EINVAL
+    assert lib.mt_point_speeds(buf, 1, 2, 5, [4], 1, 1.0, ffi.NULL, ffi.NULL) == lib.MT_EINVAL
     columns = ffi.new("long long[24]", [-1] * 24)
     assert lib.mt_footskate_write(1, 1, 8, buf, buf, buf, columns, 1.0, buf, [0, 1, 2], buf) == lib.MT_OK
     columns[5] = 1  # the root's column too

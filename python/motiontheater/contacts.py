@@ -41,9 +41,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mtcore import footskate as kernels
+
 from ._io import Source, decode, encode, output, read_source
 from .errors import FormatError, UnknownNameError
-from .legs import Legs, body_scale, speeds
+from .legs import Legs, body_scale
 
 PLANT_POINTS = ("heel", "ball")
 _HEADER = "# motiontheater contacts: frames {first}..{last} at {rate:g} Hz"
@@ -331,9 +333,7 @@ def detect_contacts(
     """The footplants of a take's legs (:class:`~motiontheater.legs.LegArrays`) on its ground."""
     heel_ball = arrays.points[:, :, [3, 2]]
     heights = (ground.above(heel_ball) - ground.clearance[:, None, :2]).transpose(0, 2, 1)  # (legs, 2, frames)
-    heel_ball = heel_ball.transpose(0, 2, 1, 3)
-    speed = speeds(heel_ball, frame_rate)
-    central = speeds(heel_ball, frame_rate, central=True)
+    speed, central = kernels.point_speeds(arrays.points, [3, 2], frame_rate, central=True)
     scale = body_scale(arrays.legs, meters_per_unit)
     masks = detect_masks(heights, speed, central, frame_rate, meters_per_unit, scale, thresholds).transpose(0, 2, 1)
     return Contacts.from_masks(masks, arrays.legs, first_frame, frame_rate)

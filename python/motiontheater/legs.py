@@ -47,6 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mtcore import footskate as kernels
 from mtcore.kinematics import forward_kinematics
 
 from .errors import UnknownNameError
@@ -432,8 +433,6 @@ def leg_arrays(
     the legs' channels as angles, and the legs' points by ``leg_points``.  Heels the rest pose
     could not give are derived from this take (see the module docstring), along ``up``
     (:func:`choose_up`), with thresholds in metres by ``meters_per_unit`` (default the skeleton's)."""
-    from mtcore import footskate as kernels
-
     skeleton = motion.skeleton
     tree = skeleton.tree
     hips, parents = _upper_kinematics(motion.values, tree, legs)
@@ -520,19 +519,12 @@ def speeds(p: np.ndarray, frame_rate: float, *, central: bool = False) -> np.nda
     """Speed (..., frames) of points (..., frames, 3), in their unit per second: the larger of the
     distances to the frames before and after (one frame: 0), so that neither difference quotient
     finds it faster; with ``central``, the central difference (numpy.gradient's: one-sided at the
-    ends)."""
-    if p.shape[-2] < 2:
-        return np.zeros(p.shape[:-1])
-    d = np.gradient(p, axis=-2) if central else np.diff(p, axis=-2)
-    # the norm written out: numpy's norm reduces over an axis of three, several times slower
-    step = np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1] + d[..., 2] * d[..., 2])
-    step *= frame_rate
-    if central:
-        return step
-    out = np.empty(p.shape[:-1])
-    out[..., 0], out[..., -1] = step[..., 0], step[..., -1]
-    np.maximum(step[..., 1:], step[..., :-1], out=out[..., 1:-1])
-    return out
+    ends).  In C: :func:`mtcore.footskate.point_speeds`, which measures chosen points of the legs'
+    (legs, frames, 5, 3) in place."""
+    p = np.asarray(p, dtype=float)
+    tracks = p.reshape(-1, p.shape[-2], 1, 3)
+    speed = kernels.point_speeds(tracks, [0], frame_rate, central=central)
+    return (speed[1] if central else speed).reshape(p.shape[:-1])
 
 
 @dataclass(frozen=True, eq=False)
@@ -595,7 +587,7 @@ def fit_ground(
     scale = body_scale(legs, meters_per_unit)
     contact = arrays.points[:, :, [3, 2, 4]]  # heel, ball, tip
     has_tip = legs.points[:, 4] >= 0
-    speed = speeds(contact.transpose(0, 2, 1, 3), frame_rate).transpose(0, 2, 1) * meters_per_unit
+    speed = kernels.point_speeds(arrays.points, [3, 2, 4], frame_rate).transpose(0, 2, 1) * meters_per_unit
     vertical = along(contact, up_vector)
     resting = speed < _REST_SPEED * scale
     needed = max(3, round(0.05 * frame_rate))

@@ -39,6 +39,7 @@ __all__ = [
     "cleanup",
     "leg_points",
     "plan_leg",
+    "point_speeds",
     "solve_leg",
     "write_channels",
 ]
@@ -512,3 +513,43 @@ def write_channels(values, angles, solved, columns, angle_scale: float, root, ro
         "mt_footskate_write",
     )
     return out
+
+
+def point_speeds(points, which, frame_rate: float, *, central: bool = False):
+    """Speeds of points over frames, in their unit per second (``mt_point_speeds``).
+
+    ``points`` (tracks, frames, per_frame, 3), of which the points ``which``
+    (indices below per_frame) of each frame are measured.  Returns (tracks,
+    len(which), frames): the larger of the distances to the frames before and
+    after, times ``frame_rate``, so that neither difference quotient finds a
+    point faster (a single frame: 0); with ``central``, also the length of
+    the central difference (numpy.gradient's: one-sided at the ends) times
+    ``frame_rate``.  NaN in, NaN out.
+    """
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    if points.ndim != 4 or points.shape[3] != 3:
+        raise ValueError(f"points must have shape (tracks, frames, per_frame, 3), got {points.shape}")
+    tracks, frames, per_frame = points.shape[:3]
+    wanted = np.asarray(which)
+    if wanted.ndim != 1 or wanted.dtype.kind not in "iu" or not ((wanted >= 0) & (wanted < per_frame)).all():
+        raise ValueError(f"which must list points below {per_frame}, got {which!r}")
+    picked = np.ascontiguousarray(wanted, dtype=np.uintp)
+    if not math.isfinite(frame_rate):
+        raise ValueError(f"frame_rate must be finite, got {frame_rate}")
+    speed = np.empty((tracks, len(picked), frames))
+    middle = np.empty_like(speed) if central else None
+    check(
+        lib.mt_point_speeds(
+            c_array(points),
+            tracks,
+            frames,
+            per_frame,
+            c_array(picked, "size_t[]"),
+            len(picked),
+            float(frame_rate),
+            c_array(speed),
+            c_array(middle),
+        ),
+        "mt_point_speeds",
+    )
+    return (speed, middle) if central else speed

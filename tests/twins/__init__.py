@@ -743,6 +743,17 @@ def write_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
+def speed_cases(rng: np.random.Generator) -> list[tuple]:
+    """Tracks of points of 0 to 40 frames, some NaN, measured one or several points of a frame at a time."""
+    out = []
+    for tracks, frames, per_frame in ((1, 0, 1), (2, 1, 5), (1, 2, 1), (2, 3, 5), (3, 40, 5)):
+        points = rng.normal(0, 1, (tracks, frames, per_frame, 3)).cumsum(axis=1)
+        points[rng.random(points.shape) < 0.02] = np.nan
+        which = [0] if per_frame == 1 else [3, 2, 4]
+        out += [(points, which, float(rng.choice([30.0, 120.0])), central) for central in (False, True)]
+    return out
+
+
 # --- the registry ---------------------------------------------------------------------------
 
 TWINS: dict[str, Twin] = {
@@ -838,6 +849,12 @@ TWINS: dict[str, Twin] = {
     "mt_footskate_root": Twin(fs.adjust_root, footskate.adjust_root, root_cases, close(1e-9)),
     "mt_footskate_solve": Twin(fast_solve, slow_solve, solve_cases, close(1e-6)),
     "mt_footskate_write": Twin(fs.write_channels, footskate.write_channels, write_cases, exact),
+    "mt_point_speeds": Twin(
+        lambda p, which, rate, central: fs.point_speeds(p, which, rate, central=central),
+        lambda p, which, rate, central: footskate.point_speeds(p, which, rate, central=central),
+        speed_cases,
+        exact,
+    ),
 }
 
 EXEMPT = {

@@ -1,7 +1,8 @@
 """Footskate cleanup in vectorised numpy: the slow twin of mtcore.footskate's C kernels.
 
 Same signatures and results (to rounding) as :func:`mtcore.footskate.leg_points`,
-:func:`mtcore.footskate.cleanup` and :func:`mtcore.footskate.write_channels`; every phase is written over all frames
+:func:`mtcore.footskate.cleanup`, :func:`mtcore.footskate.write_channels` and
+:func:`mtcore.footskate.point_speeds`; every phase is written over all frames
 at once, the plants' targets frame by frame as the method states them.
 """
 
@@ -700,3 +701,20 @@ def write_channels(values, angles, solved, columns, angle_scale, root, root_colu
     cols = list(root_columns)
     out[:, cols] = np.where(root != 0, out[:, cols] + root, out[:, cols])  # -0.0 + 0.0 would be +0.0
     return out
+
+
+def point_speeds(points, which, frame_rate, *, central=False):
+    """Speeds of the points ``which`` of each frame (see mtcore.footskate.point_speeds), in numpy."""
+    p = np.asarray(points, dtype=float)[:, :, list(which)].transpose(0, 2, 1, 3)  # (tracks, count, frames, 3)
+    if p.shape[2] < 2:
+        zeros = np.zeros(p.shape[:-1])
+        return (zeros, zeros.copy()) if central else zeros
+    d = np.diff(p, axis=2)
+    step = np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1] + d[..., 2] * d[..., 2]) * frame_rate
+    speed = np.empty(p.shape[:-1])
+    speed[..., 0], speed[..., -1] = step[..., 0], step[..., -1]
+    np.maximum(step[..., 1:], step[..., :-1], out=speed[..., 1:-1])
+    if not central:
+        return speed
+    g = np.gradient(p, axis=2)
+    return speed, np.sqrt(g[..., 0] * g[..., 0] + g[..., 1] * g[..., 1] + g[..., 2] * g[..., 2]) * frame_rate
