@@ -234,8 +234,10 @@ def _check_range(comment: str, first_frame: int, frames: int) -> None:
 
 def runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Starts and ends (exclusive) of the runs of True in a 1-d mask."""
-    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
-    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    padded = np.zeros(len(mask) + 2, bool)
+    padded[1:-1] = mask
+    edges = np.flatnonzero(padded[1:] != padded[:-1])  # where runs start and end, in turn
+    return edges[::2], edges[1::2]
 
 
 @dataclass(frozen=True)
@@ -299,27 +301,32 @@ def detect_masks(
         firm_count = np.add.reduceat(f.astype(np.int64), starts)
         starts, ends = starts[firm_count > 0], ends[firm_count > 0]
         if len(starts) > 1:  # merge short gaps that the point crosses slowly
-            fast = np.r_[0, np.cumsum(~moving_slowly)]
+            fast = np.concatenate(([0], np.cumsum(~moving_slowly)))
             join = (starts[1:] - ends[:-1] <= gap) & (fast[starts[1:]] == fast[ends[:-1]])
-            starts, ends = starts[np.r_[True, ~join]], ends[np.r_[~join, True]]
+            starts, ends = starts[np.concatenate(([True], ~join))], ends[np.concatenate((~join, [True]))]
         if not len(starts):
             continue
         # cut the ends of each plant where the point has risen from it (heel strike, push-off), sure frames kept
-        bounds = np.ravel(np.column_stack([starts, ends]))
-        bounds = bounds[:-1] if bounds[-1] == n else bounds
+        bounds = _bounds(starts, ends, n)
         plant = np.searchsorted(starts, index, side="right") - 1
         inside = (plant >= 0) & (index < ends[np.maximum(plant, 0)])
         lowest = np.minimum.reduceat(h, bounds)[::2]
         still = inside & ((h <= lowest[np.maximum(plant, 0)] + rise) | certain)
         first = np.minimum.reduceat(np.where(still, index, n), bounds)[::2]
         last = np.maximum.reduceat(np.where(still, index, -1), bounds)[::2] + 1
-        held = np.r_[0, np.cumsum(certain)]
+        held = np.concatenate(([0], np.cumsum(certain)))
         keep = (last > first) & ((last - first >= shortest) | (held[np.maximum(last, first)] > held[first]))
-        edges = np.zeros(n + 1, np.int64)
-        np.add.at(edges, first[keep], 1)
-        np.add.at(edges, last[keep], -1)
+        edges = np.bincount(first[keep], minlength=n + 1) - np.bincount(last[keep], minlength=n + 1)
         out[r] = np.cumsum(edges[:-1]) > 0
     return out.reshape(heights.shape)
+
+
+def _bounds(starts: np.ndarray, ends: np.ndarray, n: int) -> np.ndarray:
+    """Indices for ufunc.reduceat over runs [start, end) of n items: every run's start and end in
+    turn (the even pieces are the runs), without an end at n, where reduceat stops anyway."""
+    bounds = np.empty(2 * len(starts), np.int64)
+    bounds[0::2], bounds[1::2] = starts, ends
+    return bounds[:-1] if len(bounds) and bounds[-1] == n else bounds
 
 
 def detect_contacts(
@@ -349,9 +356,7 @@ def plant_targets(masks: np.ndarray, points: np.ndarray) -> np.ndarray:
             starts, ends = runs(masks[i, :, k])
             if not len(starts):
                 continue
-            bounds = np.ravel(np.column_stack([starts, ends]))
-            if bounds[-1] == frames:  # reduceat sums the last piece to the end
-                bounds = bounds[:-1]
+            bounds = _bounds(starts, ends, frames)
             means = np.add.reduceat(points[i, :, column], bounds, axis=0)[::2] / (ends - starts)[:, None]
             out[i, masks[i, :, k], k] = np.repeat(means, ends - starts, axis=0)  # planted frames, in order
     return out

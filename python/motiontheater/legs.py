@@ -124,14 +124,24 @@ class Legs:
         return float(np.mean(np.linalg.norm(self.segments[:, :2], axis=-1).sum(axis=1)))
 
 
+_SEPARATORS = re.compile(r"[\s_.\-]")
+
+
 def _normal(name: str) -> str:
     """A joint name without namespace, case or separators: 'mixamorig:Left_Up-Leg' -> 'leftupleg'."""
-    return re.sub(r"[\s_.\-]", "", name.rsplit(":", 1)[-1]).lower()
+    return _SEPARATORS.sub("", name.rsplit(":", 1)[-1]).lower()
 
 
-def _side_part(name: str, side: str, parts: tuple[str, ...]) -> bool:
-    word = _normal(name)
-    return any(word in (s + p, p + s) for s in _SIDE_WORDS[side] for p in parts)
+# the names of a side's part: the side word before or after the part's ("lfoot", "footleft")
+_SIDE_PART_NAMES = {
+    (side, part): frozenset(w for s in _SIDE_WORDS[side] for p in words for w in (s + p, p + s))
+    for side in SIDES
+    for part, words in _PARTS.items()
+}
+
+
+def _side_part(name: str, side: str, part: str) -> bool:
+    return _normal(name) in _SIDE_PART_NAMES[side, part]
 
 
 def _turns(skeleton: Skeleton, name: str) -> bool:
@@ -165,7 +175,7 @@ def find_legs(skeleton: Skeleton, names: Sequence[str] | None = None) -> tuple[L
 
 
 def _find_leg(skeleton: Skeleton, side: str) -> Leg:
-    named = [b.name for b in skeleton.bones if not b.end_site and _side_part(b.name, side, _PARTS["ankle"])]
+    named = [b.name for b in skeleton.bones if not b.end_site and _side_part(b.name, side, "ankle")]
     below: list[str | None] = list(named)
     if skeleton.convention != "bvh":
         # an ASF bone named after the point it ends at ("LeftFoot": knee to ankle) is a shin: its foot is below
@@ -585,10 +595,10 @@ def fit_ground(
         raise ValueError(f"a take of {frames} frame(s) has no resting feet to find the floor from: give more frames")
     up_vector = choose_up(arrays, up)
     scale = body_scale(legs, meters_per_unit)
-    contact = arrays.points[:, :, [3, 2, 4]]  # heel, ball, tip
+    contact = [3, 2, 4]  # heel, ball, tip among the legs' points
     has_tip = legs.points[:, 4] >= 0
-    speed = kernels.point_speeds(arrays.points, [3, 2, 4], frame_rate).transpose(0, 2, 1) * meters_per_unit
-    vertical = along(contact, up_vector)
+    speed = kernels.point_speeds(arrays.points, contact, frame_rate).transpose(0, 2, 1) * meters_per_unit
+    vertical = along(arrays.points, up_vector)[:, :, contact]
     resting = speed < _REST_SPEED * scale
     needed = max(3, round(0.05 * frame_rate))
     for i in range(len(legs)):  # a point that never rests (a run on the balls): its slowest low frames
@@ -619,7 +629,7 @@ def fit_ground(
         where = where[:: -(-len(where) // _FIT_SAMPLES)]
     point_id = (where // 3 // frames) * 3 + where % 3
     ids, point = np.unique(point_id, return_inverse=True)
-    flat = contact.reshape(-1, 3)[where]
+    flat = arrays.points.reshape(-1, 5, 3)[where // 3, np.take(contact, where % 3)]
     x, y = flat[:, horizontal_axes[0]], flat[:, horizontal_axes[1]]
     z = vertical.reshape(-1)[where]
     centre = np.array([x.mean(), y.mean()])
@@ -628,15 +638,16 @@ def fit_ground(
     prior = np.sqrt(len(z)) * _SLOPE_PRIOR * scale / meters_per_unit
     keep = np.ones(len(z), bool)
     n = len(ids)
+    xx, yy, xy, xz, yz = x * x, y * y, x * y, x * z, y * z  # the weights are 0 or 1: w x x is w (x x)
     for _ in range(3):  # z = gx x + gy y + c[point]: least squares by its normal equations, summed by point
         w = keep.astype(float)
         a = np.zeros((2 + n, 2 + n))
-        a[0, 0], a[1, 1] = (w * x * x).sum() + prior**2, (w * y * y).sum() + prior**2
-        a[0, 1] = a[1, 0] = (w * x * y).sum()
+        a[0, 0], a[1, 1] = (w * xx).sum() + prior**2, (w * yy).sum() + prior**2
+        a[0, 1] = a[1, 0] = (w * xy).sum()
         a[0, 2:] = a[2:, 0] = np.bincount(point, w * x, n)
         a[1, 2:] = a[2:, 1] = np.bincount(point, w * y, n)
         a[2:, 2:] = np.diag(np.bincount(point, w, n))
-        b = np.r_[(w * x * z).sum(), (w * y * z).sum(), np.bincount(point, w * z, n)]
+        b = np.concatenate(([(w * xz).sum(), (w * yz).sum()], np.bincount(point, w * z, n)))
         coef = np.linalg.solve(a, b)
         keep = z - (coef[0] * x + coef[1] * y + coef[2:][point]) < band
     gradient = coef[:2]

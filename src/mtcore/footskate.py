@@ -77,14 +77,13 @@ class LegChain:
                 raise ValueError(f"LegChain.{name} must have shape {shape}, got {a.shape}")
         if not (np.isfinite(axis).all() and np.isfinite(segments).all()):
             raise ValueError("LegChain axis and segments must be finite")
-        for j, joint in enumerate(JOINTS):
-            row = axes[j]
+        for j, (joint, row) in enumerate(zip(JOINTS, axes.tolist())):  # twelve numbers: checked as a list
             count = self.count(j, axes)
-            if (row[count:] != -1).any() or ((row[:count] < 0) | (row[:count] > 2)).any():
+            used = row[:count]
+            if any(a != -1 for a in row[count:]) or any(not 0 <= a <= 2 for a in used):
                 raise ValueError(
-                    f"LegChain.axes[{j}] ({joint}) must list axes 0-2 then -1 for unused entries, got {row.tolist()}"
+                    f"LegChain.axes[{j}] ({joint}) must list axes 0-2 then -1 for unused entries, got {row}"
                 )
-            used = list(row[:count])
             if (count < 3 and len(set(used)) < count) or (count == 3 and (used[0] == used[1] or used[1] == used[2])):
                 raise ValueError(f"LegChain.axes[{j}] ({joint}) repeats an axis: {used}")
         if self.count(0, axes) == 0 or self.count(1, axes) == 0:
