@@ -338,8 +338,9 @@ def detect_contacts(
     thresholds: Thresholds = DEFAULT,
 ) -> Contacts:
     """The footplants of a take's legs (:class:`~motiontheater.legs.LegArrays`) on its ground."""
-    heel_ball = arrays.points[:, :, [3, 2]]
-    heights = (ground.above(heel_ball) - ground.clearance[:, None, :2]).transpose(0, 2, 1)  # (legs, 2, frames)
+    heights = ground.above(arrays.points[:, :, 2:4])[:, :, ::-1]  # ball, heel: heel, ball
+    heights -= ground.clearance[:, None, :2]
+    heights = heights.transpose(0, 2, 1)  # (legs, 2, frames)
     speed, central = kernels.point_speeds(arrays.points, [3, 2], frame_rate, central=True)
     scale = body_scale(arrays.legs, meters_per_unit)
     masks = detect_masks(heights, speed, central, frame_rate, meters_per_unit, scale, thresholds).transpose(0, 2, 1)
