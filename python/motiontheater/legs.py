@@ -329,6 +329,9 @@ def along(p: np.ndarray, v: np.ndarray) -> np.ndarray:
     """p . v for points (..., 3) and a vector v, the dot product written out (matmul with a vector
     takes a slow path for stacked points), summed in place: on an hour of frames a temporary per
     term is as much fresh memory again."""
+    p = np.asarray(p)
+    if p.ndim < 2:  # one point: a number
+        return p[0] * v[0] + p[1] * v[1] + p[2] * v[2]
     out = np.multiply(p[..., 0], v[0])
     term = np.multiply(p[..., 1], v[1])
     out += term
