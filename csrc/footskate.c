@@ -1728,3 +1728,88 @@ int mt_point_speeds(const double *points, size_t tracks, size_t frames, size_t p
         }
     return MT_OK;
 }
+
+/* ---------------------------------------------------------------- footplants */
+
+struct plant_row {
+    const double *h, *speed, *central;
+    const struct mt_plant_thresholds *th;
+    unsigned char *mask;
+};
+
+static int sure_at(const struct plant_row *r, size_t t)
+{
+    return r->h[t] < r->th->sure_height && r->central[t] < r->th->sure_speed;
+}
+
+static int close_at(const struct plant_row *r, size_t t)
+{
+    return (r->h[t] < r->th->height && r->speed[t] < r->th->speed) || sure_at(r, t);
+}
+
+static int firm_at(const struct plant_row *r, size_t t)
+{
+    return (r->h[t] < r->th->firm_height && r->speed[t] < r->th->firm_speed) || sure_at(r, t);
+}
+
+/* plant [s, e): cut back to its still frames, kept if long enough or sure somewhere */
+static void finish_plant(const struct plant_row *r, size_t s, size_t e)
+{
+    double lowest = r->h[s];
+    for (size_t t = s + 1; t < e; t++) /* as numpy.minimum: NaN if any is */
+        lowest = lowest != lowest || r->h[t] != r->h[t] ? lowest + r->h[t] : r->h[t] < lowest ? r->h[t] : lowest;
+    size_t first = e, last = s;
+    for (size_t t = s; t < e; t++)
+        if (r->h[t] <= lowest + r->th->rise || sure_at(r, t)) {
+            first = first < t ? first : t;
+            last = t + 1;
+        }
+    if (last <= first)
+        return;
+    int sure = 0;
+    for (size_t t = first; t < last && !sure; t++)
+        sure = sure_at(r, t);
+    if (last - first >= r->th->shortest || sure)
+        memset(r->mask + first, 1, last - first);
+}
+
+int mt_plant_masks(const double *heights, const double *speed, const double *central, size_t rows, size_t n,
+                   const struct mt_plant_thresholds *th, unsigned char *mask)
+{
+    if (!th)
+        return MT_EINVAL;
+    if (rows == 0 || n == 0)
+        return MT_OK;
+    if (!heights || !speed || !central || !mask)
+        return MT_EINVAL;
+    for (size_t i = 0; i < rows; i++) {
+        const struct plant_row r = {heights + i * n, speed + i * n, central + i * n, th, mask + i * n};
+        memset(r.mask, 0, n);
+        int open = 0; /* a plant [s, e) is being gathered */
+        size_t s = 0, e = 0;
+        for (size_t t = 0; t < n;) {
+            if (!close_at(&r, t)) {
+                t++;
+                continue;
+            }
+            size_t end = t, firm = 0; /* the run of close frames [t, end) */
+            for (; end < n && close_at(&r, end); end++)
+                firm += (size_t)firm_at(&r, end);
+            if (firm) {
+                int slow = open && t - e <= th->gap;
+                for (size_t u = e; slow && u < t; u++)
+                    slow = r.speed[u] < th->merge_speed;
+                if (!slow) {
+                    if (open)
+                        finish_plant(&r, s, e);
+                    s = t, open = 1;
+                }
+                e = end;
+            }
+            t = end;
+        }
+        if (open)
+            finish_plant(&r, s, e);
+    }
+    return MT_OK;
+}

@@ -618,6 +618,32 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
                        double *out);
 
 /*
+ * Footplant detection (motiontheater.contacts) over rows of n frames: the
+ * thresholds, already in the samples' units and scaled.
+ */
+struct mt_plant_thresholds {
+    double sure_height, sure_speed;   /* sure: height < sure_height and central < sure_speed */
+    double height, speed;             /* close: height < height and speed < speed, or sure */
+    double firm_height, firm_speed;   /* firm: likewise, or sure (firm frames are close) */
+    double merge_speed;               /* plants gap frames apart merge when every frame between is slower */
+    double rise;                      /* a plant's ends more than this above its lowest frame are cut */
+    size_t gap, shortest;             /* frames */
+};
+
+/*
+ * The footplants of rows of samples (heights, speed, central: rows x n;
+ * mask: rows x n, 1 planted, 0 not).  A plant is a run of close frames
+ * holding a firm one; plants whose gap is at most th->gap frames merge when
+ * every frame of the gap has speed < merge_speed; each plant's first and
+ * last frames are cut back to those at most rise above its lowest height
+ * (the minimum over the plant, gaps included; NaN if any is NaN) or sure;
+ * plants shorter than th->shortest frames then are dropped unless they hold
+ * a sure frame.  NaN compares false.
+ */
+int mt_plant_masks(const double *heights, const double *speed, const double *central, size_t rows, size_t n,
+                   const struct mt_plant_thresholds *th, unsigned char *mask);
+
+/*
  * Speeds of points over frames, in their unit per second (rate: frames per
  * second).  points: tracks x frames x per_frame x 3, of which the points
  * which[0 .. count-1] (< per_frame) of each frame are measured; speed

@@ -18,7 +18,7 @@ holds a frame faster than 0.45 m/s by the larger difference (or 5 cm/s by
 the central one).  Thresholds are in
 metres, m/s and seconds at the reference leg length (0.85 m hip to ankle),
 multiplied by :func:`~motiontheater.legs.body_scale`; frames come from the
-frame rate.
+frame rate.  The runs are found in C (:func:`mtcore.footskate.plant_masks`).
 
 The result is a :class:`Contacts` table: one row per plant (foot, point,
 first frame, last frame), which users read, edit and give back as CSV::
@@ -283,42 +283,24 @@ def detect_masks(
     th = thresholds
     unit = scale / meters_per_unit
     fastest = FASTEST / meters_per_unit
-    sure = (heights < SURE_HEIGHT / meters_per_unit) & (central < SURE_SPEED / meters_per_unit)
-    close = (heights < th.height * unit) & (speed < min(th.speed * unit, fastest)) | sure
-    firm = (heights < th.enter_height * unit) & (speed < min(th.enter_speed * unit, fastest)) | sure
-    slow = speed < th.merge_speed / meters_per_unit
-    rise = th.rise * unit
-    gap = round(th.gap * frame_rate)
-    shortest = round(th.min_length * frame_rate)
+    limits = kernels.PlantThresholds(
+        sure_height=SURE_HEIGHT / meters_per_unit,
+        sure_speed=SURE_SPEED / meters_per_unit,
+        height=th.height * unit,
+        speed=min(th.speed * unit, fastest),
+        firm_height=th.enter_height * unit,
+        firm_speed=min(th.enter_speed * unit, fastest),
+        merge_speed=th.merge_speed / meters_per_unit,
+        rise=th.rise * unit,
+        gap=round(th.gap * frame_rate),
+        shortest=round(th.min_length * frame_rate),
+    )
     n = heights.shape[-1]
-    rows = [a.reshape(-1, n) for a in (heights, close, firm, sure, slow)]
-    out = np.zeros(rows[0].shape, bool)
-    index = np.arange(n)
-    for r, (h, c, f, certain, moving_slowly) in enumerate(zip(*rows)):
-        starts, ends = runs(c)
-        if not len(starts):
-            continue
-        firm_count = np.add.reduceat(f.astype(np.int64), starts)
-        starts, ends = starts[firm_count > 0], ends[firm_count > 0]
-        if len(starts) > 1:  # merge short gaps that the point crosses slowly
-            fast = np.concatenate(([0], np.cumsum(~moving_slowly)))
-            join = (starts[1:] - ends[:-1] <= gap) & (fast[starts[1:]] == fast[ends[:-1]])
-            starts, ends = starts[np.concatenate(([True], ~join))], ends[np.concatenate((~join, [True]))]
-        if not len(starts):
-            continue
-        # cut the ends of each plant where the point has risen from it (heel strike, push-off), sure frames kept
-        bounds = _bounds(starts, ends, n)
-        plant = np.searchsorted(starts, index, side="right") - 1
-        inside = (plant >= 0) & (index < ends[np.maximum(plant, 0)])
-        lowest = np.minimum.reduceat(h, bounds)[::2]
-        still = inside & ((h <= lowest[np.maximum(plant, 0)] + rise) | certain)
-        first = np.minimum.reduceat(np.where(still, index, n), bounds)[::2]
-        last = np.maximum.reduceat(np.where(still, index, -1), bounds)[::2] + 1
-        held = np.concatenate(([0], np.cumsum(certain)))
-        keep = (last > first) & ((last - first >= shortest) | (held[np.maximum(last, first)] > held[first]))
-        edges = np.bincount(first[keep], minlength=n + 1) - np.bincount(last[keep], minlength=n + 1)
-        out[r] = np.cumsum(edges[:-1]) > 0
-    return out.reshape(heights.shape)
+
+    def rows(a: np.ndarray) -> np.ndarray:
+        return np.reshape(a, (-1, n))
+
+    return kernels.plant_masks(rows(heights), rows(speed), rows(central), limits).reshape(heights.shape)
 
 
 def _bounds(starts: np.ndarray, ends: np.ndarray, n: int) -> np.ndarray:

@@ -35,10 +35,12 @@ __all__ = [
     "CleanupOptions",
     "LegChain",
     "LegPlan",
+    "PlantThresholds",
     "adjust_root",
     "cleanup",
     "leg_points",
     "plan_leg",
+    "plant_masks",
     "point_speeds",
     "solve_leg",
     "write_channels",
@@ -157,6 +159,57 @@ class CleanupOptions:
         opt.knee_soft = self.knee_soft
         opt.knee_keep = self.knee_keep
         return opt
+
+
+@dataclass(frozen=True)
+class PlantThresholds:
+    """Footplant detection's thresholds (``struct mt_plant_thresholds``), in the samples' units.
+
+    A frame is *sure* when its height is below ``sure_height`` and its central
+    speed below ``sure_speed``; *close* when its height is below ``height`` and
+    its speed below ``speed``, or sure; *firm* likewise with ``firm_height``
+    and ``firm_speed`` (which must not exceed height and speed: firm frames are
+    close).  Plants at most ``gap`` frames apart merge when every frame between
+    is slower than ``merge_speed``; a plant's ends more than ``rise`` above its
+    lowest frame are cut; plants shorter than ``shortest`` frames are dropped
+    unless they hold a sure frame.
+    """
+
+    sure_height: float
+    sure_speed: float
+    height: float
+    speed: float
+    firm_height: float
+    firm_speed: float
+    merge_speed: float
+    rise: float
+    gap: int
+    shortest: int
+
+    def __post_init__(self) -> None:
+        for name in ("gap", "shortest"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                raise ValueError(f"{name} must be a whole number >= 0, got {value!r}")
+        if not (self.firm_height <= self.height and self.firm_speed <= self.speed):
+            raise ValueError("firm_height and firm_speed must not exceed height and speed (firm frames are close)")
+
+    def struct(self):
+        """The thresholds as the kernel takes them."""
+        th = ffi.new("struct mt_plant_thresholds *")
+        for name in (
+            "sure_height",
+            "sure_speed",
+            "height",
+            "speed",
+            "firm_height",
+            "firm_speed",
+            "merge_speed",
+            "rise",
+        ):
+            setattr(th, name, float(getattr(self, name)))
+        th.gap, th.shortest = int(self.gap), int(self.shortest)
+        return th
 
 
 @dataclass(frozen=True, eq=False)
@@ -552,3 +605,33 @@ def point_speeds(points, which, frame_rate: float, *, central: bool = False):
         "mt_point_speeds",
     )
     return (speed, middle) if central else speed
+
+
+def plant_masks(heights, speed, central, thresholds: PlantThresholds) -> np.ndarray:
+    """Footplant masks (rows, frames) bool (``mt_plant_masks``) of rows of samples: ``heights``
+    above rest, ``speed`` the larger of the forward and backward differences' and ``central`` the
+    central difference's (as :func:`point_speeds` gives them), all (rows, frames), by
+    ``thresholds`` (see :class:`PlantThresholds`).  Each plant's lowest height is the minimum over
+    it, gaps merged included, NaN if any is; NaN compares false."""
+    heights = np.ascontiguousarray(heights, dtype=np.float64)
+    if heights.ndim != 2:
+        raise ValueError(f"heights must have shape (rows, frames), got {heights.shape}")
+    speed = _doubles(speed, "speed", heights.shape)
+    central = _doubles(central, "central", heights.shape)
+    if not isinstance(thresholds, PlantThresholds):
+        raise TypeError(f"thresholds must be PlantThresholds, got {type(thresholds).__name__}")
+    rows, frames = heights.shape
+    mask = np.empty((rows, frames), np.uint8)
+    check(
+        lib.mt_plant_masks(
+            c_array(heights),
+            c_array(speed),
+            c_array(central),
+            rows,
+            frames,
+            thresholds.struct(),
+            c_array(mask, "unsigned char[]"),
+        ),
+        "mt_plant_masks",
+    )
+    return mask.view(bool)

@@ -754,6 +754,22 @@ def speed_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
+def plant_cases(rng: np.random.Generator) -> list[tuple]:
+    """Rows of heights and speeds that wander in and out of the thresholds (NaN among them), with
+    gaps and lengths of every kind."""
+    out = []
+    for rows, frames in ((1, 0), (1, 1), (2, 2), (4, 60), (3, 400)):
+        heights = np.abs(rng.normal(0, 0.03, (rows, frames)).cumsum(axis=1) % 0.08 - 0.01)
+        speed = np.abs(rng.normal(0, 0.3, (rows, frames)))
+        central = speed * rng.uniform(0.3, 1.0, (rows, frames))
+        for a in (heights, speed, central):
+            a[rng.random(a.shape) < 0.01] = np.nan
+        for gap, shortest, rise in ((0, 0, 0.0), (3, 5, 0.005), (12, 6, 0.01)):
+            th = fs.PlantThresholds(0.02, 0.05, 0.03, 0.4, 0.02, 0.35, 0.4, rise, gap, shortest)
+            out.append((heights, speed, central, th))
+    return out
+
+
 # --- the registry ---------------------------------------------------------------------------
 
 TWINS: dict[str, Twin] = {
@@ -849,6 +865,7 @@ TWINS: dict[str, Twin] = {
     "mt_footskate_root": Twin(fs.adjust_root, footskate.adjust_root, root_cases, close(1e-9)),
     "mt_footskate_solve": Twin(fast_solve, slow_solve, solve_cases, close(1e-6)),
     "mt_footskate_write": Twin(fs.write_channels, footskate.write_channels, write_cases, exact),
+    "mt_plant_masks": Twin(fs.plant_masks, footskate.plant_masks, plant_cases, exact),
     "mt_point_speeds": Twin(
         lambda p, which, rate, central: fs.point_speeds(p, which, rate, central=central),
         lambda p, which, rate, central: footskate.point_speeds(p, which, rate, central=central),
