@@ -1,7 +1,6 @@
 /*
  * blocks.h - build-internal: rotations of BLOCK frames at a time, shared by
- * forward kinematics (kinematics.c), the rotation kernels (rotation.c) and the
- * legs of the footskate kernels (footskate.c).
+ * forward kinematics (kinematics.c) and the rotation kernels (rotation.c).
  *
  * Frames are computed BLOCK at a time, every quantity an array over the
  * block (structure of arrays), so that the inner loops run over frames and
@@ -15,7 +14,6 @@
 #include "mtcore.h"
 
 #include <math.h>
-#include <string.h>
 
 enum { BLOCK = 8 };
 
@@ -119,33 +117,6 @@ static MT_INLINE void rotate_left_block(double m[9][BLOCK], int axis, const doub
             m[3 * a + k][f] = c[f] * ra - s[f] * rb;
             m[3 * b + k][f] = s[f] * ra + c[f] * rb;
         }
-}
-
-/* out = x y for block matrices. */
-static MT_INLINE void multiply_block(double x[9][BLOCK], double y[9][BLOCK], double out[9][BLOCK])
-{
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            for (int f = 0; f < BLOCK; f++)
-                out[3 * i + k][f] = x[3 * i][f] * y[k][f] + x[3 * i + 1][f] * y[3 + k][f] +
-                                    x[3 * i + 2][f] * y[6 + k][f];
-}
-
-/* out = C m C^T for a constant C and block matrices m. */
-static MT_INLINE void conjugate_block(const double *c, double m[9][BLOCK], double out[9][BLOCK])
-{
-    double c9[9], cm[9][BLOCK]; /* C copied: out might alias it for all the compiler knows, and then it
-                                   could neither keep C in registers nor vectorise the second product */
-    memcpy(c9, c, sizeof c9);
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            for (int f = 0; f < BLOCK; f++)
-                cm[3 * i + k][f] = c9[3 * i] * m[k][f] + c9[3 * i + 1] * m[3 + k][f] + c9[3 * i + 2] * m[6 + k][f];
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            for (int f = 0; f < BLOCK; f++)
-                out[3 * i + k][f] = cm[3 * i][f] * c9[3 * k] + cm[3 * i + 1][f] * c9[3 * k + 1] +
-                                    cm[3 * i + 2][f] * c9[3 * k + 2];
 }
 
 #endif /* MT_BLOCKS_H */

@@ -620,67 +620,54 @@ static MT_INLINE void realize_n(const struct mt_leg *leg, int j, const double *w
 
 /* ---------------------------------------------------------------- legs */
 
-/* The poses of up to BLOCK consecutive frames, each quantity an array over them (see blocks.h). */
+/* The poses of up to BLOCK consecutive frames, over the lanes. */
 struct pose_block {
-    double local[4][9][BLOCK];
-    double foot[9][BLOCK];
-    double point[5][3][BLOCK];
+    double local[4][9 * BLOCK]; /* hip, knee, ankle and toe joints' local rotations */
+    double foot[9 * BLOCK];     /* the foot's world rotation */
+    double point[5][3 * BLOCK]; /* knee, ankle, ball, heel, tip */
 };
 
 /*
  * The poses of frames 0 .. n-1 (n <= BLOCK) of hips, parents and angles
- * (lanes past n repeat the last frame), so that the loops over frames, sin
- * and cos included, vectorise: L = C M C^T as forward kinematics builds it
- * (M turned from the identity, channel by channel).
+ * (lanes past n repeat the last frame), side by side: the joints' local
+ * rotations by local_rotation_of_n, as the solve builds those it solves.
  */
 static MT_CLONES void pose_block(const struct mt_leg *leg, size_t n, const double *hips, const double *parents,
                                  const double *angles, struct pose_block *out)
 {
-    size_t row[BLOCK];
-    for (size_t f = 0; f < BLOCK; f++)
-        row[f] = f < n ? f : n - 1;
+    enum { L = BLOCK };
+    size_t row[L];
+    for (size_t l = 0; l < L; l++)
+        row[l] = l < n ? l : n - 1;
     for (int j = 0; j < 4; j++) {
-        double m[9][BLOCK], v[BLOCK], sn[BLOCK], cs[BLOCK];
-        for (int e = 0; e < 9; e++)
-            for (int f = 0; f < BLOCK; f++)
-                m[e][f] = identity[e];
-        for (int c = 0; c < 3 && leg->axes[j][c] >= 0; c++) {
-            for (int f = 0; f < BLOCK; f++)
-                v[f] = angles[12 * row[f] + 3 * (size_t)j + (size_t)c];
-            sincos_block(v, sn, cs);
-            rotate_left_block(m, leg->axes[j][c], sn, cs);
-        }
-        if (memcmp(leg->axis[j], identity, sizeof identity) == 0)
-            memcpy(out->local[j], m, sizeof m);
-        else
-            conjugate_block(leg->axis[j], m, out->local[j]);
+        const int count = channels(leg, j);
+        double v[3 * L], sn[3 * L], cs[3 * L];
+        for (int c = 0; c < count; c++)
+            for (size_t l = 0; l < L; l++)
+                v[(size_t)c * L + l] = angles[12 * row[l] + 3 * (size_t)j + (size_t)c];
+        sincos_lanes(v, sn, cs, count * L);
+        local_rotation_of_n(leg, j, sn, cs, out->local[j], L);
     }
-    double parent[9][BLOCK], thigh[9][BLOCK], shin[9][BLOCK], toes[9][BLOCK];
-    for (int e = 0; e < 9; e++)
-        for (int f = 0; f < BLOCK; f++)
-            parent[e][f] = parents[9 * row[f] + (size_t)e];
-    multiply_block(parent, out->local[0], thigh);
-    multiply_block(thigh, out->local[1], shin);
-    multiply_block(shin, out->local[2], out->foot);
-    multiply_block(out->foot, out->local[3], toes);
-    /* each point: the one it hangs from plus its segment turned by the rotation that turns it (the
-     * segments and points local, so that the compiler need not fear they alias) */
-    double s[5][3], p[5][3][BLOCK];
-    memcpy(s, leg->segment, sizeof s);
-    for (int e = 0; e < 3; e++)
-        for (int f = 0; f < BLOCK; f++) {
-            p[0][e][f] = hips[3 * row[f] + (size_t)e] + thigh[3 * e][f] * s[0][0] + thigh[3 * e + 1][f] * s[0][1] +
-                         thigh[3 * e + 2][f] * s[0][2];
-            p[1][e][f] = p[0][e][f] + shin[3 * e][f] * s[1][0] + shin[3 * e + 1][f] * s[1][1] +
-                         shin[3 * e + 2][f] * s[1][2];
-            p[2][e][f] = p[1][e][f] + out->foot[3 * e][f] * s[2][0] + out->foot[3 * e + 1][f] * s[2][1] +
-                         out->foot[3 * e + 2][f] * s[2][2];
-            p[3][e][f] = p[1][e][f] + out->foot[3 * e][f] * s[3][0] + out->foot[3 * e + 1][f] * s[3][1] +
-                         out->foot[3 * e + 2][f] * s[3][2];
-            p[4][e][f] = p[2][e][f] + toes[3 * e][f] * s[4][0] + toes[3 * e + 1][f] * s[4][1] +
-                         toes[3 * e + 2][f] * s[4][2];
-        }
-    memcpy(out->point, p, sizeof p);
+    double hip[3 * L], parent[9 * L], thigh[9 * L], shin[9 * L], toes[9 * L], s[3 * L], v[3 * L];
+    for (size_t l = 0; l < L; l++) {
+        for (size_t e = 0; e < 3; e++)
+            hip[e * L + l] = hips[3 * row[l] + e];
+        for (size_t e = 0; e < 9; e++)
+            parent[e * L + l] = parents[9 * row[l] + e];
+    }
+    mat_mul_n(parent, out->local[0], thigh, L);
+    mat_mul_n(thigh, out->local[1], shin, L);
+    mat_mul_n(shin, out->local[2], out->foot, L);
+    mat_mul_n(out->foot, out->local[3], toes, L);
+    /* each point: the one it hangs from plus its segment turned by the rotation that turns it */
+    const double *turned_by[5] = {thigh, shin, out->foot, out->foot, toes};
+    const double *from[5] = {hip, out->point[0], out->point[1], out->point[1], out->point[2]};
+    for (int k = 0; k < 5; k++) {
+        spread_n(leg->segment[k], 3, s, L);
+        mat_vec_n(turned_by[k], s, v, L);
+        for (int e = 0; e < 3 * L; e++)
+            out->point[k][e] = from[k][e] + v[e];
+    }
 }
 
 static int check_leg(const struct mt_leg *leg)
@@ -721,10 +708,10 @@ int mt_leg_points(const struct mt_leg *legs, size_t nlegs, size_t frames, const 
             for (size_t f = 0; f < n; f++) {
                 for (int k = 0; k < 5; k++)
                     for (int e = 0; e < 3; e++)
-                        points[15 * (f0 + f) + 3 * (size_t)k + (size_t)e] = block.point[k][e][f];
+                        points[15 * (f0 + f) + 3 * (size_t)k + (size_t)e] = block.point[k][(size_t)e * BLOCK + f];
                 if (feet)
                     for (int e = 0; e < 9; e++)
-                        feet[9 * (f0 + f) + (size_t)e] = block.foot[e][f];
+                        feet[9 * (f0 + f) + (size_t)e] = block.foot[(size_t)e * BLOCK + f];
             }
         }
     return MT_OK;
@@ -1486,9 +1473,9 @@ static MT_CLONES void solve_block(const struct solve_job *job, size_t t0, size_t
     for (int e = 0; e < 3; e++) /* heel -> ball: what a two-channel ankle keeps */
         for (int l = 0; l < L; l++)
             aim[e * L + l] = leg->segment[2][e] - leg->segment[3][e];
-    const double *local0 = (const double *)pose->local[0], *local1 = (const double *)pose->local[1];
+    const double *local0 = pose->local[0], *local1 = pose->local[1];
     rotvec_exp_n(turn, q, L);
-    mat_mul_n(q, (const double *)pose->foot, foot_goal, L);
+    mat_mul_n(q, pose->foot, foot_goal, L);
     struct hinge h;
     hinge_n(leg, local1, job->knee, &h, L);
     two_bone_n(leg, hip, parent, angles, local0, local1, &h, job->knee, opt->knee_soft, first, foot_goal, aim, out,
@@ -1614,11 +1601,11 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
                 continue;
             double *result = out + 12 * (t0 + f), foot_now[9], ball_now[3], toe_local[9];
             for (int e = 0; e < 9; e++) {
-                foot_now[e] = todo[f] ? solved.foot[e * BLOCK + f] : pose.foot[e][f];
-                toe_local[e] = pose.local[3][e][f];
+                foot_now[e] = todo[f] ? solved.foot[e * BLOCK + f] : pose.foot[e * BLOCK + f];
+                toe_local[e] = pose.local[3][e * BLOCK + f];
             }
             for (int e = 0; e < 3; e++)
-                ball_now[e] = todo[f] ? ball[e * BLOCK + f] : pose.point[2][e][f];
+                ball_now[e] = todo[f] ? ball[e * BLOCK + f] : pose.point[2][e * BLOCK + f];
             if (todo[f])
                 for (int c = 0; c < 12; c++)
                     result[c] = solved.angles[c * BLOCK + f];

@@ -33,6 +33,31 @@ static int check_tree(size_t joints, const long long *parent, const long long *o
     return status;
 }
 
+/* out = x y for block matrices. */
+static MT_INLINE void multiply_block(double x[9][BLOCK], double y[9][BLOCK], double out[9][BLOCK])
+{
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            for (int f = 0; f < BLOCK; f++)
+                out[3 * i + k][f] = x[3 * i][f] * y[k][f] + x[3 * i + 1][f] * y[3 + k][f] +
+                                    x[3 * i + 2][f] * y[6 + k][f];
+}
+
+/* out = C m C^T for a constant C and block matrices m. */
+static MT_INLINE void conjugate_block(const double *c9, double m[9][BLOCK], double out[9][BLOCK])
+{
+    double cm[9][BLOCK];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            for (int f = 0; f < BLOCK; f++)
+                cm[3 * i + k][f] = c9[3 * i] * m[k][f] + c9[3 * i + 1] * m[3 + k][f] + c9[3 * i + 2] * m[6 + k][f];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            for (int f = 0; f < BLOCK; f++)
+                out[3 * i + k][f] = cm[3 * i][f] * c9[3 * k] + cm[3 * i + 1][f] * c9[3 * k + 1] +
+                                    cm[3 * i + 2][f] * c9[3 * k + 2];
+}
+
 struct fk {
     const double *values;
     size_t channels, joints;
