@@ -5,7 +5,8 @@ The take is cmu/01_01 (2,751 frames, 120 Hz, 31 joints), end to end from
 the motion: legs, upper-body kinematics, floor fit, footplant detection,
 targets, the cleanup's phases and the channels written back.  The numpy
 peer is the same pipeline with the kernels' phases in whole-array numpy
-(tests/twins/footskate.py: leg kinematics, plan, root, solve).  The hour
+(tests/twins/footskate.py: leg kinematics, the contact points' speeds, the
+footplants' runs, plan, root, solve, the channels written back).  The hour
 is 01_01 tiled to 432,000 frames (one hour at 120 Hz, 62 channels), on one
 core (the kernels run in the calling thread).
 """
@@ -40,6 +41,9 @@ def numpy_clean(motion):
     with (
         mock.patch.object(kernels, "leg_points", footskate_twin.leg_points),
         mock.patch.object(kernels, "cleanup", footskate_twin.cleanup),
+        mock.patch.object(kernels, "write_channels", footskate_twin.write_channels),
+        mock.patch.object(kernels, "point_speeds", footskate_twin.point_speeds),
+        mock.patch.object(kernels, "plant_masks", footskate_twin.plant_masks),
     ):
         return clean_footskate(motion)
 

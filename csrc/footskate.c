@@ -4,12 +4,16 @@
  *
  * A leg is four joints turning thigh, shin, foot and toes.  Per frame and leg
  * the kernels rebuild the leg from its hip point, its hip's parent rotation
- * and its channels (leg_fk), and solve it analytically; frames interact only
- * through the plants' targets (phase 1, in frame order), the blending of
- * adjustments around constraints (phase 2), the root's smoothing (phase 3)
- * and the lifting of a sinking foot (phase 5).  The Python twin in
- * tests/footskate_twin.py computes the same, phase by phase, in numpy.
+ * and its channels (pose_block), and solve it analytically; frames interact
+ * only through the plants' targets (phase 1, in frame order), the blending
+ * of adjustments around constraints (phase 2), the root's smoothing (phase
+ * 3) and the lifting of a sinking foot (phase 5).  The per-frame work runs
+ * BLOCK frames side by side, each quantity an array over them ("lanes"), so
+ * that it vectorises.  The Python twin in tests/twins/footskate.py computes
+ * the same, phase by phase, in numpy.
  */
+#include "blocks.h"
+#include "clones.h"
 #include "mtcore.h"
 
 #include <math.h>
@@ -20,17 +24,223 @@ static const double pi = 3.14159265358979323846;
 static const double tiny = 1e-12; /* below this a length or sine counts as zero */
 enum { HEEL = 0, BALL = 1 };
 
-/* ---------------------------------------------------------------- vectors and rotations */
+/* ---------------------------------------------------------------- lanes */
+
+/*
+ * Quantities over n lanes (frames solved side by side): a number x[l], a
+ * vector v[e n + l], a matrix m[e n + l] (its entries row-major), l = 0 ..
+ * n - 1, n <= BLOCK.  With n = 1 that is the plain layout of a number, a
+ * vector or a matrix: the plan's code, a frame at a time, shares these
+ * functions with the solve, which runs them BLOCK frames at a time, where
+ * their loops over lanes vectorise (the elementary functions included: those
+ * of blocks.h).  An output may be an input of the same lane only where said.
+ */
+
+static MT_INLINE void dot_n(const double *a, const double *b, double *out, int n)
+{
+    for (int l = 0; l < n; l++)
+        out[l] = a[l] * b[l] + a[n + l] * b[n + l] + a[2 * n + l] * b[2 * n + l];
+}
+
+/* out may be a or b */
+static MT_INLINE void cross_n(const double *a, const double *b, double *out, int n)
+{
+    for (int l = 0; l < n; l++) {
+        const double x = a[n + l] * b[2 * n + l] - a[2 * n + l] * b[n + l];
+        const double y = a[2 * n + l] * b[l] - a[l] * b[2 * n + l];
+        const double z = a[l] * b[n + l] - a[n + l] * b[l];
+        out[l] = x, out[n + l] = y, out[2 * n + l] = z;
+    }
+}
+
+/* out may be a */
+static MT_INLINE void unit_n(const double *a, double *out, int n)
+{
+    for (int l = 0; l < n; l++) {
+        const double m = sqrt(a[l] * a[l] + a[n + l] * a[n + l] + a[2 * n + l] * a[2 * n + l]);
+        for (int e = 0; e < 3; e++)
+            out[e * n + l] = m > 0 ? a[e * n + l] / m : 0.0;
+    }
+}
+
+/* out = a with its component along the unit vector e (the same in every lane) removed; out may be a */
+static MT_INLINE void perpendicular_n(const double *a, const double *e, double *out, int n)
+{
+    for (int l = 0; l < n; l++) {
+        const double d = a[l] * e[0] + a[n + l] * e[1] + a[2 * n + l] * e[2];
+        for (int c = 0; c < 3; c++)
+            out[c * n + l] = a[c * n + l] - d * e[c];
+    }
+}
+
+/* out = m v (out may be v) */
+static MT_INLINE void mat_vec_n(const double *m, const double *v, double *out, int n)
+{
+    for (int l = 0; l < n; l++) {
+        double r[3];
+        for (int i = 0; i < 3; i++)
+            r[i] = m[3 * i * n + l] * v[l] + m[(3 * i + 1) * n + l] * v[n + l] +
+                   m[(3 * i + 2) * n + l] * v[2 * n + l];
+        for (int i = 0; i < 3; i++)
+            out[i * n + l] = r[i];
+    }
+}
+
+/* out = m^T v (out may be v) */
+static MT_INLINE void mat_tvec_n(const double *m, const double *v, double *out, int n)
+{
+    for (int l = 0; l < n; l++) {
+        double r[3];
+        for (int i = 0; i < 3; i++)
+            r[i] = m[i * n + l] * v[l] + m[(3 + i) * n + l] * v[n + l] + m[(6 + i) * n + l] * v[2 * n + l];
+        for (int i = 0; i < 3; i++)
+            out[i * n + l] = r[i];
+    }
+}
+
+/* out = a b, a^T b, a b^T (out may be a or b) */
+static MT_INLINE void mat_mul_n(const double *a, const double *b, double *out, int n)
+{
+    for (int l = 0; l < n; l++) {
+        double r[9];
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++)
+                r[3 * i + k] = a[3 * i * n + l] * b[k * n + l] + a[(3 * i + 1) * n + l] * b[(3 + k) * n + l] +
+                               a[(3 * i + 2) * n + l] * b[(6 + k) * n + l];
+        for (int e = 0; e < 9; e++)
+            out[e * n + l] = r[e];
+    }
+}
+
+static MT_INLINE void mat_tmul_n(const double *a, const double *b, double *out, int n)
+{
+    for (int l = 0; l < n; l++) {
+        double r[9];
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++)
+                r[3 * i + k] = a[i * n + l] * b[k * n + l] + a[(3 + i) * n + l] * b[(3 + k) * n + l] +
+                               a[(6 + i) * n + l] * b[(6 + k) * n + l];
+        for (int e = 0; e < 9; e++)
+            out[e * n + l] = r[e];
+    }
+}
+
+static MT_INLINE void mat_mult_n(const double *a, const double *b, double *out, int n)
+{
+    for (int l = 0; l < n; l++) {
+        double r[9];
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++)
+                r[3 * i + k] = a[3 * i * n + l] * b[3 * k * n + l] + a[(3 * i + 1) * n + l] * b[(3 * k + 1) * n + l] +
+                               a[(3 * i + 2) * n + l] * b[(3 * k + 2) * n + l];
+        for (int e = 0; e < 9; e++)
+            out[e * n + l] = r[e];
+    }
+}
+
+/* out (count entries over the lanes) = v, the same in every lane */
+static MT_INLINE void spread_n(const double *v, int count, double *out, int n)
+{
+    for (int e = 0; e < count; e++)
+        for (int l = 0; l < n; l++)
+            out[e * n + l] = v[e];
+}
+
+/* The rotations about the unit axes by the angles of cosines c and sines s (Rodrigues). */
+static MT_INLINE void about_cs_n(const double *axis, const double *c, const double *s, double *out, int n)
+{
+    for (int l = 0; l < n; l++) {
+        const double x = axis[l], y = axis[n + l], z = axis[2 * n + l], cl = c[l], sl = s[l], t = 1 - cl;
+        const double r[9] = {cl + t * x * x,     t * x * y - sl * z, t * x * z + sl * y,
+                             t * x * y + sl * z, cl + t * y * y,     t * y * z - sl * x,
+                             t * x * z - sl * y, t * y * z + sl * x, cl + t * z * z};
+        for (int e = 0; e < 9; e++)
+            out[e * n + l] = r[e];
+    }
+}
+
+/* The rotations by the angles about the unit axes. */
+static MT_INLINE void about_n(const double *axis, const double *angle, double *out, int n)
+{
+    double s[BLOCK], c[BLOCK];
+    sincos_lanes(angle, s, c, n);
+    about_cs_n(axis, c, s, out, n);
+}
+
+/* acos of x in [-1, 1]: (1 - x)(1 + x) keeps the digits of 1 - x^2 near either end */
+static MT_INLINE void acos_n(const double *x, double *out, int n)
+{
+    double y[BLOCK];
+    for (int l = 0; l < n; l++)
+        y[l] = sqrt((1 - x[l]) * (1 + x[l]));
+    atan2_lanes(y, x, out, n);
+}
+
+/* The smallest rotations taking the directions of u onto those of v (half turns for opposite ones). */
+static MT_INLINE void between_n(const double *u0, const double *v0, double *out, int n)
+{
+    double u[3 * BLOCK], v[3 * BLOCK], k[3 * BLOCK], s[BLOCK], c[BLOCK];
+    unit_n(u0, u, n);
+    unit_n(v0, v, n);
+    cross_n(u, v, k, n);
+    dot_n(k, k, s, n);
+    dot_n(u, v, c, n);
+    int wide = 0;
+    for (int l = 0; l < n; l++) { /* R = c I + [k]x + k k^T / (1 + c), k = u x v: no trigonometry */
+        const double f = 1 / (1 + c[l]), x = k[l], y = k[n + l], z = k[2 * n + l], cl = c[l];
+        const double r[9] = {cl + f * x * x, -z + f * x * y, y + f * x * z,  z + f * y * x, cl + f * y * y,
+                             -x + f * y * z, -y + f * z * x, x + f * z * y, cl + f * z * z};
+        for (int e = 0; e < 9; e++)
+            out[e * n + l] = r[e];
+        s[l] = sqrt(s[l]);
+        wide |= !(cl > -0.5);
+    }
+    if (!wide)
+        return;
+    /* a turn of 120 degrees or more, where 1 + c loses digits: about the axis by atan2(s, c), or
+     * for opposite directions a half turn about an axis perpendicular to u */
+    double axis[3 * BLOCK], angle[BLOCK], turn[9 * BLOCK];
+    for (int l = 0; l < n; l++) {
+        const int along = s[l] > tiny, low = fabs(u[l]) < 0.9;
+        const double other[3] = {low, low ? 0.0 : 1.0, 0.0};
+        const double p[3] = {u[n + l] * other[2] - u[2 * n + l] * other[1],
+                             u[2 * n + l] * other[0] - u[l] * other[2], u[l] * other[1] - u[n + l] * other[0]};
+        for (int e = 0; e < 3; e++)
+            axis[e * n + l] = along ? k[e * n + l] : p[e];
+    }
+    unit_n(axis, axis, n);
+    atan2_lanes(s, c, angle, n);
+    for (int l = 0; l < n; l++)
+        angle[l] = s[l] > tiny ? angle[l] : c[l] < 0 ? pi : 0.0;
+    about_n(axis, angle, turn, n);
+    for (int l = 0; l < n; l++)
+        if (!(c[l] > -0.5))
+            for (int e = 0; e < 9; e++)
+                out[e * n + l] = turn[e * n + l];
+}
+
+static MT_INLINE void rotvec_exp_n(const double *v, double *m, int n)
+{
+    double axis[3 * BLOCK], angle[BLOCK];
+    dot_n(v, v, angle, n);
+    for (int l = 0; l < n; l++)
+        angle[l] = sqrt(angle[l]);
+    unit_n(v, axis, n);
+    about_n(axis, angle, m, n);
+}
+
+/* the one-lane forms, for the code that takes a frame at a time */
 
 static double dot3(const double *a, const double *b)
 {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    double d;
+    dot_n(a, b, &d, 1);
+    return d;
 }
 
 static void cross3(const double *a, const double *b, double *out)
 {
-    const double x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x, out[1] = y, out[2] = z;
+    cross_n(a, b, out, 1);
 }
 
 static double norm3(const double *a)
@@ -40,105 +250,42 @@ static double norm3(const double *a)
 
 static void unit3(const double *a, double *out)
 {
-    const double n = norm3(a);
-    for (int e = 0; e < 3; e++)
-        out[e] = n > 0 ? a[e] / n : 0.0;
+    unit_n(a, out, 1);
 }
 
-/* out = a with its component along the unit vector e removed */
 static void perpendicular(const double *a, const double *e, double *out)
 {
-    const double d = dot3(a, e);
-    for (int c = 0; c < 3; c++)
-        out[c] = a[c] - d * e[c];
+    perpendicular_n(a, e, out, 1);
 }
 
 static void mat_vec(const double *m, const double *v, double *out)
 {
-    double r[3];
-    for (int i = 0; i < 3; i++)
-        r[i] = m[3 * i] * v[0] + m[3 * i + 1] * v[1] + m[3 * i + 2] * v[2];
-    memcpy(out, r, sizeof r);
+    mat_vec_n(m, v, out, 1);
 }
 
-/* out = m^T v */
 static void mat_tvec(const double *m, const double *v, double *out)
 {
-    double r[3];
-    for (int i = 0; i < 3; i++)
-        r[i] = m[i] * v[0] + m[3 + i] * v[1] + m[6 + i] * v[2];
-    memcpy(out, r, sizeof r);
+    mat_tvec_n(m, v, out, 1);
 }
 
-/* out = a b (out may be a or b) */
 static void mat_mul(const double *a, const double *b, double *out)
 {
-    double r[9];
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            r[3 * i + k] = a[3 * i] * b[k] + a[3 * i + 1] * b[3 + k] + a[3 * i + 2] * b[6 + k];
-    memcpy(out, r, sizeof r);
+    mat_mul_n(a, b, out, 1);
 }
 
-/* out = a^T b */
-static void mat_tmul(const double *a, const double *b, double *out)
-{
-    double r[9];
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            r[3 * i + k] = a[i] * b[k] + a[3 + i] * b[3 + k] + a[6 + i] * b[6 + k];
-    memcpy(out, r, sizeof r);
-}
-
-/* out = a b^T */
-static void mat_mult(const double *a, const double *b, double *out)
-{
-    double r[9];
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            r[3 * i + k] = a[3 * i] * b[3 * k] + a[3 * i + 1] * b[3 * k + 1] + a[3 * i + 2] * b[3 * k + 2];
-    memcpy(out, r, sizeof r);
-}
-
-/* The rotation about the unit axis by the angle of cosine c and sine s (Rodrigues). */
-static void about_cs(const double *axis, double c, double s, double *out)
-{
-    const double x = axis[0], y = axis[1], z = axis[2], t = 1 - c;
-    out[0] = c + t * x * x, out[1] = t * x * y - s * z, out[2] = t * x * z + s * y;
-    out[3] = t * x * y + s * z, out[4] = c + t * y * y, out[5] = t * y * z - s * x;
-    out[6] = t * x * z - s * y, out[7] = t * y * z + s * x, out[8] = c + t * z * z;
-}
-
-/* The rotation by angle about the unit axis. */
 static void about(const double *axis, double angle, double *out)
 {
-    about_cs(axis, cos(angle), sin(angle), out);
+    about_n(axis, &angle, out, 1);
 }
 
-/* The smallest rotation taking the direction of u onto that of v (a half turn for opposite ones). */
-static void between(const double *u0, const double *v0, double *out)
+static void between(const double *u, const double *v, double *out)
 {
-    double u[3], v[3], axis[3];
-    unit3(u0, u);
-    unit3(v0, v);
-    cross3(u, v, axis);
-    const double s = norm3(axis), c = dot3(u, v);
-    if (c > -0.5) { /* R = c I + [k]x + k k^T / (1 + c), k = u x v: no trigonometry */
-        const double f = 1 / (1 + c), *k = axis;
-        out[0] = c + f * k[0] * k[0], out[1] = -k[2] + f * k[0] * k[1], out[2] = k[1] + f * k[0] * k[2];
-        out[3] = k[2] + f * k[1] * k[0], out[4] = c + f * k[1] * k[1], out[5] = -k[0] + f * k[1] * k[2];
-        out[6] = -k[1] + f * k[2] * k[0], out[7] = k[0] + f * k[2] * k[1], out[8] = c + f * k[2] * k[2];
-        return;
-    }
-    if (s > tiny) {
-        unit3(axis, axis);
-        about(axis, atan2(s, c), out);
-        return;
-    }
-    const double other[3] = {fabs(u[0]) < 0.9, fabs(u[0]) < 0.9 ? 0.0 : 1.0, 0.0};
-    cross3(u, other, axis);
-    unit3(axis, axis);
-    about(axis, c < 0 ? pi : 0.0, out);
+    between_n(u, v, out, 1);
+}
+
+static void rotvec_exp(const double *v, double *m)
+{
+    rotvec_exp_n(v, m, 1);
 }
 
 /* The rotation vector (angle in [0, pi]) of a rotation. */
@@ -168,38 +315,31 @@ static void rotvec_of(const double *m, double *v)
         v[e] = w[e] * factor;
 }
 
-static void rotvec_exp(const double *v, double *m)
-{
-    double axis[3];
-    unit3(v, axis);
-    about(axis, norm3(v), m);
-}
-
 /* whole turns nearest to x / 2 pi; below 3 (0.48 turn) that is 0, the common case, without the call */
-static double round_turns(double x)
+static MT_INLINE double round_turns(double x)
 {
     return fabs(x) < 3.0 ? 0.0 : nearbyint(x / (2 * pi));
 }
 
 /* angle plus the whole turns that bring it nearest to ref */
-static double wrap_near(double angle, double ref)
+static MT_INLINE double wrap_near(double angle, double ref)
 {
     return angle + 2 * pi * round_turns(ref - angle);
 }
 
-static double wrap(double angle)
+static MT_INLINE double wrap(double angle)
 {
     return angle - 2 * pi * round_turns(angle);
 }
 
 /* sqrt(x^2 + y^2) without hypot's care for overflow, which costs a call: the arguments here are
  * coordinates of unit vectors and of a human's limbs, far from the limits of a double */
-static double length2(double x, double y)
+static MT_INLINE double length2(double x, double y)
 {
     return sqrt(x * x + y * y);
 }
 
-static double clip(double x, double lo, double hi)
+static MT_INLINE double clip(double x, double lo, double hi)
 {
     return x < lo ? lo : x > hi ? hi : x;
 }
@@ -220,24 +360,50 @@ static int channels(const struct mt_leg *leg, int j)
     return n;
 }
 
-/* m = R(axis) m, R the rotation about a coordinate axis of the given sine and cosine: it mixes two rows */
-static void rotate_left(double *m, int axis, double s, double c)
+/* the rows (or columns) p, q that a turn about a coordinate axis mixes */
+static int mixed_first(int axis)
 {
-    double *ra = m + 3 * (axis == 0 ? 1 : axis == 1 ? 2 : 0), *rb = m + 3 * (axis == 0 ? 2 : axis == 1 ? 0 : 1);
-    for (int k = 0; k < 3; k++) {
-        const double a = ra[k], b = rb[k];
-        ra[k] = c * a - s * b;
-        rb[k] = s * a + c * b;
+    return axis == 0 ? 1 : axis == 1 ? 2 : 0;
+}
+
+static int mixed_second(int axis)
+{
+    return axis == 0 ? 2 : axis == 1 ? 0 : 1;
+}
+
+/* m = R(axis) m, R the rotations about a coordinate axis of the given sines and cosines: they mix two rows */
+static MT_INLINE void rotate_left_n(double *m, int axis, const double *s, const double *c, int n)
+{
+    const int p = mixed_first(axis), q = mixed_second(axis);
+    for (int k = 0; k < 3; k++)
+        for (int l = 0; l < n; l++) {
+            const double a = m[(3 * p + k) * n + l], b = m[(3 * q + k) * n + l];
+            m[(3 * p + k) * n + l] = c[l] * a - s[l] * b;
+            m[(3 * q + k) * n + l] = s[l] * a + c[l] * b;
+        }
+}
+
+/* v = R(axis) v, R as for rotate_left_n */
+static MT_INLINE void rotate_vector_n(double *v, int axis, const double *s, const double *c, int n)
+{
+    const int p = mixed_first(axis), q = mixed_second(axis);
+    for (int l = 0; l < n; l++) {
+        const double a = v[p * n + l], b = v[q * n + l];
+        v[p * n + l] = c[l] * a - s[l] * b;
+        v[q * n + l] = s[l] * a + c[l] * b;
     }
 }
 
-/* v = R(axis) v, R as for rotate_left */
-static void rotate_vector(double *v, int axis, double s, double c)
+/* m = m R(axis), R as for rotate_left_n: it mixes two columns */
+static MT_INLINE void rotate_right_n(double *m, int axis, const double *s, const double *c, int n)
 {
-    const int p = axis == 0 ? 1 : axis == 1 ? 2 : 0, q = axis == 0 ? 2 : axis == 1 ? 0 : 1;
-    const double a = v[p], b = v[q];
-    v[p] = c * a - s * b;
-    v[q] = s * a + c * b;
+    const int p = mixed_first(axis), q = mixed_second(axis);
+    for (int k = 0; k < 9; k += 3)
+        for (int l = 0; l < n; l++) {
+            const double a = m[(k + p) * n + l], b = m[(k + q) * n + l];
+            m[(k + p) * n + l] = c[l] * a + s[l] * b;
+            m[(k + q) * n + l] = -s[l] * a + c[l] * b;
+        }
 }
 
 static int is_identity(const double *m)
@@ -246,206 +412,262 @@ static int is_identity(const double *m)
            m[8] == 1;
 }
 
-/* m = m R(axis), R as for rotate_left: it mixes two columns */
-static void rotate_right(double *m, int axis, double s, double c)
-{
-    const int p = axis == 0 ? 1 : axis == 1 ? 2 : 0, q = axis == 0 ? 2 : axis == 1 ? 0 : 1;
-    for (int k = 0; k < 9; k += 3) {
-        const double a = m[k + p], b = m[k + q];
-        m[k + p] = c * a + s * b;
-        m[k + q] = -s * a + c * b;
-    }
-}
-
-/* L = C M C^T of joint j, M its channels' rotations (given by the sines and cosines of their angles),
- * each about a fixed axis after the ones before: C M built by turning C's columns, the last first. */
-static void local_rotation_of(const struct mt_leg *leg, int j, const double *sines, const double *cosines, double *out)
+/* L = C M C^T of joint j, M its channels' rotations (given by the sines and cosines of their angles,
+ * channel c's at c n), each about a fixed axis after the ones before: C M built by turning C's
+ * columns, the last first. */
+static MT_INLINE void local_rotation_of_n(const struct mt_leg *leg, int j, const double *sines, const double *cosines,
+                                          double *out, int n)
 {
     const int count = channels(leg, j);
     if (is_identity(leg->axis[j])) {
-        double m[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-        for (int n = 0; n < count; n++)
-            rotate_left(m, leg->axes[j][n], sines[n], cosines[n]);
-        memcpy(out, m, sizeof m);
+        spread_n(identity, 9, out, n);
+        for (int c = 0; c < count; c++)
+            rotate_left_n(out, leg->axes[j][c], sines + c * n, cosines + c * n, n);
         return;
     }
     if (count == 1) { /* C R C^T is the turn about C's column of the channel's axis: Rodrigues, no products */
         const double *c = leg->axis[j];
         const int a = leg->axes[j][0];
         const double u[3] = {c[a], c[3 + a], c[6 + a]};
-        about_cs(u, cosines[0], sines[0], out);
+        double axis[3 * BLOCK];
+        spread_n(u, 3, axis, n);
+        about_cs_n(axis, cosines, sines, out, n);
         return;
     }
-    double m[9];
-    memcpy(m, leg->axis[j], sizeof m);
-    for (int n = count - 1; n >= 0; n--)
-        rotate_right(m, leg->axes[j][n], sines[n], cosines[n]);
-    mat_mult(m, leg->axis[j], out);
+    double m[9 * BLOCK], cb[9 * BLOCK];
+    spread_n(leg->axis[j], 9, cb, n);
+    memcpy(m, cb, 9 * (size_t)n * sizeof *m);
+    for (int c = count - 1; c >= 0; c--)
+        rotate_right_n(m, leg->axes[j][c], sines + c * n, cosines + c * n, n);
+    mat_mult_n(m, cb, out, n);
 }
 
 static void local_rotation(const struct mt_leg *leg, int j, const double *angles, double *out)
 {
     double sines[3], cosines[3];
-    for (int n = 0; n < channels(leg, j); n++)
-        sines[n] = sin(angles[n]), cosines[n] = cos(angles[n]);
-    local_rotation_of(leg, j, sines, cosines, out);
+    for (int c = 0; c < channels(leg, j); c++)
+        sines[c] = sin(angles[c]), cosines[c] = cos(angles[c]);
+    local_rotation_of_n(leg, j, sines, cosines, out, 1);
 }
 
 /*
  * Angles about fixed axes (i, j, k) applying in order, M = R_k(c) R_j(b) R_i(a),
- * of the rotation m (proper Euler when k = i): of the two solutions, the one
+ * of the rotations m (proper Euler when k = i): of the two solutions, the one
  * nearest ref, each angle whole turns from it.  b and c come from column i of
  * m, a from row j of R_last(-c) m, which is row j of R_i(a); at gimbal lock c
  * is ref's and a makes up the rest.
  */
-static void euler_nearest(const double *m, const int *axes, const double *ref, double *out)
+static MT_INLINE void euler_nearest_n(const double *m, const int *axes, const double *ref, double *out, int n)
 {
     const int i = axes[0], j = axes[1], proper = axes[2] == i, k = proper ? 3 - i - j : axes[2];
+    const int last = proper ? i : k, p = mixed_first(last), q = mixed_second(last);
     const double eps = (j - i + 3) % 3 == 1 ? 1.0 : -1.0;
-#define M(r, c) m[3 * (r) + (c)]
-    double a, b, c, h;
-    int last;
-    if (proper) {
-        h = length2(M(j, i), M(k, i));
-        b = atan2(h, M(i, i));
-        c = h < 1e-9 ? ref[2] : atan2(M(j, i), -eps * M(k, i));
-        last = i;
-    } else {
-        h = length2(M(i, i), M(j, i));
-        b = atan2(-eps * M(k, i), h);
-        c = h < 1e-9 ? ref[2] : atan2(eps * M(j, i), M(i, i));
-        last = k;
+    double h[BLOCK], by[BLOCK], bx[BLOCK], cy[BLOCK], cx[BLOCK], a[BLOCK], b[BLOCK], c[BLOCK];
+    double cc[BLOCK], sc[BLOCK], ay[BLOCK], ax[BLOCK];
+#define M(r, col) m[(3 * (r) + (col)) * n + l]
+    int locked = 0;
+    for (int l = 0; l < n; l++) {
+        h[l] = proper ? length2(M(j, i), M(k, i)) : length2(M(i, i), M(j, i));
+        by[l] = proper ? h[l] : -eps * M(k, i), bx[l] = proper ? M(i, i) : h[l];
+        cy[l] = proper ? M(j, i) : eps * M(j, i), cx[l] = proper ? -eps * M(k, i) : M(i, i);
+        /* the cosine and sine of c, unless locked */
+        cc[l] = cx[l] / h[l], sc[l] = cy[l] / h[l];
+        locked |= h[l] < 1e-9;
+    }
+    atan2_lanes(by, bx, b, n);
+    atan2_lanes(cy, cx, c, n);
+    if (locked) {
+        double sn[BLOCK], cs[BLOCK];
+        for (int l = 0; l < n; l++)
+            c[l] = h[l] < 1e-9 ? ref[2 * n + l] : c[l];
+        sincos_lanes(c, sn, cs, n);
+        for (int l = 0; l < n; l++)
+            if (h[l] < 1e-9)
+                cc[l] = cs[l], sc[l] = sn[l];
+    }
+    for (int l = 0; l < n; l++) { /* row j of R_last(-c) m: rows p' = c p + s q, q' = -s p + c q */
+        const double rj = j == p ? cc[l] * M(p, j) + sc[l] * M(q, j) : -sc[l] * M(p, j) + cc[l] * M(q, j);
+        const double rk = j == p ? cc[l] * M(p, k) + sc[l] * M(q, k) : -sc[l] * M(p, k) + cc[l] * M(q, k);
+        ay[l] = -eps * rk, ax[l] = rj;
     }
 #undef M
-    const int lock = h < 1e-9;
-    /* row j of R_last(-c) m: R_last turns rows (p, q) of what it multiplies, as rotate_left does */
-    const double cc = lock ? cos(c) : (proper ? -eps * m[3 * k + i] : m[3 * i + i]) / h;
-    const double sc = lock ? sin(c) : (proper ? m[3 * j + i] : eps * m[3 * j + i]) / h;
-    const int p = last == 0 ? 1 : last == 1 ? 2 : 0, q = last == 0 ? 2 : last == 1 ? 0 : 1;
-    double row[3];
-    for (int e = 0; e < 3; e++) /* R(-c): rows p' = c p + s q, q' = -s p + c q */
-        row[e] = j == p ? cc * m[3 * p + e] + sc * m[3 * q + e] : -sc * m[3 * p + e] + cc * m[3 * q + e];
-    a = atan2(-eps * row[k], row[j]);
-    const double first[3] = {wrap_near(a, ref[0]), wrap_near(b, ref[1]), wrap_near(c, ref[2])};
-    const double second[3] = {wrap_near(a + pi, ref[0]), wrap_near((proper ? 0.0 : pi) - b, ref[1]),
-                              wrap_near(c + pi, ref[2])};
-    double d1 = 0, d2 = 0;
-    for (int e = 0; e < 3; e++)
-        d1 += (first[e] - ref[e]) * (first[e] - ref[e]), d2 += (second[e] - ref[e]) * (second[e] - ref[e]);
-    memcpy(out, d2 < d1 && !lock ? second : first, sizeof first);
+    atan2_lanes(ay, ax, a, n);
+    for (int l = 0; l < n; l++) {
+        const double r0 = ref[l], r1 = ref[n + l], r2 = ref[2 * n + l];
+        const double first[3] = {wrap_near(a[l], r0), wrap_near(b[l], r1), wrap_near(c[l], r2)};
+        const double second[3] = {wrap_near(a[l] + pi, r0), wrap_near((proper ? 0.0 : pi) - b[l], r1),
+                                  wrap_near(c[l] + pi, r2)};
+        const double d1 = (first[0] - r0) * (first[0] - r0) + (first[1] - r1) * (first[1] - r1) +
+                          (first[2] - r2) * (first[2] - r2);
+        const double d2 = (second[0] - r0) * (second[0] - r0) + (second[1] - r1) * (second[1] - r1) +
+                          (second[2] - r2) * (second[2] - r2);
+        const int pick = d2 < d1 && !(h[l] < 1e-9);
+        for (int e = 0; e < 3; e++)
+            out[e * n + l] = pick ? second[e] : first[e];
+    }
 }
 
 /*
- * The angles of joint j nearest to the wanted local rotation that its
- * channels can take: three give it exactly; two turn the body vector aim
- * where wanted turns it; one turns aim as near as its axis allows; none keep
- * ref.  Angles are whole turns from ref.  With one or two channels, sines and
- * cosines receive those of the angles found (for local_rotation_of).
+ * The angles (ref, out: 3 over the lanes) of joint j nearest to the wanted
+ * local rotations that its channels can take: three give them exactly; two
+ * turn the body vectors aim where wanted turns them; one turns aim as near
+ * as its axis allows; none keep ref.  Angles are whole turns from ref.  With
+ * one or two channels, sines and cosines (2 over the lanes) receive those of
+ * the angles found (for local_rotation_of_n).
  */
-static void realize(const struct mt_leg *leg, int j, const double *wanted, const double *aim, const double *ref,
-                    double *out, double *sines, double *cosines)
+static MT_INLINE void realize_n(const struct mt_leg *leg, int j, const double *wanted, const double *aim,
+                                const double *ref, double *out, double *sines, double *cosines, int n)
 {
     const int count = channels(leg, j);
-    const double *c = leg->axis[j];
-    memcpy(out, ref, 3 * sizeof *out);
-    if (count == 3) {
-        double m[9];
-        mat_tmul(c, wanted, m);
-        mat_mul(m, c, m);
-        euler_nearest(m, leg->axes[j], ref, out);
-        return;
-    }
+    memcpy(out, ref, 3 * (size_t)n * sizeof *out);
     if (count == 0)
         return;
-    double p[3], q[3], turned[3];
-    mat_tvec(c, aim, p);
-    unit3(p, p);
-    mat_vec(wanted, aim, turned);
-    mat_tvec(c, turned, q);
-    unit3(q, q);
+    double c[9 * BLOCK];
+    spread_n(leg->axis[j], 9, c, n);
+    if (count == 3) {
+        double m[9 * BLOCK];
+        mat_tmul_n(c, wanted, m, n);
+        mat_mul_n(m, c, m, n);
+        euler_nearest_n(m, leg->axes[j], ref, out, n);
+        return;
+    }
+    double p[3 * BLOCK], q[3 * BLOCK], y[BLOCK], x[BLOCK], h[BLOCK], angle[BLOCK];
+    mat_tvec_n(c, aim, p, n);
+    unit_n(p, p, n);
+    mat_vec_n(wanted, aim, q, n);
+    mat_tvec_n(c, q, q, n);
+    unit_n(q, q, n);
     if (count == 1) {
         const int axis = leg->axes[j][0];
         const double e[3] = {axis == 0, axis == 1, axis == 2};
-        double pp[3], qq[3], n[3];
-        perpendicular(p, e, pp);
-        perpendicular(q, e, qq);
-        cross3(pp, qq, n);
-        const double y = dot3(e, n), x = dot3(pp, qq), h = length2(x, y);
-        out[0] = wrap_near(atan2(y, x), ref[0]);
-        sines[0] = h > 0 ? y / h : 0.0, cosines[0] = h > 0 ? x / h : 1.0;
+        double pp[3 * BLOCK], qq[3 * BLOCK], nn[3 * BLOCK];
+        perpendicular_n(p, e, pp, n);
+        perpendicular_n(q, e, qq, n);
+        cross_n(pp, qq, nn, n);
+        for (int l = 0; l < n; l++) {
+            y[l] = e[0] * nn[l] + e[1] * nn[n + l] + e[2] * nn[2 * n + l];
+            x[l] = pp[l] * qq[l] + pp[n + l] * qq[n + l] + pp[2 * n + l] * qq[2 * n + l];
+            h[l] = length2(x[l], y[l]);
+        }
+        atan2_lanes(y, x, angle, n);
+        for (int l = 0; l < n; l++) {
+            out[l] = wrap_near(angle[l], ref[l]);
+            sines[l] = h[l] > 0 ? y[l] / h[l] : 0.0, cosines[l] = h[l] > 0 ? x[l] / h[l] : 1.0;
+        }
         return;
     }
     const int ai = leg->axes[j][0], aj = leg->axes[j][1];
-    const double ei[3] = {ai == 0, ai == 1, ai == 2}, ej[3] = {aj == 0, aj == 1, aj == 2};
-    double eip[3];
-    cross3(ei, p, eip);
-    const double big_a = p[aj], big_b = eip[aj], rho = length2(big_a, big_b);
-    if (!(rho > tiny)) { /* aim along the first axis: nothing to turn, the angles kept */
-        for (int n = 0; n < 2; n++)
-            sines[n] = sin(ref[n]), cosines[n] = cos(ref[n]);
-        return;
+    const double ej[3] = {aj == 0, aj == 1, aj == 2};
+    const double ei[3] = {ai == 0, ai == 1, ai == 2};
+    double eip[3 * BLOCK], big_a[BLOCK], big_b[BLOCK], rho[BLOCK], kappa[BLOCK], base[BLOCK], spread[BLOCK];
+    spread_n(ei, 3, eip, n);
+    cross_n(eip, p, eip, n);
+    int flat = 0;
+    for (int l = 0; l < n; l++) {
+        big_a[l] = p[aj * n + l], big_b[l] = eip[aj * n + l];
+        rho[l] = length2(big_a[l], big_b[l]);
+        kappa[l] = clip(q[aj * n + l] / rho[l], -1.0, 1.0);
+        flat |= !(rho[l] > tiny);
     }
-    const double kappa = clip(q[aj] / rho, -1.0, 1.0), base = atan2(big_b, big_a), spread = acos(kappa);
+    atan2_lanes(big_b, big_a, base, n);
+    acos_n(kappa, spread, n);
     /* sines and cosines of base +- spread by the angle sums, from base's (B, A) / rho and spread's cosine */
-    const double cb = big_a / rho, sb = big_b / rho, ss = sqrt(1 - kappa * kappa);
-    double best[6] = {0, 0, 0, 1, 0, 1}, best_cost = 0; /* a, b, sin a, cos a, sin b, cos b */
+    double best[6][BLOCK] = {{0}}, cost[BLOCK] = {0}; /* a, b, sin a, cos a, sin b, cos b */
     for (int s = 0; s < 2; s++) {
-        double v[3], rp[3], qp[3], n[3];
+        double v[3 * BLOCK], rp[3 * BLOCK], qp[3 * BLOCK], nn[3 * BLOCK], sa[BLOCK], ca[BLOCK], a[BLOCK], b[BLOCK];
         const double sign = s == 0 ? 1.0 : -1.0;
-        const double a = wrap_near(base + sign * spread, ref[0]);
-        const double sa = sb * kappa + sign * cb * ss, ca = cb * kappa - sign * sb * ss;
-        memcpy(v, p, sizeof v);
-        rotate_vector(v, ai, sa, ca);
-        perpendicular(v, ej, rp);
-        perpendicular(q, ej, qp);
-        cross3(rp, qp, n);
-        const double y = dot3(ej, n), x = dot3(rp, qp), h = length2(x, y);
-        const double b = wrap_near(atan2(y, x), ref[1]);
-        const double cost = (a - ref[0]) * (a - ref[0]) + (b - ref[1]) * (b - ref[1]);
-        if (s == 0 || cost < best_cost) {
-            const double pick[6] = {a, b, sa, ca, h > 0 ? y / h : 0.0, h > 0 ? x / h : 1.0};
-            memcpy(best, pick, sizeof best);
-            best_cost = cost;
+        for (int l = 0; l < n; l++) {
+            const double cb = big_a[l] / rho[l], sb = big_b[l] / rho[l], ss = sqrt(1 - kappa[l] * kappa[l]);
+            a[l] = wrap_near(base[l] + sign * spread[l], ref[l]);
+            sa[l] = sb * kappa[l] + sign * cb * ss, ca[l] = cb * kappa[l] - sign * sb * ss;
+        }
+        memcpy(v, p, 3 * (size_t)n * sizeof *v);
+        rotate_vector_n(v, ai, sa, ca, n);
+        perpendicular_n(v, ej, rp, n);
+        perpendicular_n(q, ej, qp, n);
+        cross_n(rp, qp, nn, n);
+        for (int l = 0; l < n; l++) {
+            y[l] = ej[0] * nn[l] + ej[1] * nn[n + l] + ej[2] * nn[2 * n + l];
+            x[l] = rp[l] * qp[l] + rp[n + l] * qp[n + l] + rp[2 * n + l] * qp[2 * n + l];
+            h[l] = length2(x[l], y[l]);
+        }
+        atan2_lanes(y, x, b, n);
+        for (int l = 0; l < n; l++) {
+            b[l] = wrap_near(b[l], ref[n + l]);
+            const double d = (a[l] - ref[l]) * (a[l] - ref[l]) + (b[l] - ref[n + l]) * (b[l] - ref[n + l]);
+            if (s == 0 || d < cost[l]) {
+                best[0][l] = a[l], best[1][l] = b[l], best[2][l] = sa[l], best[3][l] = ca[l];
+                best[4][l] = h[l] > 0 ? y[l] / h[l] : 0.0, best[5][l] = h[l] > 0 ? x[l] / h[l] : 1.0;
+                cost[l] = d;
+            }
         }
     }
-    out[0] = best[0], out[1] = best[1];
-    sines[0] = best[2], cosines[0] = best[3], sines[1] = best[4], cosines[1] = best[5];
+    for (int l = 0; l < n; l++) {
+        out[l] = best[0][l], out[n + l] = best[1][l];
+        sines[l] = best[2][l], cosines[l] = best[3][l], sines[n + l] = best[4][l], cosines[n + l] = best[5][l];
+    }
+    if (flat) { /* aim along the first axis: nothing to turn, the angles kept */
+        double sn[2 * BLOCK], cs[2 * BLOCK];
+        sincos_lanes(ref, sn, cs, 2 * n);
+        for (int l = 0; l < n; l++)
+            if (!(rho[l] > tiny))
+                for (int e = 0; e < 2; e++) {
+                    const int at = e * n + l;
+                    out[at] = ref[at], sines[at] = sn[at], cosines[at] = cs[at];
+                }
+    }
 }
 
 /* ---------------------------------------------------------------- legs */
 
-struct leg_pose {
-    double local[4][9]; /* hip, knee, ankle and toe joints' local rotations */
-    double foot[9];     /* the foot's world rotation */
-    double point[5][3]; /* knee, ankle, ball, heel, tip */
+/* The poses of up to BLOCK consecutive frames, over the lanes. */
+struct pose_block {
+    double local[4][9 * BLOCK]; /* hip, knee, ankle and toe joints' local rotations */
+    double foot[9 * BLOCK];     /* the foot's world rotation */
+    double point[5][3 * BLOCK]; /* knee, ankle, ball, heel, tip */
 };
 
-static void leg_fk(const struct mt_leg *leg, const double *hip, const double *parent, const double *angles,
-                   struct leg_pose *pose)
+/*
+ * The poses of frames 0 .. n-1 (n <= BLOCK) of hips, parents and angles
+ * (lanes past n repeat the last frame), side by side: the joints' local
+ * rotations by local_rotation_of_n, as the solve builds those it solves.
+ */
+static MT_CLONES void pose_block(const struct mt_leg *leg, size_t n, const double *hips, const double *parents,
+                                 const double *angles, struct pose_block *out)
 {
-    const double(*s)[3] = leg->segment;
-    double thigh[9], shin[9], toes[9], v[3];
-    for (int j = 0; j < 4; j++)
-        local_rotation(leg, j, angles + 3 * j, pose->local[j]);
-    mat_mul(parent, pose->local[0], thigh);
-    mat_mul(thigh, pose->local[1], shin);
-    mat_mul(shin, pose->local[2], pose->foot);
-    mat_mul(pose->foot, pose->local[3], toes);
-    mat_vec(thigh, s[0], v);
-    for (int e = 0; e < 3; e++)
-        pose->point[0][e] = hip[e] + v[e];
-    mat_vec(shin, s[1], v);
-    for (int e = 0; e < 3; e++)
-        pose->point[1][e] = pose->point[0][e] + v[e];
-    mat_vec(pose->foot, s[2], v);
-    for (int e = 0; e < 3; e++)
-        pose->point[2][e] = pose->point[1][e] + v[e];
-    mat_vec(pose->foot, s[3], v);
-    for (int e = 0; e < 3; e++)
-        pose->point[3][e] = pose->point[1][e] + v[e];
-    mat_vec(toes, s[4], v);
-    for (int e = 0; e < 3; e++)
-        pose->point[4][e] = pose->point[2][e] + v[e];
+    enum { L = BLOCK };
+    size_t row[L];
+    for (size_t l = 0; l < L; l++)
+        row[l] = l < n ? l : n - 1;
+    for (int j = 0; j < 4; j++) {
+        const int count = channels(leg, j);
+        double v[3 * L], sn[3 * L], cs[3 * L];
+        for (int c = 0; c < count; c++)
+            for (size_t l = 0; l < L; l++)
+                v[(size_t)c * L + l] = angles[12 * row[l] + 3 * (size_t)j + (size_t)c];
+        sincos_lanes(v, sn, cs, count * L);
+        local_rotation_of_n(leg, j, sn, cs, out->local[j], L);
+    }
+    double hip[3 * L], parent[9 * L], thigh[9 * L], shin[9 * L], toes[9 * L], s[3 * L], v[3 * L];
+    for (size_t l = 0; l < L; l++) {
+        for (size_t e = 0; e < 3; e++)
+            hip[e * L + l] = hips[3 * row[l] + e];
+        for (size_t e = 0; e < 9; e++)
+            parent[e * L + l] = parents[9 * row[l] + e];
+    }
+    mat_mul_n(parent, out->local[0], thigh, L);
+    mat_mul_n(thigh, out->local[1], shin, L);
+    mat_mul_n(shin, out->local[2], out->foot, L);
+    mat_mul_n(out->foot, out->local[3], toes, L);
+    /* each point: the one it hangs from plus its segment turned by the rotation that turns it */
+    const double *turned_by[5] = {thigh, shin, out->foot, out->foot, toes};
+    const double *from[5] = {hip, out->point[0], out->point[1], out->point[1], out->point[2]};
+    for (int k = 0; k < 5; k++) {
+        spread_n(leg->segment[k], 3, s, L);
+        mat_vec_n(turned_by[k], s, v, L);
+        for (int e = 0; e < 3 * L; e++)
+            out->point[k][e] = from[k][e] + v[e];
+    }
 }
 
 static int check_leg(const struct mt_leg *leg)
@@ -479,13 +701,18 @@ int mt_leg_points(const struct mt_leg *legs, size_t nlegs, size_t frames, const 
         if (check_leg(legs + i) != MT_OK)
             return MT_EINVAL;
     for (size_t i = 0; i < nlegs; i++)
-        for (size_t t = 0; t < frames; t++) {
-            const size_t f = i * frames + t;
-            struct leg_pose pose;
-            leg_fk(legs + i, hips + 3 * f, parents + 9 * f, angles + 12 * f, &pose);
-            memcpy(points + 15 * f, pose.point, sizeof pose.point);
-            if (feet)
-                memcpy(feet + 9 * f, pose.foot, sizeof pose.foot);
+        for (size_t t0 = 0; t0 < frames; t0 += BLOCK) {
+            const size_t n = frames - t0 < BLOCK ? frames - t0 : BLOCK, f0 = i * frames + t0;
+            struct pose_block block;
+            pose_block(legs + i, n, hips + 3 * f0, parents + 9 * f0, angles + 12 * f0, &block);
+            for (size_t f = 0; f < n; f++) {
+                for (int k = 0; k < 5; k++)
+                    for (int e = 0; e < 3; e++)
+                        points[15 * (f0 + f) + 3 * (size_t)k + (size_t)e] = block.point[k][(size_t)e * BLOCK + f];
+                if (feet)
+                    for (int e = 0; e < 9; e++)
+                        feet[9 * (f0 + f) + (size_t)e] = block.foot[(size_t)e * BLOCK + f];
+            }
         }
     return MT_OK;
 }
@@ -661,32 +888,70 @@ static void raise_lever(const double *lever, const double *pivot, double rest, c
 
 /* ---------------------------------------------------------------- knee */
 
+/* over the lanes: |hip -> ankle|^2 = base + 2 rho cos(delta - phi) turning the knee by delta */
 struct hinge {
-    double base, rho, phi; /* |hip -> ankle|^2 = base + 2 rho cos(delta - phi) turning the knee by delta */
-    double cos_phi, sin_phi;
+    double base[BLOCK], rho[BLOCK], phi[BLOCK], cos_phi[BLOCK], sin_phi[BLOCK];
 };
 
-static struct hinge hinge_of(const struct mt_leg *leg, const double *knee_local, const double *axis)
+static MT_INLINE void hinge_n(const struct mt_leg *leg, const double *knee_local, const double *axis, struct hinge *h,
+                              int n)
 {
     const double *s1 = leg->segment[0];
-    double u[3], au[3];
-    mat_vec(knee_local, leg->segment[1], u);
-    cross3(axis, u, au);
-    const double c0 = dot3(s1, axis) * dot3(u, axis), x = dot3(s1, u) - c0, y = dot3(s1, au);
-    const double rho = length2(x, y);
-    struct hinge h = {dot3(s1, s1) + dot3(u, u) + 2 * c0, rho, atan2(y, x), rho > 0 ? x / rho : 1.0,
-                      rho > 0 ? y / rho : 0.0};
-    return h;
+    double s2[3 * BLOCK], a[3 * BLOCK], u[3 * BLOCK], au[3 * BLOCK], x[BLOCK], y[BLOCK];
+    spread_n(leg->segment[1], 3, s2, n);
+    spread_n(axis, 3, a, n);
+    mat_vec_n(knee_local, s2, u, n);
+    cross_n(a, u, au, n);
+    const double s1a = dot3(s1, axis), s1s1 = dot3(s1, s1);
+    for (int l = 0; l < n; l++) {
+        const double u0 = u[l], u1 = u[n + l], u2 = u[2 * n + l];
+        const double c0 = s1a * (u0 * axis[0] + u1 * axis[1] + u2 * axis[2]);
+        x[l] = s1[0] * u0 + s1[1] * u1 + s1[2] * u2 - c0;
+        y[l] = s1[0] * au[l] + s1[1] * au[n + l] + s1[2] * au[2 * n + l];
+        const double rho = length2(x[l], y[l]);
+        h->base[l] = s1s1 + (u0 * u0 + u1 * u1 + u2 * u2) + 2 * c0;
+        h->rho[l] = rho, h->cos_phi[l] = rho > 0 ? x[l] / rho : 1.0, h->sin_phi[l] = rho > 0 ? y[l] / rho : 0.0;
+    }
+    atan2_lanes(y, x, h->phi, n);
 }
 
 /* the longest hip -> ankle distance with the knee bent at least min(soft, its bend now), and keep times it */
-static double reach(struct hinge h, double soft, double keep)
+static MT_INLINE void reach_n(const struct hinge *h, double soft, double keep, double *out, int n)
 {
-    const double now = fabs(wrap(-h.phi)), least = now < soft ? now : soft;
-    const double bend = keep * now > least ? keep * now : least;
-    /* the bend now is phi's (cos is even and whole turns round): its cosine without a call */
-    const double r2 = h.base + 2 * h.rho * (bend == now ? h.cos_phi : cos(bend));
-    return sqrt(r2 > 0 ? r2 : 0.0);
+    double now[BLOCK], bend[BLOCK], sn[BLOCK], cs[BLOCK];
+    for (int l = 0; l < n; l++) {
+        now[l] = fabs(wrap(-h->phi[l]));
+        const double least = now[l] < soft ? now[l] : soft;
+        bend[l] = keep * now[l] > least ? keep * now[l] : least;
+    }
+    sincos_lanes(bend, sn, cs, n);
+    for (int l = 0; l < n; l++) {
+        /* the bend now is phi's (cos is even and whole turns round): its cosine is known */
+        const double r2 = h->base[l] + 2 * h->rho[l] * (bend[l] == now[l] ? h->cos_phi[l] : cs[l]);
+        out[l] = sqrt(r2 > 0 ? r2 : 0.0);
+    }
+}
+
+/*
+ * The knees of frames 0 .. n-1 (n <= BLOCK; lanes past n repeat the last) of
+ * angles, about the hinge axis: their reaches (reach_n with soft and keep)
+ * and the bends wrap(-phi), whose signs tell the side the knee bends to.
+ */
+static MT_CLONES void knee_block(const struct mt_leg *leg, size_t n, const double *angles, const double *axis,
+                                 double soft, double keep, double *reaches, double *bends)
+{
+    const int count = channels(leg, 1);
+    double v[3 * BLOCK], sines[3 * BLOCK], cosines[3 * BLOCK], knee_local[9 * BLOCK], r[BLOCK];
+    for (int c = 0; c < count; c++)
+        for (size_t f = 0; f < BLOCK; f++)
+            v[(size_t)c * BLOCK + f] = angles[12 * (f < n ? f : n - 1) + 3 + (size_t)c];
+    sincos_lanes(v, sines, cosines, count * BLOCK);
+    local_rotation_of_n(leg, 1, sines, cosines, knee_local, BLOCK);
+    struct hinge h;
+    hinge_n(leg, knee_local, axis, &h, BLOCK);
+    reach_n(&h, soft, keep, r, BLOCK);
+    for (size_t f = 0; f < n; f++)
+        reaches[f] = r[f], bends[f] = wrap(-h.phi[f]);
 }
 
 /* ---------------------------------------------------------------- phases 1 and 2 */
@@ -739,13 +1004,12 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *ang
     }
     /* the knee's reach and the side it bends to */
     double sides = 0;
-    for (size_t t = 0; t < frames; t++) {
-        double knee_local[9];
-        local_rotation(leg, 1, angles + 12 * t + 3, knee_local);
-        const struct hinge h = hinge_of(leg, knee_local, axis);
-        const double w = wrap(-h.phi);
-        sides += (w > 0) - (w < 0);
-        reaches[t] = reach(h, opt->knee_soft, opt->knee_keep);
+    for (size_t t0 = 0; t0 < frames; t0 += BLOCK) {
+        const size_t n = frames - t0 < BLOCK ? frames - t0 : BLOCK;
+        double bends[BLOCK];
+        knee_block(leg, n, angles + 12 * t0, axis, opt->knee_soft, opt->knee_keep, reaches + t0, bends);
+        for (size_t f = 0; f < n; f++)
+            sides += (bends[f] > 0) - (bends[f] < 0);
     }
     memcpy(knee, axis, sizeof axis);
     knee[3] = sides >= 0 ? 1.0 : -1.0;
@@ -1002,91 +1266,131 @@ int mt_footskate_root(size_t legs, size_t frames, const double *hips, const doub
 
 /* ---------------------------------------------------------------- phases 4 and 5: the legs */
 
+/* the legs solved, over the lanes */
 struct solved {
-    double angles[12];
-    double knee_delta;  /* the turn about the knee's hinge */
-    double wanted[3][9]; /* the local rotations asked of hip, knee and ankle */
-    double foot[9];
-    double ankle[3];
+    double angles[12 * BLOCK];
+    double knee_delta[BLOCK];    /* the turn about the knee's hinge */
+    double wanted[3][9 * BLOCK]; /* the local rotations asked of hip, knee and ankle */
+    double foot[9 * BLOCK];
+    double ankle[3 * BLOCK];
 };
 
 /*
- * Two-bone IK of one frame: the knee bends about its hinge so that hip ->
- * ankle has the goal's length (within the knee's reach, never past straight,
- * to the side it bends), the hip turns the leg onto the goal, the ankle
- * takes foot_goal (its aim exactly, with fewer than three channels).  Joints
- * that take the rotation asked exactly (three channels; a one-channel knee
- * turning about its channel's axis) are left for finish_angles: a foot
+ * Two-bone IK over the lanes (angles: 12 over them; local0, local1: the hip's
+ * and the knee's local rotations now): the knee bends about its hinge so that
+ * hip -> ankle has the goal's length (within the knee's reach, never past
+ * straight, to the side it bends), the hip turns the leg onto the goal, the
+ * ankle takes foot_goal (its aim exactly, with fewer than three channels).
+ * Joints that take the rotation asked exactly (three channels; a one-channel
+ * knee turning about its channel's axis) are left for finish_angles_n: a foot
  * re-aimed solves the leg again, and their Euler angles are needed once.
  */
-static void two_bone(const struct mt_leg *leg, const double *hip, const double *parent, const double *angles,
-                     const struct leg_pose *pose, const struct hinge *h, const double *knee, double soft,
-                     const double *ankle_goal, const double *foot_goal, const double *aim, struct solved *out)
+static MT_INLINE void two_bone_n(const struct mt_leg *leg, const double *hip, const double *parent,
+                                 const double *angles, const double *local0, const double *local1,
+                                 const struct hinge *h, const double *knee, double soft, const double *ankle_goal,
+                                 const double *foot_goal, const double *aim, struct solved *out, int n)
 {
-    const double *s1 = leg->segment[0], *s2 = leg->segment[1];
-    memcpy(out->angles, angles, sizeof out->angles);
-    double goal[3];
+    double s1[3 * BLOCK], s2[3 * BLOCK], axis[3 * BLOCK], goal[3 * BLOCK], longest[BLOCK], cosine[BLOCK];
+    double bend[BLOCK], c[BLOCK], s[BLOCK], r[9 * BLOCK], knee_local[9 * BLOCK], thigh[9 * BLOCK], shin[9 * BLOCK];
+    double v[3 * BLOCK], leg_vector[3 * BLOCK], world[3 * BLOCK], hip_local[9 * BLOCK];
+    double sines[3 * BLOCK], cosines[3 * BLOCK];
+    spread_n(leg->segment[0], 3, s1, n);
+    spread_n(leg->segment[1], 3, s2, n);
+    spread_n(knee, 3, axis, n);
+    memcpy(out->angles, angles, 12 * (size_t)n * sizeof *angles);
     for (int e = 0; e < 3; e++)
-        goal[e] = ankle_goal[e] - hip[e];
-    const double longest = reach(*h, soft, 0.0), low2 = h->base - 2 * h->rho;
-    const double shortest = sqrt(low2 > 0 ? low2 : 0.0);
-    const double d = clip(norm3(goal), shortest, longest);
-    const double cosine = clip((d * d - h->base) / (2 * (h->rho > tiny ? h->rho : 1.0)), -1.0, 1.0);
-    const double bend = h->rho > tiny ? acos(cosine) : 0.0;
-    double r[9], knee_local[9], thigh[9], shin[9], v[3], leg_vector[3], world[3], hip_local[9], sines[3], cosines[3];
-    out->knee_delta = h->phi + knee[3] * bend;
-    /* cos and sin of phi + side bend by the angle sums: phi's from the hinge, bend's from its cosine */
-    const double sin_bend = sqrt(1 - cosine * cosine) * (h->rho > tiny), cos_bend = h->rho > tiny ? cosine : 1.0;
-    about_cs(knee, h->cos_phi * cos_bend - knee[3] * h->sin_phi * sin_bend,
-             h->sin_phi * cos_bend + knee[3] * h->cos_phi * sin_bend, r);
-    mat_mul(r, pose->local[1], out->wanted[1]);
+        for (int l = 0; l < n; l++)
+            goal[e * n + l] = ankle_goal[e * n + l] - hip[e * n + l];
+    reach_n(h, soft, 0.0, longest, n);
+    for (int l = 0; l < n; l++) {
+        const double low2 = h->base[l] - 2 * h->rho[l], shortest = sqrt(low2 > 0 ? low2 : 0.0);
+        const double d = clip(sqrt(goal[l] * goal[l] + goal[n + l] * goal[n + l] + goal[2 * n + l] * goal[2 * n + l]),
+                              shortest, longest[l]);
+        cosine[l] = clip((d * d - h->base[l]) / (2 * (h->rho[l] > tiny ? h->rho[l] : 1.0)), -1.0, 1.0);
+    }
+    acos_n(cosine, bend, n);
+    for (int l = 0; l < n; l++) {
+        const int bends = h->rho[l] > tiny;
+        bend[l] = bends ? bend[l] : 0.0;
+        out->knee_delta[l] = h->phi[l] + knee[3] * bend[l];
+        /* cos and sin of phi + side bend by the angle sums: phi's from the hinge, bend's from its cosine */
+        const double sin_bend = sqrt(1 - cosine[l] * cosine[l]) * bends, cos_bend = bends ? cosine[l] : 1.0;
+        c[l] = h->cos_phi[l] * cos_bend - knee[3] * h->sin_phi[l] * sin_bend;
+        s[l] = h->sin_phi[l] * cos_bend + knee[3] * h->cos_phi[l] * sin_bend;
+    }
+    about_cs_n(axis, c, s, r, n);
+    mat_mul_n(r, local1, out->wanted[1], n);
     if (channels(leg, 1) == 2) {
-        realize(leg, 1, out->wanted[1], s2, angles + 3, out->angles + 3, sines, cosines);
-        local_rotation_of(leg, 1, sines, cosines, knee_local);
+        realize_n(leg, 1, out->wanted[1], s2, angles + 3 * n, out->angles + 3 * n, sines, cosines, n);
+        local_rotation_of_n(leg, 1, sines, cosines, knee_local, n);
     } else {
-        memcpy(knee_local, out->wanted[1], sizeof knee_local);
+        memcpy(knee_local, out->wanted[1], 9 * (size_t)n * sizeof *knee_local);
     }
-    mat_mul(parent, pose->local[0], thigh);
-    mat_vec(knee_local, s2, v);
-    for (int e = 0; e < 3; e++)
+    mat_mul_n(parent, local0, thigh, n);
+    mat_vec_n(knee_local, s2, v, n);
+    for (int e = 0; e < 3 * n; e++)
         leg_vector[e] = s1[e] + v[e];
-    mat_vec(thigh, leg_vector, world);
-    between(world, goal, r);
-    mat_mul(r, thigh, out->wanted[0]);
-    mat_tmul(parent, out->wanted[0], out->wanted[0]);
+    mat_vec_n(thigh, leg_vector, world, n);
+    between_n(world, goal, r, n);
+    mat_mul_n(r, thigh, out->wanted[0], n);
+    mat_tmul_n(parent, out->wanted[0], out->wanted[0], n);
     if (channels(leg, 0) < 3) {
-        realize(leg, 0, out->wanted[0], leg_vector, angles, out->angles, sines, cosines);
-        local_rotation_of(leg, 0, sines, cosines, hip_local);
+        realize_n(leg, 0, out->wanted[0], leg_vector, angles, out->angles, sines, cosines, n);
+        local_rotation_of_n(leg, 0, sines, cosines, hip_local, n);
     } else {
-        memcpy(hip_local, out->wanted[0], sizeof hip_local);
+        memcpy(hip_local, out->wanted[0], 9 * (size_t)n * sizeof *hip_local);
     }
-    mat_mul(parent, hip_local, thigh);
-    mat_mul(thigh, knee_local, shin);
-    mat_tmul(shin, foot_goal, out->wanted[2]);
+    mat_mul_n(parent, hip_local, thigh, n);
+    mat_mul_n(thigh, knee_local, shin, n);
+    mat_tmul_n(shin, foot_goal, out->wanted[2], n);
     if (channels(leg, 2) < 3) {
-        realize(leg, 2, out->wanted[2], aim, angles + 6, out->angles + 6, sines, cosines);
-        local_rotation_of(leg, 2, sines, cosines, r);
-        mat_mul(shin, r, out->foot);
+        realize_n(leg, 2, out->wanted[2], aim, angles + 6 * n, out->angles + 6 * n, sines, cosines, n);
+        local_rotation_of_n(leg, 2, sines, cosines, r, n);
+        mat_mul_n(shin, r, out->foot, n);
     } else {
-        mat_mul(shin, out->wanted[2], out->foot);
+        mat_mul_n(shin, out->wanted[2], out->foot, n);
     }
-    double a[3], b[3];
-    mat_vec(thigh, s1, a);
-    mat_vec(shin, s2, b);
-    for (int e = 0; e < 3; e++)
+    double a[3 * BLOCK], b[3 * BLOCK];
+    mat_vec_n(thigh, s1, a, n);
+    mat_vec_n(shin, s2, b, n);
+    for (int e = 0; e < 3 * n; e++)
         out->ankle[e] = hip[e] + a[e] + b[e];
 }
 
-/* The Euler angles two_bone left: joints of three channels, and a one-channel knee (its angle plus
+/* The Euler angles two_bone_n left: joints of three channels, and a one-channel knee (its angle plus
  * the turn about its hinge, which is its channel's axis). */
-static void finish_angles(const struct mt_leg *leg, const double *angles, const double *aim, struct solved *solved)
+static MT_INLINE void finish_angles_n(const struct mt_leg *leg, const double *angles, const double *aim,
+                                      struct solved *solved, int n)
 {
-    double sines[3], cosines[3];
+    double sines[3 * BLOCK], cosines[3 * BLOCK];
     for (int j = 0; j < 3; j++)
         if (channels(leg, j) == 3)
-            realize(leg, j, solved->wanted[j], aim, angles + 3 * j, solved->angles + 3 * j, sines, cosines);
+            realize_n(leg, j, solved->wanted[j], aim, angles + 3 * j * n, solved->angles + 3 * j * n, sines,
+                      cosines, n);
     if (channels(leg, 1) == 1)
-        solved->angles[3] = angles[3] + wrap(solved->knee_delta);
+        for (int l = 0; l < n; l++)
+            solved->angles[3 * n + l] = angles[3 * n + l] + wrap(solved->knee_delta[l]);
+}
+
+/* how far the lower of heel and ball, of feet at ankle turned to foot, are above where they rest */
+static MT_INLINE void foot_low_n(const struct mt_leg *leg, const double *ankle, const double *foot,
+                                 const double *clearance, const struct mt_footskate *opt, double *out, int n)
+{
+    double heel[3 * BLOCK], ball[3 * BLOCK];
+    spread_n(leg->segment[3], 3, heel, n);
+    spread_n(leg->segment[2], 3, ball, n);
+    mat_vec_n(foot, heel, heel, n);
+    mat_vec_n(foot, ball, ball, n);
+    const double g[3] = {opt->up[0] - opt->slope[0], opt->up[1] - opt->slope[1], opt->up[2] - opt->slope[2]};
+    for (int l = 0; l < n; l++) {
+        double low[2];
+        for (int k = 0; k < 2; k++) {
+            const double *v = k == HEEL ? heel : ball;
+            const double p0 = ankle[l] + v[l], p1 = ankle[n + l] + v[n + l], p2 = ankle[2 * n + l] + v[2 * n + l];
+            low[k] = p0 * g[0] + p1 * g[1] + p2 * g[2] - opt->level - clearance[k];
+        }
+        out[l] = low[HEEL] < low[BALL] ? low[HEEL] : low[BALL];
+    }
 }
 
 /* the toe angles that raise a toe tip below the floor onto it, about the toe joint's axis */
@@ -1110,9 +1414,11 @@ static void bend_toes(const struct mt_leg *leg, const double *foot, const double
     mat_tvec(foot, n, k); /* the height's gradient in the foot's frame */
     mat_vec(toe_local, t, u);
     cross3(axis, u, au);
-    const double c0 = dot3(k, axis) * dot3(u, axis), x = dot3(k, u) - c0, y = dot3(k, au);
-    const double rho = length2(x, y), phi = atan2(y, x), base = height(opt, ball);
-    if (!(base + dot3(k, u) < clearance_tip && rho > tiny))
+    const double c0 = dot3(k, axis) * dot3(u, axis), base = height(opt, ball);
+    if (!(base + dot3(k, u) < clearance_tip))
+        return;
+    const double x = dot3(k, u) - c0, y = dot3(k, au), rho = length2(x, y), phi = atan2(y, x);
+    if (!(rho > tiny))
         return;
     const double need = clearance_tip - base - c0; /* rho cos(delta - phi) must reach this */
     const double spread = acos(clip(need / rho, -1.0, 1.0));
@@ -1122,23 +1428,91 @@ static void bend_toes(const struct mt_leg *leg, const double *foot, const double
     mat_mul(r, toe_local, wanted);
     double sines[3], cosines[3];
     memcpy(ref, angles, sizeof ref);
-    realize(leg, 3, wanted, t, ref, angles, sines, cosines);
+    realize_n(leg, 3, wanted, t, ref, angles, sines, cosines, 1);
 }
 
-/* how far the lower of heel and ball, of a foot at ankle turned to foot, is above where they rest */
-static double foot_low(const struct mt_leg *leg, const double *ankle, const double *foot, const double *clearance,
-                       const struct mt_footskate *opt)
+/* What the solve of a block of frames reads (see mt_footskate_solve), and the lifts worked out before it. */
+struct solve_job {
+    const struct mt_leg *leg;
+    const struct mt_footskate *opt;
+    const double *hips, *parents, *angles, *goal, *turn, *knee, *root, *clearance, *lift_by;
+    const unsigned char *planted;
+};
+
+/*
+ * Phases 4 and 5 of frames t0 .. t0 + n - 1 side by side (n <= BLOCK; lanes
+ * past n repeat the last frame), their poses given: the legs solved, and the
+ * balls where they put them (3 over the lanes).  A lane's leg is solved again
+ * with a re-aimed or lifted goal when any lane's is; the others' goals stay,
+ * and their results with them.
+ */
+static MT_CLONES void solve_block(const struct solve_job *job, size_t t0, size_t n, const struct pose_block *pose,
+                                  struct solved *out, double *ball)
 {
-    double v[3], p[3];
-    mat_vec(foot, leg->segment[3], v);
-    for (int e = 0; e < 3; e++)
-        p[e] = ankle[e] + v[e];
-    const double heel = height(opt, p) - clearance[HEEL];
-    mat_vec(foot, leg->segment[2], v);
-    for (int e = 0; e < 3; e++)
-        p[e] = ankle[e] + v[e];
-    const double ball = height(opt, p) - clearance[BALL];
-    return heel < ball ? heel : ball;
+    enum { L = BLOCK };
+    const struct mt_leg *leg = job->leg;
+    const struct mt_footskate *opt = job->opt;
+    double hip[3 * L], parent[9 * L], angles[12 * L], first[3 * L], target[3 * L], turn[3 * L], q[9 * L];
+    double foot_goal[9 * L], aim[3 * L], low[L];
+    size_t row[L];
+    int some[L], any_some = 0, sinking = 0;
+    for (size_t l = 0; l < L; l++) {
+        const size_t t = row[l] = t0 + (l < n ? l : n - 1);
+        for (int e = 0; e < 3; e++) {
+            hip[e * L + l] = job->hips[3 * t + e] + job->root[3 * t + e];
+            first[e * L + l] = job->goal[3 * t + e] + job->lift_by[t] * opt->up[e];
+            turn[e * L + l] = job->turn[3 * t + e];
+        }
+        for (int e = 0; e < 9; e++)
+            parent[e * L + l] = job->parents[9 * t + e];
+        for (int c = 0; c < 12; c++)
+            angles[c * L + l] = job->angles[12 * t + c];
+        some[l] = job->planted[2 * t] || job->planted[2 * t + 1];
+        any_some |= some[l];
+    }
+    for (int e = 0; e < 3; e++) /* heel -> ball: what a two-channel ankle keeps */
+        for (int l = 0; l < L; l++)
+            aim[e * L + l] = leg->segment[2][e] - leg->segment[3][e];
+    const double *local0 = pose->local[0], *local1 = pose->local[1];
+    rotvec_exp_n(turn, q, L);
+    mat_mul_n(q, pose->foot, foot_goal, L);
+    struct hinge h;
+    hinge_n(leg, local1, job->knee, &h, L);
+    two_bone_n(leg, hip, parent, angles, local0, local1, &h, job->knee, opt->knee_soft, first, foot_goal, aim, out,
+               L);
+    memcpy(target, first, sizeof target);
+    if (channels(leg, 2) < 3 && any_some) { /* the ankle cannot roll: re-aim it so that the pivot lands */
+        double pivot[3 * L], want[3 * L], got[3 * L]; /* once: the miss after it is a few micrometres */
+        for (int l = 0; l < L; l++) {
+            const double *p = leg->segment[job->planted[2 * row[l]] ? 3 : 2];
+            for (int e = 0; e < 3; e++)
+                pivot[e * L + l] = p[e];
+        }
+        mat_vec_n(foot_goal, pivot, want, L);
+        mat_vec_n(out->foot, pivot, got, L);
+        for (int e = 0; e < 3; e++)
+            for (int l = 0; l < L; l++)
+                target[e * L + l] = some[l] ? first[e * L + l] + want[e * L + l] - got[e * L + l] : target[e * L + l];
+        two_bone_n(leg, hip, parent, angles, local0, local1, &h, job->knee, opt->knee_soft, target, foot_goal, aim,
+                   out, L);
+    }
+    /* what the leg could not quite reach is lifted frame by frame */
+    foot_low_n(leg, out->ankle, out->foot, job->clearance, opt, low, L);
+    for (int l = 0; l < L; l++)
+        if (!some[l] && low[l] < 0) {
+            for (int e = 0; e < 3; e++)
+                target[e * L + l] -= low[l] * opt->up[e];
+            sinking = 1;
+        }
+    if (sinking)
+        two_bone_n(leg, hip, parent, angles, local0, local1, &h, job->knee, opt->knee_soft, target, foot_goal, aim,
+                   out, L);
+    finish_angles_n(leg, angles, aim, out, L);
+    double s2[3 * L];
+    spread_n(leg->segment[2], 3, s2, L);
+    mat_vec_n(out->foot, s2, s2, L);
+    for (int e = 0; e < 3 * L; e++)
+        ball[e] = out->ankle[e] + s2[e];
 }
 
 int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hips, const double *parents,
@@ -1198,63 +1572,231 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
         lift_by[t] = planted[2 * t] || planted[2 * t + 1] ? 0.0 : best;
     }
     free(bump);
-    double aim[3];
-    for (int e = 0; e < 3; e++)
-        aim[e] = leg->segment[2][e] - leg->segment[3][e]; /* heel -> ball: what a two-channel ankle keeps */
-    for (size_t t = 0; t < frames; t++) {
-        const unsigned char *now = planted + 2 * t;
-        const int some = now[HEEL] || now[BALL];
-        const double *r = root + 3 * t;
-        double *result = out + 12 * t, foot_now[9], ball_now[3];
-        memcpy(result, angles + 12 * t, 12 * sizeof *result);
-        const int todo = some || weight[t] > 0 || r[0] != 0 || r[1] != 0 || r[2] != 0 || lift_by[t] > 0;
-        if (!todo && !(height(opt, points + 15 * t + 12) < clearance[2]))
-            continue; /* untouched, toes above the floor */
-        struct leg_pose pose;
-        leg_fk(leg, hips + 3 * t, parents + 9 * t, angles + 12 * t, &pose);
-        memcpy(foot_now, pose.foot, sizeof foot_now);
-        memcpy(ball_now, pose.point[2], sizeof ball_now);
-        if (todo) {
-            double hip[3], q[9], foot_goal[9], first[3], target[3];
-            for (int e = 0; e < 3; e++) {
-                hip[e] = hips[3 * t + e] + r[e];
-                first[e] = goal[3 * t + e] + lift_by[t] * opt->up[e];
-            }
-            rotvec_exp(turn + 3 * t, q);
-            mat_mul(q, pose.foot, foot_goal);
-            struct solved solved;
-            const struct hinge h = hinge_of(leg, pose.local[1], knee);
-            two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, first, foot_goal,
-                     aim, &solved);
-            memcpy(target, first, sizeof target);
-            if (channels(leg, 2) < 3 && some) { /* the ankle cannot roll: re-aim it so that the pivot lands */
-                const double *pivot = leg->segment[now[HEEL] ? 3 : 2];
-                double want[3], got[3]; /* once: the miss after it is a few micrometres */
-                mat_vec(foot_goal, pivot, want);
-                mat_vec(solved.foot, pivot, got);
-                for (int e = 0; e < 3; e++)
-                    target[e] = first[e] + want[e] - got[e];
-                two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, target,
-                         foot_goal, aim, &solved);
-            }
-            /* what the leg could not quite reach is lifted frame by frame */
-            const double low = foot_low(leg, solved.ankle, solved.foot, clearance, opt);
-            if (!some && low < 0) {
-                for (int e = 0; e < 3; e++)
-                    target[e] -= low * opt->up[e];
-                two_bone(leg, hip, parents + 9 * t, angles + 12 * t, &pose, &h, knee, opt->knee_soft, target,
-                         foot_goal, aim, &solved);
-            }
-            finish_angles(leg, angles + 12 * t, aim, &solved);
-            memcpy(result, solved.angles, sizeof solved.angles);
-            memcpy(foot_now, solved.foot, sizeof foot_now);
-            double v[3];
-            mat_vec(solved.foot, leg->segment[2], v);
-            for (int e = 0; e < 3; e++)
-                ball_now[e] = solved.ankle[e] + v[e];
+    const struct solve_job job = {leg,  opt,  hips, parents,   angles,  goal,
+                                  turn, knee, root, clearance, lift_by, planted};
+    memcpy(out, angles, 12 * frames * sizeof *out);
+    for (size_t t0 = 0; t0 < frames; t0 += BLOCK) {
+        const size_t n = frames - t0 < BLOCK ? frames - t0 : BLOCK;
+        /* frames to solve, frames with the toe tip below the floor */
+        int todo[BLOCK], low_toes[BLOCK], solving = 0, touched = 0;
+        for (size_t f = 0; f < n; f++) {
+            const size_t t = t0 + f;
+            const double *r = root + 3 * t;
+            todo[f] = planted[2 * t] || planted[2 * t + 1] || weight[t] > 0 || r[0] != 0 || r[1] != 0 || r[2] != 0 ||
+                      lift_by[t] > 0;
+            low_toes[f] = height(opt, points + 15 * t + 12) < clearance[2];
+            solving |= todo[f];
+            touched |= todo[f] || low_toes[f];
         }
-        bend_toes(leg, foot_now, ball_now, pose.local[3], clearance[2], opt, result + 9);
+        if (!touched)
+            continue; /* untouched, toes above the floor */
+        struct pose_block pose;
+        struct solved solved;
+        double ball[3 * BLOCK];
+        pose_block(leg, n, hips + 3 * t0, parents + 9 * t0, angles + 12 * t0, &pose);
+        if (solving)
+            solve_block(&job, t0, n, &pose, &solved, ball);
+        for (size_t f = 0; f < n; f++) {
+            if (!todo[f] && !low_toes[f])
+                continue;
+            double *result = out + 12 * (t0 + f), foot_now[9], ball_now[3], toe_local[9];
+            for (int e = 0; e < 9; e++) {
+                foot_now[e] = todo[f] ? solved.foot[e * BLOCK + f] : pose.foot[e * BLOCK + f];
+                toe_local[e] = pose.local[3][e * BLOCK + f];
+            }
+            for (int e = 0; e < 3; e++)
+                ball_now[e] = todo[f] ? ball[e * BLOCK + f] : pose.point[2][e * BLOCK + f];
+            if (todo[f])
+                for (int c = 0; c < 12; c++)
+                    result[c] = solved.angles[c * BLOCK + f];
+            bend_toes(leg, foot_now, ball_now, toe_local, clearance[2], opt, result + 9);
+        }
     }
     free(lift_by);
+    return MT_OK;
+}
+
+/* ---------------------------------------------------------------- the channels */
+
+int mt_footskate_write(size_t legs, size_t frames, size_t channels, const double *values, const double *angles,
+                       const double *solved, const long long *columns, double angle_scale, const double *root,
+                       const long long *root_columns, double *out)
+{
+    if (legs > 2 || !columns || !root_columns || !(angle_scale != 0 && isfinite(angle_scale)))
+        return MT_EINVAL;
+    /* the slots written, as (leg, slot) and column: each column once */
+    size_t slot[24], column[27], count = 0;
+    for (size_t i = 0; i < 12 * legs; i++) {
+        if (columns[i] < -1 || columns[i] >= (long long)channels)
+            return MT_EINVAL;
+        if (columns[i] >= 0)
+            slot[count] = i, column[count++] = (size_t)columns[i];
+    }
+    for (int e = 0; e < 3; e++) {
+        if (root_columns[e] < 0 || root_columns[e] >= (long long)channels)
+            return MT_EINVAL;
+        column[count + (size_t)e] = (size_t)root_columns[e];
+    }
+    for (size_t a = 0; a < count + 3; a++)
+        for (size_t b = 0; b < a; b++)
+            if (column[a] == column[b])
+                return MT_EINVAL;
+    if (frames == 0)
+        return MT_OK;
+    if (!values || !out || (count > 0 && (!angles || !solved)) || !root)
+        return MT_EINVAL;
+    for (size_t t = 0; t < frames; t++) {
+        const double *in = values + t * channels;
+        double *row = out + t * channels;
+        memcpy(row, in, channels * sizeof *row);
+        for (size_t k = 0; k < count; k++) {
+            const size_t at = ((slot[k] / 12) * frames + t) * 12 + slot[k] % 12;
+            if (solved[at] != angles[at])
+                row[column[k]] = solved[at] / angle_scale;
+        }
+        for (int e = 0; e < 3; e++)
+            if (root[3 * t + e] != 0)
+                row[column[count + (size_t)e]] = in[column[count + (size_t)e]] + root[3 * t + e];
+    }
+    return MT_OK;
+}
+
+/* ---------------------------------------------------------------- speeds */
+
+/* the larger, NaN if either is (as numpy.maximum) */
+static double nan_max(double a, double b)
+{
+    return a != a || b != b ? a + b : a > b ? a : b;
+}
+
+/* |a - b| * rate, scaled by half for a central difference */
+static double step_length(const double *a, const double *b, double half, double rate)
+{
+    const double x = (a[0] - b[0]) / half, y = (a[1] - b[1]) / half, z = (a[2] - b[2]) / half;
+    return sqrt(x * x + y * y + z * z) * rate;
+}
+
+int mt_point_speeds(const double *points, size_t tracks, size_t frames, size_t per_frame, const size_t *which,
+                    size_t count, double rate, double *speed, double *central)
+{
+    if (tracks == 0 || frames == 0 || count == 0)
+        return MT_OK;
+    if (!points || !which || !speed)
+        return MT_EINVAL;
+    for (size_t k = 0; k < count; k++)
+        if (which[k] >= per_frame)
+            return MT_EINVAL;
+    for (size_t i = 0; i < tracks; i++)
+        for (size_t k = 0; k < count; k++) {
+            const double *p = points + 3 * (i * frames * per_frame + which[k]);
+            double *s = speed + (i * count + k) * frames, *c = central ? central + (i * count + k) * frames : NULL;
+            const size_t stride = 3 * per_frame;
+            if (frames == 1) {
+                s[0] = 0.0;
+                if (c)
+                    c[0] = 0.0;
+                continue;
+            }
+            /* the step before frame t, kept from the last frame's step after it */
+            double before = step_length(p + stride, p, 1.0, rate);
+            s[0] = before;
+            for (size_t t = 1; t + 1 < frames; t++) {
+                const double after = step_length(p + (t + 1) * stride, p + t * stride, 1.0, rate);
+                s[t] = nan_max(after, before);
+                before = after;
+            }
+            s[frames - 1] = before;
+            if (!c)
+                continue;
+            c[0] = s[0];
+            for (size_t t = 1; t + 1 < frames; t++)
+                c[t] = step_length(p + (t + 1) * stride, p + (t - 1) * stride, 2.0, rate);
+            c[frames - 1] = before;
+        }
+    return MT_OK;
+}
+
+/* ---------------------------------------------------------------- footplants */
+
+struct plant_row {
+    const double *h, *speed, *central;
+    const struct mt_plant_thresholds *th;
+    unsigned char *mask;
+};
+
+static int sure_at(const struct plant_row *r, size_t t)
+{
+    return r->h[t] < r->th->sure_height && r->central[t] < r->th->sure_speed;
+}
+
+static int close_at(const struct plant_row *r, size_t t)
+{
+    return (r->h[t] < r->th->height && r->speed[t] < r->th->speed) || sure_at(r, t);
+}
+
+static int firm_at(const struct plant_row *r, size_t t)
+{
+    return (r->h[t] < r->th->firm_height && r->speed[t] < r->th->firm_speed) || sure_at(r, t);
+}
+
+/* plant [s, e): cut back to its still frames, kept if long enough or sure somewhere */
+static void finish_plant(const struct plant_row *r, size_t s, size_t e)
+{
+    double lowest = r->h[s];
+    for (size_t t = s + 1; t < e; t++) /* as numpy.minimum: NaN if any is */
+        lowest = lowest != lowest || r->h[t] != r->h[t] ? lowest + r->h[t] : r->h[t] < lowest ? r->h[t] : lowest;
+    size_t first = e, last = s;
+    for (size_t t = s; t < e; t++)
+        if (r->h[t] <= lowest + r->th->rise || sure_at(r, t)) {
+            first = first < t ? first : t;
+            last = t + 1;
+        }
+    if (last <= first)
+        return;
+    int sure = 0;
+    for (size_t t = first; t < last && !sure; t++)
+        sure = sure_at(r, t);
+    if (last - first >= r->th->shortest || sure)
+        memset(r->mask + first, 1, last - first);
+}
+
+int mt_plant_masks(const double *heights, const double *speed, const double *central, size_t rows, size_t n,
+                   const struct mt_plant_thresholds *th, unsigned char *mask)
+{
+    if (!th)
+        return MT_EINVAL;
+    if (rows == 0 || n == 0)
+        return MT_OK;
+    if (!heights || !speed || !central || !mask)
+        return MT_EINVAL;
+    for (size_t i = 0; i < rows; i++) {
+        const struct plant_row r = {heights + i * n, speed + i * n, central + i * n, th, mask + i * n};
+        memset(r.mask, 0, n);
+        int open = 0; /* a plant [s, e) is being gathered */
+        size_t s = 0, e = 0;
+        for (size_t t = 0; t < n;) {
+            if (!close_at(&r, t)) {
+                t++;
+                continue;
+            }
+            size_t end = t, firm = 0; /* the run of close frames [t, end) */
+            for (; end < n && close_at(&r, end); end++)
+                firm += (size_t)firm_at(&r, end);
+            if (firm) {
+                int slow = open && t - e <= th->gap;
+                for (size_t u = e; slow && u < t; u++)
+                    slow = r.speed[u] < th->merge_speed;
+                if (!slow) {
+                    if (open)
+                        finish_plant(&r, s, e);
+                    s = t, open = 1;
+                }
+                e = end;
+            }
+            t = end;
+        }
+        if (open)
+            finish_plant(&r, s, e);
+    }
     return MT_OK;
 }

@@ -659,6 +659,60 @@ int mt_footskate_solve(const struct mt_leg *leg, size_t frames, const double *hi
                        const double *goal, const double *turn, const double *weight, const double *knee,
                        const double *root, const double *clearance, const struct mt_footskate *opt,
                        double *out);
+
+/*
+ * Footplant detection (motiontheater.contacts) over rows of n frames: the
+ * thresholds, already in the samples' units and scaled.
+ */
+struct mt_plant_thresholds {
+    double sure_height, sure_speed;   /* sure: height < sure_height and central < sure_speed */
+    double height, speed;             /* close: height < height and speed < speed, or sure */
+    double firm_height, firm_speed;   /* firm: likewise, or sure (firm frames are close) */
+    double merge_speed;               /* plants gap frames apart merge when every frame between is slower */
+    double rise;                      /* a plant's ends more than this above its lowest frame are cut */
+    size_t gap, shortest;             /* frames */
+};
+
+/*
+ * The footplants of rows of samples (heights, speed, central: rows x n;
+ * mask: rows x n, 1 planted, 0 not).  A plant is a run of close frames
+ * holding a firm one; plants whose gap is at most th->gap frames merge when
+ * every frame of the gap has speed < merge_speed; each plant's first and
+ * last frames are cut back to those at most rise above its lowest height
+ * (the minimum over the plant, gaps included; NaN if any is NaN) or sure;
+ * plants shorter than th->shortest frames then are dropped unless they hold
+ * a sure frame.  NaN compares false.
+ */
+int mt_plant_masks(const double *heights, const double *speed, const double *central, size_t rows, size_t n,
+                   const struct mt_plant_thresholds *th, unsigned char *mask);
+
+/*
+ * Speeds of points over frames, in their unit per second (rate: frames per
+ * second).  points: tracks x frames x per_frame x 3, of which the points
+ * which[0 .. count-1] (< per_frame) of each frame are measured; speed
+ * (tracks x count x frames): the larger of the distances to the frames
+ * before and after, times rate (so that neither difference quotient finds
+ * the point faster); central (the same, or NULL): the length of the central
+ * difference (p[t+1] - p[t-1]) / 2, one-sided at the ends, times rate.  A
+ * single frame has speed 0; NaN in, NaN out.
+ */
+int mt_point_speeds(const double *points, size_t tracks, size_t frames, size_t per_frame, const size_t *which,
+                    size_t count, double rate, double *speed, double *central);
+
+/*
+ * The cleanup written back to the channels of a motion (values, out: frames
+ * x channels; out may not alias values): out is values but where a leg's
+ * solved angle differs from its input angle (angles, solved: legs x frames x
+ * 12, as mt_footskate_solve takes and gives them), written to its column as
+ * solved / angle_scale (columns: legs x 12, the column of each slot or -1
+ * for none), and in the root's translation columns (root_columns, 3), to
+ * which root (frames x 3) is added where it is not 0 (so that a -0.0 stays).
+ * Every other value is copied bit for bit.  The columns given must be
+ * distinct and below channels, else MT_EINVAL.
+ */
+int mt_footskate_write(size_t legs, size_t frames, size_t channels, const double *values, const double *angles,
+                       const double *solved, const long long *columns, double angle_scale, const double *root,
+                       const long long *root_columns, double *out);
 /*
  * Retargeting (retarget.c): a motion of a source skeleton as the rotation
  * channels of a target skeleton.

@@ -293,6 +293,10 @@ def test_the_cleanup_holds_its_bounds(take, state):
     assert report.worst("sliding_max_mm") <= 5.0
     assert report.worst("penetration_mm") <= 5.0
     assert report.worst("float_mm") <= 1.0
+    # the issue's skating ratio on the detected plants; 0 before the cleanup too, by construction (detection
+    # plants no point faster than 0.45 m/s, skating needs 0.5): a table that plants moving feet shows it counts
+    # (test_the_planted_skating_ratio_counts_plants_over_a_swing)
+    assert report.worst("planted_skating_ratio") <= 0.01
     # only the root's translation and the legs' joints change
     others = [c for c in range(motion.values.shape[1]) if c not in channels_of_legs(motion, legs)]
     np.testing.assert_array_equal(result.motion.values[:, others], motion.values[:, others])
@@ -384,6 +388,28 @@ def test_the_skating_ratio_is_the_papers(rng):
             skating |= low[:-1] & low[1:] & (speed > 0.5) & (mean > 0.5)
         assert foot.skating_ratio == pytest.approx(skating.mean(), abs=1e-12)
         assert 0.1 < foot.skating_ratio < 0.5  # a walk's swing passes the floor low and fast
+
+
+def test_the_planted_skating_ratio_counts_plants_over_a_swing():
+    # a ball plant laid over the start of each foot's swing (low and fast after push-off): it skates there
+    # before the cleanup, and the cleanup holds it
+    motion, result, mpu = cleaned("16_15", "as captured")
+    table = result.contacts
+
+    def metrics(m: mt.Motion, contacts: Contacts):
+        return skate_metrics(m, contacts, legs=result.legs, ground=result.ground, meters_per_unit=mpu)
+
+    assert metrics(motion, table).worst("planted_skating_ratio") == 0  # the detected plants hold no fast point
+    swings = []
+    for foot in result.legs.feet:
+        balls = table.of(foot, "ball")
+        start = next(a.last + 1 for a, b in itertools.pairwise(balls) if b.first - a.last > 30)
+        swings.append(Plant(foot, "ball", start + 2, start + 14))
+    edited = Contacts([*table.plants, *swings], table.first_frame, table.frames)
+    before = metrics(motion, edited)
+    assert min(f.planted_skating_ratio for f in before.feet) > 0.01
+    after = metrics(clean_footskate(motion, edited, legs=result.legs).motion, edited)
+    assert after.worst("planted_skating_ratio") <= 0.01
 
 
 def test_the_metrics_of_a_sliding_take_and_of_its_cleanup():

@@ -233,10 +233,32 @@ def test_bad_arguments_raise_before_any_c_call():
         fs.cleanup([], arrays.hips, arrays.parents, arrays.angles, arrays.points, masks, masks, [], opt)
     with pytest.raises(TypeError, match="chains must be one or more LegChain"):
         fs.leg_points(["leg"], arrays.hips[:1], arrays.parents[:1], arrays.angles[:1])
+    limits = fs.PlantThresholds(0.02, 0.05, 0.03, 0.4, 0.02, 0.35, 0.4, 0.01, 12, 6)
+    with pytest.raises(ValueError, match=r"speed must have shape \(4, 517\)"):
+        fs.plant_masks(np.zeros((4, f)), np.zeros((4, f - 1)), np.zeros((4, f)), limits)
+    with pytest.raises(ValueError, match="firm_height and firm_speed must not exceed height and speed"):
+        fs.PlantThresholds(0.02, 0.05, 0.03, 0.4, 0.04, 0.35, 0.4, 0.01, 12, 6)
+    with pytest.raises(ValueError, match="which must list points below 5"):
+        fs.point_speeds(arrays.points, [3, 5], 120.0)
+    with pytest.raises(ValueError, match=r"points must have shape \(tracks, frames, per_frame, 3\)"):
+        fs.point_speeds(arrays.points[0], [0], 120.0)
+    values, solved, root = np.zeros((f, 62)), arrays.angles, np.zeros((f, 3))
+    columns = np.where(arrays.columns >= 0, arrays.columns, -1)
+    with pytest.raises(ValueError, match="columns and root_columns must be distinct columns of the 62 channels"):
+        fs.write_channels(values, arrays.angles, solved, columns, 1.0, root, columns[0, 0])
+    with pytest.raises(ValueError, match=r"solved must have shape \(1 or 2 legs, 517, 4, 3\)"):
+        fs.write_channels(values, arrays.angles, solved[:, 1:], columns, 1.0, root, [0, 1, 2])
+    with pytest.raises(ValueError, match=r"out.enforced must have shape \(516, 2, 3\)"):
+        plans = fs.plan_leg(chain, arrays.angles[0], arrays.points[0], masks[0], np.zeros((f, 2, 3)), [0, 0, 0], opt)
+        fs.plan_leg(
+            chain, arrays.angles[0, 1:], arrays.points[0, 1:], masks[0, 1:], np.zeros((f - 1, 2, 3)), [0, 0, 0], opt,
+            out=plans,
+        )  # fmt: skip
 
 
 def test_the_c_kernels_check_their_arguments_again():
     opt = fs.CleanupOptions().struct()
+    limits = fs.PlantThresholds(0.02, 0.05, 0.03, 0.4, 0.02, 0.35, 0.4, 0.01, 12, 6)
     leg = ffi.new("struct mt_leg *")
     for j in range(4):
         leg.axes[j] = [0, -1, -1]
@@ -248,3 +270,16 @@ def test_the_c_kernels_check_their_arguments_again():
     assert lib.mt_footskate_root(3, 1, buf, buf, buf, buf, opt, buf) == lib.MT_EINVAL
     opt.up = [0, 0, 0]
     assert lib.mt_footskate_root(1, 1, buf, buf, buf, buf, opt, buf) == lib.MT_EINVAL
+    mask = ffi.new("unsigned char[8]")
+    assert lib.mt_plant_masks(buf, buf, buf, 1, 8, ffi.NULL, mask) == lib.MT_EINVAL
+    assert lib.mt_plant_masks(buf, ffi.NULL, buf, 1, 8, limits.struct(), mask) == lib.MT_EINVAL
+    assert lib.mt_point_speeds(buf, 1, 2, 5, [5], 1, 1.0, buf, ffi.NULL) == lib.MT_EINVAL
+    assert lib.mt_point_speeds(buf, 1, 2, 5, [4], 1, 1.0, ffi.NULL, ffi.NULL) == lib.MT_EINVAL
+    columns = ffi.new("long long[24]", [-1] * 24)
+    assert lib.mt_footskate_write(1, 1, 8, buf, buf, buf, columns, 1.0, buf, [0, 1, 2], buf) == lib.MT_OK
+    columns[5] = 1  # the root's column too
+    assert lib.mt_footskate_write(1, 1, 8, buf, buf, buf, columns, 1.0, buf, [0, 1, 2], buf) == lib.MT_EINVAL
+    columns[5] = 8  # past the channels
+    assert lib.mt_footskate_write(1, 1, 8, buf, buf, buf, columns, 1.0, buf, [0, 1, 2], buf) == lib.MT_EINVAL
+    columns[5] = -1
+    assert lib.mt_footskate_write(1, 1, 8, buf, buf, buf, columns, 0.0, buf, [0, 1, 2], buf) == lib.MT_EINVAL

@@ -713,10 +713,12 @@ def build_parser() -> argparse.ArgumentParser:
         description=(
             "Measure how much a take's planted feet slide (mm from where each plant began), how often "
             "they skate (the motion-generation papers' ratio: a foot within 5 cm of the floor moving faster "
-            "than 0.5 m/s, which a walk's swing does too), how deep they go below the floor and how high "
-            "planted points float. The plants are detected unless --contacts gives a table; the floor is "
-            "fitted unless --floor gives its level. Prints a Markdown table, or JSON. To measure what a "
-            "cleanup did, give both takes the same table: detection on the cleaned take finds other plants."
+            "than 0.5 m/s, which a walk's swing does too, and the same over the steps in which a point is "
+            "planted: 0 on the plants detected on the take itself, which hold no point that fast), how deep "
+            "they go below the floor and how high planted points float. The plants are detected unless "
+            "--contacts gives a table; the floor is fitted unless --floor gives its level. Prints a Markdown "
+            "table, or JSON. To measure what a cleanup did, give both takes the same table: detection on the "
+            "cleaned take finds other plants."
         ),
         epilog=(
             "Example: motiontheater contacts 07_05-walk.amc -o plants.csv && motiontheater cleanup "

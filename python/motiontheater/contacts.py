@@ -18,7 +18,7 @@ holds a frame faster than 0.45 m/s by the larger difference (or 5 cm/s by
 the central one).  Thresholds are in
 metres, m/s and seconds at the reference leg length (0.85 m hip to ankle),
 multiplied by :func:`~motiontheater.legs.body_scale`; frames come from the
-frame rate.
+frame rate.  The runs are found in C (:func:`mtcore.footskate.plant_masks`).
 
 The result is a :class:`Contacts` table: one row per plant (foot, point,
 first frame, last frame), which users read, edit and give back as CSV::
@@ -41,9 +41,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mtcore import footskate as kernels
+
 from ._io import Source, decode, encode, output, read_source
 from .errors import FormatError, UnknownNameError
-from .legs import Legs, body_scale, speeds
+from .legs import Legs, body_scale
 
 PLANT_POINTS = ("heel", "ball")
 _HEADER = "# motiontheater contacts: frames {first}..{last} at {rate:g} Hz"
@@ -232,8 +234,10 @@ def _check_range(comment: str, first_frame: int, frames: int) -> None:
 
 def runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Starts and ends (exclusive) of the runs of True in a 1-d mask."""
-    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
-    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    padded = np.zeros(len(mask) + 2, bool)
+    padded[1:-1] = mask
+    edges = np.flatnonzero(padded[1:] != padded[:-1])  # where runs start and end, in turn
+    return edges[::2], edges[1::2]
 
 
 @dataclass(frozen=True)
@@ -279,45 +283,32 @@ def detect_masks(
     th = thresholds
     unit = scale / meters_per_unit
     fastest = FASTEST / meters_per_unit
-    sure = (heights < SURE_HEIGHT / meters_per_unit) & (central < SURE_SPEED / meters_per_unit)
-    close = (heights < th.height * unit) & (speed < min(th.speed * unit, fastest)) | sure
-    firm = (heights < th.enter_height * unit) & (speed < min(th.enter_speed * unit, fastest)) | sure
-    slow = speed < th.merge_speed / meters_per_unit
-    rise = th.rise * unit
-    gap = round(th.gap * frame_rate)
-    shortest = round(th.min_length * frame_rate)
+    limits = kernels.PlantThresholds(
+        sure_height=SURE_HEIGHT / meters_per_unit,
+        sure_speed=SURE_SPEED / meters_per_unit,
+        height=th.height * unit,
+        speed=min(th.speed * unit, fastest),
+        firm_height=th.enter_height * unit,
+        firm_speed=min(th.enter_speed * unit, fastest),
+        merge_speed=th.merge_speed / meters_per_unit,
+        rise=th.rise * unit,
+        gap=round(th.gap * frame_rate),
+        shortest=round(th.min_length * frame_rate),
+    )
     n = heights.shape[-1]
-    rows = [a.reshape(-1, n) for a in (heights, close, firm, sure, slow)]
-    out = np.zeros(rows[0].shape, bool)
-    index = np.arange(n)
-    for r, (h, c, f, certain, moving_slowly) in enumerate(zip(*rows)):
-        starts, ends = runs(c)
-        if not len(starts):
-            continue
-        firm_count = np.add.reduceat(f.astype(np.int64), starts)
-        starts, ends = starts[firm_count > 0], ends[firm_count > 0]
-        if len(starts) > 1:  # merge short gaps that the point crosses slowly
-            fast = np.r_[0, np.cumsum(~moving_slowly)]
-            join = (starts[1:] - ends[:-1] <= gap) & (fast[starts[1:]] == fast[ends[:-1]])
-            starts, ends = starts[np.r_[True, ~join]], ends[np.r_[~join, True]]
-        if not len(starts):
-            continue
-        # cut the ends of each plant where the point has risen from it (heel strike, push-off), sure frames kept
-        bounds = np.ravel(np.column_stack([starts, ends]))
-        bounds = bounds[:-1] if bounds[-1] == n else bounds
-        plant = np.searchsorted(starts, index, side="right") - 1
-        inside = (plant >= 0) & (index < ends[np.maximum(plant, 0)])
-        lowest = np.minimum.reduceat(h, bounds)[::2]
-        still = inside & ((h <= lowest[np.maximum(plant, 0)] + rise) | certain)
-        first = np.minimum.reduceat(np.where(still, index, n), bounds)[::2]
-        last = np.maximum.reduceat(np.where(still, index, -1), bounds)[::2] + 1
-        held = np.r_[0, np.cumsum(certain)]
-        keep = (last > first) & ((last - first >= shortest) | (held[np.maximum(last, first)] > held[first]))
-        edges = np.zeros(n + 1, np.int64)
-        np.add.at(edges, first[keep], 1)
-        np.add.at(edges, last[keep], -1)
-        out[r] = np.cumsum(edges[:-1]) > 0
-    return out.reshape(heights.shape)
+
+    def rows(a: np.ndarray) -> np.ndarray:
+        return np.reshape(a, (-1, n))
+
+    return kernels.plant_masks(rows(heights), rows(speed), rows(central), limits).reshape(heights.shape)
+
+
+def _bounds(starts: np.ndarray, ends: np.ndarray, n: int) -> np.ndarray:
+    """Indices for ufunc.reduceat over runs [start, end) of n items: every run's start and end in
+    turn (the even pieces are the runs), without an end at n, where reduceat stops anyway."""
+    bounds = np.empty(2 * len(starts), np.int64)
+    bounds[0::2], bounds[1::2] = starts, ends
+    return bounds[:-1] if len(bounds) and bounds[-1] == n else bounds
 
 
 def detect_contacts(
@@ -329,11 +320,10 @@ def detect_contacts(
     thresholds: Thresholds = DEFAULT,
 ) -> Contacts:
     """The footplants of a take's legs (:class:`~motiontheater.legs.LegArrays`) on its ground."""
-    heel_ball = arrays.points[:, :, [3, 2]]
-    heights = (ground.above(heel_ball) - ground.clearance[:, None, :2]).transpose(0, 2, 1)  # (legs, 2, frames)
-    heel_ball = heel_ball.transpose(0, 2, 1, 3)
-    speed = speeds(heel_ball, frame_rate)
-    central = speeds(heel_ball, frame_rate, central=True)
+    heights = ground.above(arrays.points[:, :, 2:4])[:, :, ::-1]  # ball, heel: heel, ball
+    heights -= ground.clearance[:, None, :2]
+    heights = heights.transpose(0, 2, 1)  # (legs, 2, frames)
+    speed, central = kernels.point_speeds(arrays.points, [3, 2], frame_rate, central=True)
     scale = body_scale(arrays.legs, meters_per_unit)
     masks = detect_masks(heights, speed, central, frame_rate, meters_per_unit, scale, thresholds).transpose(0, 2, 1)
     return Contacts.from_masks(masks, arrays.legs, first_frame, frame_rate)
@@ -349,9 +339,7 @@ def plant_targets(masks: np.ndarray, points: np.ndarray) -> np.ndarray:
             starts, ends = runs(masks[i, :, k])
             if not len(starts):
                 continue
-            bounds = np.ravel(np.column_stack([starts, ends]))
-            if bounds[-1] == frames:  # reduceat sums the last piece to the end
-                bounds = bounds[:-1]
+            bounds = _bounds(starts, ends, frames)
             means = np.add.reduceat(points[i, :, column], bounds, axis=0)[::2] / (ends - starts)[:, None]
             out[i, masks[i, :, k], k] = np.repeat(means, ends - starts, axis=0)  # planted frames, in order
     return out

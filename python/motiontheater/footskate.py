@@ -205,17 +205,9 @@ def clean_footskate(
         options,
         workers=workers,
     )
-    values = motion.values.copy()
-    frames = motion.frames
-    for i in range(len(arrays.columns)):
-        slots = np.flatnonzero(arrays.columns[i].reshape(12) >= 0)
-        solved = np.take(angles[i].reshape(frames, 12), slots, axis=1)
-        given = np.take(arrays.angles[i].reshape(frames, 12), slots, axis=1)
-        columns = arrays.columns[i].reshape(12)[slots]
-        kept = np.take(values, columns, 1)  # unchanged angles keep their channel's bits
-        _put_columns(values, columns, np.where(solved != given, solved / arrays.angle_scale, kept))
-    block = np.take(values, root_columns, 1)
-    _put_columns(values, np.asarray(root_columns), np.where(root != 0, block + root, block))  # -0.0 + 0.0 is +0.0
+    values = kernels.write_channels(
+        motion.values, arrays.angles, angles, arrays.columns, arrays.angle_scale, root, root_columns
+    )
     values.flags.writeable = False
     return Cleanup(motion.replace(values=values), table, ground, arrays.legs, root, enforced, mpu)
 
@@ -253,16 +245,6 @@ def cleanup(
         blend=blend,
         knee_soft=knee_soft,
     ).motion
-
-
-def _put_columns(values: np.ndarray, columns: np.ndarray, block: np.ndarray) -> None:
-    """values[:, columns] = block, a slice at a time where the columns run on: a column index
-    array makes numpy gather and scatter element by element."""
-    start = 0
-    for end in range(1, len(columns) + 1):
-        if end == len(columns) or columns[end] != columns[end - 1] + 1:
-            values[:, columns[start] : columns[end - 1] + 1] = block[:, start:end]
-            start = end
 
 
 def _root_translation(motion: Motion) -> list[int]:

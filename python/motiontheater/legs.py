@@ -47,6 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mtcore import footskate as kernels
 from mtcore.kinematics import forward_kinematics
 
 from .errors import UnknownNameError
@@ -123,14 +124,24 @@ class Legs:
         return float(np.mean(np.linalg.norm(self.segments[:, :2], axis=-1).sum(axis=1)))
 
 
+_SEPARATORS = re.compile(r"[\s_.\-]")
+
+
 def _normal(name: str) -> str:
     """A joint name without namespace, case or separators: 'mixamorig:Left_Up-Leg' -> 'leftupleg'."""
-    return re.sub(r"[\s_.\-]", "", name.rsplit(":", 1)[-1]).lower()
+    return _SEPARATORS.sub("", name.rsplit(":", 1)[-1]).lower()
 
 
-def _side_part(name: str, side: str, parts: tuple[str, ...]) -> bool:
-    word = _normal(name)
-    return any(word in (s + p, p + s) for s in _SIDE_WORDS[side] for p in parts)
+# the names of a side's part: the side word before or after the part's ("lfoot", "footleft")
+_SIDE_PART_NAMES = {
+    (side, part): frozenset(w for s in _SIDE_WORDS[side] for p in words for w in (s + p, p + s))
+    for side in SIDES
+    for part, words in _PARTS.items()
+}
+
+
+def _side_part(name: str, side: str, part: str) -> bool:
+    return _normal(name) in _SIDE_PART_NAMES[side, part]
 
 
 def _turns(skeleton: Skeleton, name: str) -> bool:
@@ -164,7 +175,7 @@ def find_legs(skeleton: Skeleton, names: Sequence[str] | None = None) -> tuple[L
 
 
 def _find_leg(skeleton: Skeleton, side: str) -> Leg:
-    named = [b.name for b in skeleton.bones if not b.end_site and _side_part(b.name, side, _PARTS["ankle"])]
+    named = [b.name for b in skeleton.bones if not b.end_site and _side_part(b.name, side, "ankle")]
     below: list[str | None] = list(named)
     if skeleton.convention != "bvh":
         # an ASF bone named after the point it ends at ("LeftFoot": knee to ankle) is a shin: its foot is below
@@ -316,8 +327,16 @@ def _rest_down(rest: np.ndarray, legs: Sequence[Leg], index: dict[str, int], ske
 
 def along(p: np.ndarray, v: np.ndarray) -> np.ndarray:
     """p . v for points (..., 3) and a vector v, the dot product written out (matmul with a vector
-    takes a slow path for stacked points)."""
-    return p[..., 0] * v[0] + p[..., 1] * v[1] + p[..., 2] * v[2]
+    takes a slow path for stacked points), summed in place: on an hour of frames a temporary per
+    term is as much fresh memory again."""
+    p = np.asarray(p)
+    if p.ndim < 2:  # one point: a number
+        return p[0] * v[0] + p[1] * v[1] + p[2] * v[2]
+    out = np.multiply(p[..., 0], v[0])
+    term = np.multiply(p[..., 1], v[1])
+    out += term
+    out += np.multiply(p[..., 2], v[2], out=term)
+    return out
 
 
 def signed_axis_vector(v: np.ndarray) -> np.ndarray:
@@ -432,8 +451,6 @@ def leg_arrays(
     the legs' channels as angles, and the legs' points by ``leg_points``.  Heels the rest pose
     could not give are derived from this take (see the module docstring), along ``up``
     (:func:`choose_up`), with thresholds in metres by ``meters_per_unit`` (default the skeleton's)."""
-    from mtcore import footskate as kernels
-
     skeleton = motion.skeleton
     tree = skeleton.tree
     hips, parents = _upper_kinematics(motion.values, tree, legs)
@@ -520,19 +537,12 @@ def speeds(p: np.ndarray, frame_rate: float, *, central: bool = False) -> np.nda
     """Speed (..., frames) of points (..., frames, 3), in their unit per second: the larger of the
     distances to the frames before and after (one frame: 0), so that neither difference quotient
     finds it faster; with ``central``, the central difference (numpy.gradient's: one-sided at the
-    ends)."""
-    if p.shape[-2] < 2:
-        return np.zeros(p.shape[:-1])
-    d = np.gradient(p, axis=-2) if central else np.diff(p, axis=-2)
-    # the norm written out: numpy's norm reduces over an axis of three, several times slower
-    step = np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1] + d[..., 2] * d[..., 2])
-    step *= frame_rate
-    if central:
-        return step
-    out = np.empty(p.shape[:-1])
-    out[..., 0], out[..., -1] = step[..., 0], step[..., -1]
-    np.maximum(step[..., 1:], step[..., :-1], out=out[..., 1:-1])
-    return out
+    ends).  In C: :func:`mtcore.footskate.point_speeds`, which measures chosen points of the legs'
+    (legs, frames, 5, 3) in place."""
+    p = np.asarray(p, dtype=float)
+    tracks = p.reshape(-1, p.shape[-2], 1, 3)
+    speed = kernels.point_speeds(tracks, [0], frame_rate, central=central)
+    return (speed[1] if central else speed).reshape(p.shape[:-1])
 
 
 @dataclass(frozen=True, eq=False)
@@ -551,7 +561,9 @@ class Ground:
 
     def above(self, p: np.ndarray) -> np.ndarray:
         """Distance of points (..., 3) above the floor plane, along up."""
-        return along(p, np.asarray(self.up) - np.asarray(self.slope)) - self.level
+        out = along(p, np.asarray(self.up) - np.asarray(self.slope))
+        out -= self.level
+        return out
 
     def heights(self, points: np.ndarray) -> np.ndarray:
         """Heights (legs, frames, 3) of heel, ball and toe tip above where they rest,
@@ -593,10 +605,10 @@ def fit_ground(
         raise ValueError(f"a take of {frames} frame(s) has no resting feet to find the floor from: give more frames")
     up_vector = choose_up(arrays, up)
     scale = body_scale(legs, meters_per_unit)
-    contact = arrays.points[:, :, [3, 2, 4]]  # heel, ball, tip
+    contact = [3, 2, 4]  # heel, ball, tip among the legs' points
     has_tip = legs.points[:, 4] >= 0
-    speed = speeds(contact.transpose(0, 2, 1, 3), frame_rate).transpose(0, 2, 1) * meters_per_unit
-    vertical = along(contact, up_vector)
+    speed = kernels.point_speeds(arrays.points, contact, frame_rate).transpose(0, 2, 1) * meters_per_unit
+    vertical = along(arrays.points[:, :, 2:], up_vector)[:, :, [1, 0, 2]]  # ball, heel, tip: heel, ball, tip
     resting = speed < _REST_SPEED * scale
     needed = max(3, round(0.05 * frame_rate))
     for i in range(len(legs)):  # a point that never rests (a run on the balls): its slowest low frames
@@ -627,7 +639,7 @@ def fit_ground(
         where = where[:: -(-len(where) // _FIT_SAMPLES)]
     point_id = (where // 3 // frames) * 3 + where % 3
     ids, point = np.unique(point_id, return_inverse=True)
-    flat = contact.reshape(-1, 3)[where]
+    flat = arrays.points.reshape(-1, 5, 3)[where // 3, np.take(contact, where % 3)]
     x, y = flat[:, horizontal_axes[0]], flat[:, horizontal_axes[1]]
     z = vertical.reshape(-1)[where]
     centre = np.array([x.mean(), y.mean()])
@@ -636,15 +648,16 @@ def fit_ground(
     prior = np.sqrt(len(z)) * _SLOPE_PRIOR * scale / meters_per_unit
     keep = np.ones(len(z), bool)
     n = len(ids)
+    xx, yy, xy, xz, yz = x * x, y * y, x * y, x * z, y * z  # the weights are 0 or 1: w x x is w (x x)
     for _ in range(3):  # z = gx x + gy y + c[point]: least squares by its normal equations, summed by point
         w = keep.astype(float)
         a = np.zeros((2 + n, 2 + n))
-        a[0, 0], a[1, 1] = (w * x * x).sum() + prior**2, (w * y * y).sum() + prior**2
-        a[0, 1] = a[1, 0] = (w * x * y).sum()
+        a[0, 0], a[1, 1] = (w * xx).sum() + prior**2, (w * yy).sum() + prior**2
+        a[0, 1] = a[1, 0] = (w * xy).sum()
         a[0, 2:] = a[2:, 0] = np.bincount(point, w * x, n)
         a[1, 2:] = a[2:, 1] = np.bincount(point, w * y, n)
         a[2:, 2:] = np.diag(np.bincount(point, w, n))
-        b = np.r_[(w * x * z).sum(), (w * y * z).sum(), np.bincount(point, w * z, n)]
+        b = np.concatenate(([(w * xz).sum(), (w * yz).sum()], np.bincount(point, w * z, n)))
         coef = np.linalg.solve(a, b)
         keep = z - (coef[0] * x + coef[1] * y + coef[2:][point]) < band
     gradient = coef[:2]

@@ -16,6 +16,13 @@ detected unless given):
   score 10-40 % on it, before a cleanup and after: a swinging foot passes the
   floor lower than 5 cm and faster than 0.5 m/s, and a cleanup leaves swing
   alone (a planted point is never that fast: the sliding says how still it is);
+- ``planted_skating_ratio``: the same count over the frame steps in which
+  the heel or the ball is planted (both frames of the step in its plant): the
+  share of them in which a planted point skates (0 without planted steps).
+  This is how "skating on the detected plants" is judged; on a take's own
+  detected plants it is 0 by construction (detection plants no point faster
+  than 0.45 m/s, and skating needs 0.5 m/s), so it tells something where the
+  table plants feet that move: an edited table, or another take's;
 - ``penetration_mm``: the deepest any of its heel, ball and toe tip goes
   below where it rests, over all frames;
 - ``float_mm``: the mean height of planted points over their plants.
@@ -49,6 +56,7 @@ class FootMetrics:
     sliding_mean_mm: float
     sliding_max_mm: float
     skating_ratio: float
+    planted_skating_ratio: float
     penetration_mm: float
     float_mm: float
 
@@ -76,13 +84,15 @@ class SkateReport:
     def text(self) -> str:
         """The report as a Markdown table."""
         lines = [
-            "| foot | plants (heel, ball) | sliding mean mm | sliding max mm | skating % | penetration mm | float mm |",
-            "|---|---|---:|---:|---:|---:|---:|",
+            "| foot | plants (heel, ball) | sliding mean mm | sliding max mm | skating % | skating planted % "
+            "| penetration mm | float mm |",
+            "|---|---|---:|---:|---:|---:|---:|---:|",
         ]
         for f in self.feet:
             lines.append(
                 f"| {f.foot} | {f.plants['heel']}, {f.plants['ball']} | {f.sliding_mean_mm:.2f} | "
-                f"{f.sliding_max_mm:.2f} | {100 * f.skating_ratio:.2f} | {f.penetration_mm:.2f} | {f.float_mm:.2f} |"
+                f"{f.sliding_max_mm:.2f} | {100 * f.skating_ratio:.2f} | {100 * f.planted_skating_ratio:.2f} | "
+                f"{f.penetration_mm:.2f} | {f.float_mm:.2f} |"
             )
         return "\n".join(lines)
 
@@ -115,6 +125,7 @@ def measure(
     for i, foot in enumerate(legs.feet):
         slides = []
         skating = np.zeros(max(frames - 1, 0), bool)
+        planted_skating, planted_steps = np.zeros_like(skating), np.zeros_like(skating)
         for k, column in enumerate((3, 2)):
             p = _horizontal(arrays.points[i, :, column], up)
             starts, ends = runs(masks[i, :, k])
@@ -123,7 +134,11 @@ def measure(
                 continue
             speed = np.linalg.norm(np.diff(p, axis=0), axis=-1) * frame_rate * meters_per_unit
             low = heights[i, :, k] < SKATE_HEIGHT
-            skating |= low[:-1] & low[1:] & (speed > SKATE_SPEED) & (_moving_average(speed, window) > SKATE_SPEED)
+            skates = low[:-1] & low[1:] & (speed > SKATE_SPEED) & (_moving_average(speed, window) > SKATE_SPEED)
+            held = masks[i, :-1, k] & masks[i, 1:, k]  # plants never touch: both frames are of one plant
+            skating |= skates
+            planted_skating |= skates & held
+            planted_steps |= held
         slide = np.concatenate(slides) * meters_per_unit * 1000 if slides else np.zeros(0)
         points = [0, 1, 2] if legs.points[i, 4] >= 0 else [0, 1]
         depth = -float(np.nanmin(heights[i][:, points])) if frames else 0.0
@@ -136,6 +151,7 @@ def measure(
                 sliding_mean_mm=float(slide.mean()) if len(slide) else 0.0,
                 sliding_max_mm=float(slide.max()) if len(slide) else 0.0,
                 skating_ratio=float(skating.sum() / steps),
+                planted_skating_ratio=float(planted_skating.sum() / max(planted_steps.sum(), 1)),
                 penetration_mm=max(depth, 0.0) * 1000,
                 float_mm=float(np.mean(np.maximum(planted, 0.0))) * 1000 if len(planted) else 0.0,
             )

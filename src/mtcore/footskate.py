@@ -35,11 +35,15 @@ __all__ = [
     "CleanupOptions",
     "LegChain",
     "LegPlan",
+    "PlantThresholds",
     "adjust_root",
     "cleanup",
     "leg_points",
     "plan_leg",
+    "plant_masks",
+    "point_speeds",
     "solve_leg",
+    "write_channels",
 ]
 
 POINTS = ("knee", "ankle", "ball", "heel", "tip")
@@ -75,14 +79,13 @@ class LegChain:
                 raise ValueError(f"LegChain.{name} must have shape {shape}, got {a.shape}")
         if not (np.isfinite(axis).all() and np.isfinite(segments).all()):
             raise ValueError("LegChain axis and segments must be finite")
-        for j, joint in enumerate(JOINTS):
-            row = axes[j]
+        for j, (joint, row) in enumerate(zip(JOINTS, axes.tolist())):  # twelve numbers: checked as a list
             count = self.count(j, axes)
-            if (row[count:] != -1).any() or ((row[:count] < 0) | (row[:count] > 2)).any():
+            used = row[:count]
+            if any(a != -1 for a in row[count:]) or any(not 0 <= a <= 2 for a in used):
                 raise ValueError(
-                    f"LegChain.axes[{j}] ({joint}) must list axes 0-2 then -1 for unused entries, got {row.tolist()}"
+                    f"LegChain.axes[{j}] ({joint}) must list axes 0-2 then -1 for unused entries, got {row}"
                 )
-            used = list(row[:count])
             if (count < 3 and len(set(used)) < count) or (count == 3 and (used[0] == used[1] or used[1] == used[2])):
                 raise ValueError(f"LegChain.axes[{j}] ({joint}) repeats an axis: {used}")
         if self.count(0, axes) == 0 or self.count(1, axes) == 0:
@@ -158,6 +161,57 @@ class CleanupOptions:
         return opt
 
 
+@dataclass(frozen=True)
+class PlantThresholds:
+    """Footplant detection's thresholds (``struct mt_plant_thresholds``), in the samples' units.
+
+    A frame is *sure* when its height is below ``sure_height`` and its central
+    speed below ``sure_speed``; *close* when its height is below ``height`` and
+    its speed below ``speed``, or sure; *firm* likewise with ``firm_height``
+    and ``firm_speed`` (which must not exceed height and speed: firm frames are
+    close).  Plants at most ``gap`` frames apart merge when every frame between
+    is slower than ``merge_speed``; a plant's ends more than ``rise`` above its
+    lowest frame are cut; plants shorter than ``shortest`` frames are dropped
+    unless they hold a sure frame.
+    """
+
+    sure_height: float
+    sure_speed: float
+    height: float
+    speed: float
+    firm_height: float
+    firm_speed: float
+    merge_speed: float
+    rise: float
+    gap: int
+    shortest: int
+
+    def __post_init__(self) -> None:
+        for name in ("gap", "shortest"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                raise ValueError(f"{name} must be a whole number >= 0, got {value!r}")
+        if not (self.firm_height <= self.height and self.firm_speed <= self.speed):
+            raise ValueError("firm_height and firm_speed must not exceed height and speed (firm frames are close)")
+
+    def struct(self):
+        """The thresholds as the kernel takes them."""
+        th = ffi.new("struct mt_plant_thresholds *")
+        for name in (
+            "sure_height",
+            "sure_speed",
+            "height",
+            "speed",
+            "firm_height",
+            "firm_speed",
+            "merge_speed",
+            "rise",
+        ):
+            setattr(th, name, float(getattr(self, name)))
+        th.gap, th.shortest = int(self.gap), int(self.shortest)
+        return th
+
+
 @dataclass(frozen=True, eq=False)
 class LegPlan:
     """What phases 1 and 2 give for one leg (see :func:`plan_leg`)."""
@@ -168,6 +222,26 @@ class LegPlan:
     weight: np.ndarray
     reach: np.ndarray
     knee: np.ndarray
+
+
+def _plan_shapes(frames: int) -> dict[str, tuple[int, ...]]:
+    return {"enforced": (frames, 2, 3), "goal": (frames, 3), "turn": (frames, 3), "weight": (frames,),
+            "reach": (frames,), "knee": (4,)}  # fmt: skip
+
+
+def _new_plans(legs: int, frames: int) -> tuple[dict[str, np.ndarray], list[LegPlan]]:
+    """Plans of ``legs`` legs whose fields are views of arrays over the legs (returned by name), so
+    that the phase after them takes the legs' arrays without stacking copies."""
+    fields = {name: np.empty((legs, *shape)) for name, shape in _plan_shapes(frames).items()}
+    return fields, [LegPlan(**{name: a[i] for name, a in fields.items()}) for i in range(legs)]
+
+
+def _output(a, name: str, shape: tuple[int, ...]) -> None:
+    """Check an output array given: float64, C-contiguous, writeable, of the shape the kernel fills."""
+    if not (isinstance(a, np.ndarray) and a.dtype == np.float64 and a.flags.c_contiguous and a.flags.writeable):
+        raise ValueError(f"{name} must be a writeable C-contiguous float64 array")
+    if a.shape != shape:
+        raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
 
 
 def _leg_struct(chains: tuple[LegChain, ...]):
@@ -247,7 +321,9 @@ def _points(points, frames: int) -> np.ndarray:
     return _doubles(points, "points", (frames, 5, 3))
 
 
-def plan_leg(chain, angles, points, planted, targets, clearance, options: CleanupOptions) -> LegPlan:
+def plan_leg(
+    chain, angles, points, planted, targets, clearance, options: CleanupOptions, *, out: LegPlan | None = None
+) -> LegPlan:
     """Phases 1 and 2 for one leg (``mt_footskate_plan``), of its angles (frames, 4, 3) and
     points (frames, 5, 3) as :func:`leg_points` gives them.
 
@@ -261,7 +337,8 @@ def plan_leg(chain, angles, points, planted, targets, clearance, options: Cleanu
     goal rotation is the turn times its rotation now), each frame's blend
     weight (1 constrained, 0 untouched), the knee's reach (the longest
     hip-to-ankle distance the root must keep it within) and the knee's hinge
-    axis in the thigh's frame with the side it bends to, (4,).
+    axis in the thigh's frame with the side it bends to, (4,).  ``out``: a plan to write into
+    (C-contiguous float64 arrays of those shapes), e.g. views of arrays of both legs.
     """
     if not isinstance(chain, LegChain):
         raise TypeError(f"chain must be a LegChain, got {type(chain).__name__}")
@@ -274,14 +351,9 @@ def plan_leg(chain, angles, points, planted, targets, clearance, options: Cleanu
     targets = _doubles(targets, "targets", (frames, 2, 3))
     if not np.isfinite(targets[planted.astype(bool)]).all():
         raise ValueError("targets must be finite where planted")
-    plan = LegPlan(
-        np.empty((frames, 2, 3)),
-        np.empty((frames, 3)),
-        np.empty((frames, 3)),
-        np.empty(frames),
-        np.empty(frames),
-        np.empty(4),
-    )
+    plan = _new_plans(1, frames)[1][0] if out is None else out
+    for name, shape in _plan_shapes(frames).items():
+        _output(getattr(plan, name), f"out.{name}", shape)
     check(
         lib.mt_footskate_plan(
             _leg_struct((chain,)),
@@ -333,11 +405,23 @@ def adjust_root(hips, goals, reaches, weights, options: CleanupOptions) -> np.nd
 
 
 def solve_leg(
-    chain, hips, parents, angles, points, planted, plan: LegPlan, root, clearance, options: CleanupOptions
+    chain,
+    hips,
+    parents,
+    angles,
+    points,
+    planted,
+    plan: LegPlan,
+    root,
+    clearance,
+    options: CleanupOptions,
+    *,
+    out: np.ndarray | None = None,
 ) -> np.ndarray:
     """Phases 4 and 5 for one leg (``mt_footskate_solve``): the new angles (frames, 4, 3),
     the input's bit for bit in frames that need no change.  ``points`` as for :func:`plan_leg`;
-    ``root`` (frames, 3) is the root's translation from :func:`adjust_root`."""
+    ``root`` (frames, 3) is the root's translation from :func:`adjust_root`; ``out``: an array to
+    write them into (C-contiguous float64)."""
     hips, parents, angles, frames = _leg_frames(chain, hips, parents, angles)
     points = _points(points, frames)
     planted = _planted(planted, frames)
@@ -346,7 +430,9 @@ def solve_leg(
     turn = _doubles(plan.turn, "plan.turn", (frames, 3))
     weight = _doubles(plan.weight, "plan.weight", (frames,))
     knee = _doubles(plan.knee, "plan.knee", (4,))
-    out = np.empty_like(angles)
+    if out is None:
+        out = np.empty_like(angles)
+    _output(out, "out", angles.shape)
     check(
         lib.mt_footskate_solve(
             _leg_struct((chain,)),
@@ -398,25 +484,154 @@ def cleanup(
     chains = tuple(chains)
     if len(chains) not in (1, 2):
         raise ValueError(f"cleanup takes one or two legs, got {len(chains)}")
-    threads = thread_count(workers, len(hips[0]) >= _PARALLEL_MIN_FRAMES if len(hips) else False)
+    hips = np.ascontiguousarray(hips, dtype=np.float64)
+    if hips.ndim != 3 or hips.shape[0] != len(chains) or hips.shape[2] != 3:
+        raise ValueError(f"hips must have shape ({len(chains)}, frames, 3), got {hips.shape}")
+    frames = hips.shape[1]
+    threads = thread_count(workers, frames >= _PARALLEL_MIN_FRAMES)
 
     def each_leg(task):
         calls = [lambda i=i: task(i) for i in range(len(chains))]
         return run_all(calls) if threads > 1 else [call() for call in calls]
 
-    plans = each_leg(lambda i: plan_leg(chains[i], angles[i], points[i], planted[i], targets[i], clearance[i], options))
-    root = adjust_root(
-        hips,
-        np.stack([p.goal for p in plans]),
-        np.stack([p.reach for p in plans]),
-        np.stack([p.weight for p in plans]),
-        options,
+    fields, plans = _new_plans(len(chains), frames)
+    each_leg(
+        lambda i: plan_leg(chains[i], angles[i], points[i], planted[i], targets[i], clearance[i], options, out=plans[i])
     )
-    out = np.stack(
-        each_leg(
-            lambda i: solve_leg(
-                chains[i], hips[i], parents[i], angles[i], points[i], planted[i], plans[i], root, clearance[i], options
-            )
+    root = adjust_root(hips, fields["goal"], fields["reach"], fields["weight"], options)
+    out = np.empty((len(chains), frames, 4, 3))
+    each_leg(
+        lambda i: solve_leg(
+            chains[i],
+            hips[i],
+            parents[i],
+            angles[i],
+            points[i],
+            planted[i],
+            plans[i],
+            root,
+            clearance[i],
+            options,
+            out=out[i],
         )
     )
-    return out, root, np.stack([p.enforced for p in plans])
+    return out, root, fields["enforced"]
+
+
+def write_channels(values, angles, solved, columns, angle_scale: float, root, root_columns) -> np.ndarray:
+    """A cleanup written back to a motion's channels (``mt_footskate_write``): a new (frames,
+    channels) array, ``values`` but where a leg's solved angle (``solved``, (legs, frames, 4, 3)
+    as :func:`cleanup` gives them) differs from its input angle (``angles``, the same shape),
+    written to its column as solved / ``angle_scale`` (``columns`` (legs, 4, 3): the column of each
+    angle, -1 for none), and in the root's translation columns ``root_columns`` (3,), to which
+    ``root`` (frames, 3) is added where it is not 0.  Every other value is the input's, bit for
+    bit.  The columns must be distinct columns of values."""
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    if values.ndim != 2:
+        raise ValueError(f"values must have shape (frames, channels), got {values.shape}")
+    frames, width = values.shape
+    solved = np.ascontiguousarray(solved, dtype=np.float64)
+    if solved.ndim != 4 or solved.shape[0] not in (1, 2) or solved.shape[1:] != (frames, 4, 3):
+        raise ValueError(f"solved must have shape (1 or 2 legs, {frames}, 4, 3), got {solved.shape}")
+    legs = solved.shape[0]
+    angles = _doubles(angles, "angles", solved.shape)
+    root = _doubles(root, "root", (frames, 3))
+    cols = np.ascontiguousarray(columns, dtype=np.int64)
+    where = np.ascontiguousarray(root_columns, dtype=np.int64)
+    if cols.shape != (legs, 4, 3) or where.shape != (3,):
+        raise ValueError(
+            f"columns must have shape ({legs}, 4, 3) and root_columns (3,), got {cols.shape}, {where.shape}"
+        )
+    used = np.concatenate([cols[cols >= 0], where])
+    if (cols < -1).any() or (where < 0).any() or (used >= width).any() or len(np.unique(used)) < len(used):
+        raise ValueError(f"columns and root_columns must be distinct columns of the {width} channels (-1: none)")
+    if not (math.isfinite(angle_scale) and angle_scale != 0):
+        raise ValueError(f"angle_scale must be finite and not 0, got {angle_scale}")
+    out = np.empty_like(values)
+    check(
+        lib.mt_footskate_write(
+            legs,
+            frames,
+            width,
+            c_array(values),
+            c_array(angles),
+            c_array(solved),
+            c_array(cols, "long long[]"),
+            angle_scale,
+            c_array(root),
+            c_array(where, "long long[]"),
+            c_array(out),
+        ),
+        "mt_footskate_write",
+    )
+    return out
+
+
+def point_speeds(points, which, frame_rate: float, *, central: bool = False):
+    """Speeds of points over frames, in their unit per second (``mt_point_speeds``).
+
+    ``points`` (tracks, frames, per_frame, 3), of which the points ``which``
+    (indices below per_frame) of each frame are measured.  Returns (tracks,
+    len(which), frames): the larger of the distances to the frames before and
+    after, times ``frame_rate``, so that neither difference quotient finds a
+    point faster (a single frame: 0); with ``central``, also the length of
+    the central difference (numpy.gradient's: one-sided at the ends) times
+    ``frame_rate``.  NaN in, NaN out.
+    """
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    if points.ndim != 4 or points.shape[3] != 3:
+        raise ValueError(f"points must have shape (tracks, frames, per_frame, 3), got {points.shape}")
+    tracks, frames, per_frame = points.shape[:3]
+    wanted = np.asarray(which)
+    if wanted.ndim != 1 or wanted.dtype.kind not in "iu" or not ((wanted >= 0) & (wanted < per_frame)).all():
+        raise ValueError(f"which must list points below {per_frame}, got {which!r}")
+    picked = np.ascontiguousarray(wanted, dtype=np.uintp)
+    if not math.isfinite(frame_rate):
+        raise ValueError(f"frame_rate must be finite, got {frame_rate}")
+    speed = np.empty((tracks, len(picked), frames))
+    middle = np.empty_like(speed) if central else None
+    check(
+        lib.mt_point_speeds(
+            c_array(points),
+            tracks,
+            frames,
+            per_frame,
+            c_array(picked, "size_t[]"),
+            len(picked),
+            float(frame_rate),
+            c_array(speed),
+            c_array(middle),
+        ),
+        "mt_point_speeds",
+    )
+    return (speed, middle) if central else speed
+
+
+def plant_masks(heights, speed, central, thresholds: PlantThresholds) -> np.ndarray:
+    """Footplant masks (rows, frames) bool (``mt_plant_masks``) of rows of samples: ``heights``
+    above rest, ``speed`` the larger of the forward and backward differences' and ``central`` the
+    central difference's (as :func:`point_speeds` gives them), all (rows, frames), by
+    ``thresholds`` (see :class:`PlantThresholds`).  Each plant's lowest height is the minimum over
+    it, gaps merged included, NaN if any is; NaN compares false."""
+    heights = np.ascontiguousarray(heights, dtype=np.float64)
+    if heights.ndim != 2:
+        raise ValueError(f"heights must have shape (rows, frames), got {heights.shape}")
+    speed = _doubles(speed, "speed", heights.shape)
+    central = _doubles(central, "central", heights.shape)
+    if not isinstance(thresholds, PlantThresholds):
+        raise TypeError(f"thresholds must be PlantThresholds, got {type(thresholds).__name__}")
+    rows, frames = heights.shape
+    mask = np.empty((rows, frames), np.uint8)
+    check(
+        lib.mt_plant_masks(
+            c_array(heights),
+            c_array(speed),
+            c_array(central),
+            rows,
+            frames,
+            thresholds.struct(),
+            c_array(mask, "unsigned char[]"),
+        ),
+        "mt_plant_masks",
+    )
+    return mask.view(bool)

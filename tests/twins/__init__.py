@@ -777,6 +777,51 @@ def slow_solve(chain, *args):
     return joint_rotations(chain, footskate.solve_leg(chain, *args))
 
 
+def write_cases(rng: np.random.Generator) -> list[tuple]:
+    """Motions of one or two legs, some angles solved anew (NaN among them), the root moved in some
+    frames (by -0.0 too), channels at -0.0 and the root's columns anywhere among the legs'."""
+    out = []
+    for legs, frames, width in ((1, 0, 15), (1, 1, 20), (2, 7, 31), (2, 40, 62)):
+        values = rng.normal(0, 90, (frames, width))
+        values[rng.random(values.shape) < 0.1] = -0.0
+        picked = rng.permutation(width)[: 12 * legs + 3]
+        columns = np.where(rng.random((legs, 4, 3)) < 0.7, picked[: 12 * legs].reshape(legs, 4, 3), -1)
+        scale = float(rng.choice([np.pi / 180, 1.0]))
+        angles = np.where(columns[:, None] >= 0, values[:, np.maximum(columns, 0)].transpose(1, 0, 2, 3) * scale, 0.0)
+        solved = np.where(rng.random(angles.shape) < 0.4, angles + rng.normal(0, 0.1, angles.shape), angles)
+        solved[rng.random(angles.shape) < 0.05] = np.nan
+        root = np.where(rng.random((frames, 3)) < 0.5, rng.normal(0, 1, (frames, 3)), rng.choice([0.0, -0.0]))
+        out.append((values, angles, solved, columns, scale, root, picked[12 * legs :]))
+    return out
+
+
+def speed_cases(rng: np.random.Generator) -> list[tuple]:
+    """Tracks of points of 0 to 40 frames, some NaN, measured one or several points of a frame at a time."""
+    out = []
+    for tracks, frames, per_frame in ((1, 0, 1), (2, 1, 5), (1, 2, 1), (2, 3, 5), (3, 40, 5)):
+        points = rng.normal(0, 1, (tracks, frames, per_frame, 3)).cumsum(axis=1)
+        points[rng.random(points.shape) < 0.02] = np.nan
+        which = [0] if per_frame == 1 else [3, 2, 4]
+        out += [(points, which, float(rng.choice([30.0, 120.0])), central) for central in (False, True)]
+    return out
+
+
+def plant_cases(rng: np.random.Generator) -> list[tuple]:
+    """Rows of heights and speeds that wander in and out of the thresholds (NaN among them), with
+    gaps and lengths of every kind."""
+    out = []
+    for rows, frames in ((1, 0), (1, 1), (2, 2), (4, 60), (3, 400)):
+        heights = np.abs(rng.normal(0, 0.03, (rows, frames)).cumsum(axis=1) % 0.08 - 0.01)
+        speed = np.abs(rng.normal(0, 0.3, (rows, frames)))
+        central = speed * rng.uniform(0.3, 1.0, (rows, frames))
+        for a in (heights, speed, central):
+            a[rng.random(a.shape) < 0.01] = np.nan
+        for gap, shortest, rise in ((0, 0, 0.0), (3, 5, 0.005), (12, 6, 0.01)):
+            th = fs.PlantThresholds(0.02, 0.05, 0.03, 0.4, 0.02, 0.35, 0.4, rise, gap, shortest)
+            out.append((heights, speed, central, th))
+    return out
+
+
 # --- the registry ---------------------------------------------------------------------------
 
 TWINS: dict[str, Twin] = {
@@ -874,6 +919,14 @@ TWINS: dict[str, Twin] = {
     "mt_footskate_plan": Twin(fast_plan, footskate.plan_leg, plan_cases, close(1e-9)),
     "mt_footskate_root": Twin(fs.adjust_root, footskate.adjust_root, root_cases, close(1e-9)),
     "mt_footskate_solve": Twin(fast_solve, slow_solve, solve_cases, close(1e-6)),
+    "mt_footskate_write": Twin(fs.write_channels, footskate.write_channels, write_cases, exact),
+    "mt_plant_masks": Twin(fs.plant_masks, footskate.plant_masks, plant_cases, exact),
+    "mt_point_speeds": Twin(
+        lambda p, which, rate, central: fs.point_speeds(p, which, rate, central=central),
+        lambda p, which, rate, central: footskate.point_speeds(p, which, rate, central=central),
+        speed_cases,
+        exact,
+    ),
 }
 
 EXEMPT = {

@@ -1,7 +1,8 @@
 """Footskate cleanup in vectorised numpy: the slow twin of mtcore.footskate's C kernels.
 
-Same signatures and results (to rounding) as :func:`mtcore.footskate.leg_points`
-and :func:`mtcore.footskate.cleanup`; every phase is written over all frames
+Same signatures and results (to rounding) as :func:`mtcore.footskate.leg_points`,
+:func:`mtcore.footskate.cleanup`, :func:`mtcore.footskate.write_channels`,
+:func:`mtcore.footskate.point_speeds` and :func:`mtcore.footskate.plant_masks`; every phase is written over all frames
 at once, the plants' targets frame by frame as the method states them.
 """
 
@@ -686,3 +687,81 @@ def cleanup(chains, hips, parents, angles, points, planted, targets, clearance, 
         ]
     )
     return out, root, np.stack([p[0] for p in plans])
+
+
+def write_channels(values, angles, solved, columns, angle_scale, root, root_columns):
+    """The cleanup's angles and root written back to the channels (see mtcore.footskate.write_channels)."""
+    out = np.array(values, dtype=float)
+    for i in range(len(solved)):
+        used = np.asarray(columns[i]).reshape(12) >= 0
+        new = np.asarray(solved[i]).reshape(len(out), 12)[:, used]
+        old = np.asarray(angles[i]).reshape(len(out), 12)[:, used]
+        cols = np.asarray(columns[i]).reshape(12)[used]
+        out[:, cols] = np.where(new != old, new / angle_scale, out[:, cols])  # unchanged angles keep their bits
+    cols = list(root_columns)
+    out[:, cols] = np.where(root != 0, out[:, cols] + root, out[:, cols])  # -0.0 + 0.0 would be +0.0
+    return out
+
+
+def point_speeds(points, which, frame_rate, *, central=False):
+    """Speeds of the points ``which`` of each frame (see mtcore.footskate.point_speeds), in numpy."""
+    p = np.asarray(points, dtype=float)[:, :, list(which)].transpose(0, 2, 1, 3)  # (tracks, count, frames, 3)
+    if p.shape[2] < 2:
+        zeros = np.zeros(p.shape[:-1])
+        return (zeros, zeros.copy()) if central else zeros
+    d = np.diff(p, axis=2)
+    step = np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1] + d[..., 2] * d[..., 2]) * frame_rate
+    speed = np.empty(p.shape[:-1])
+    speed[..., 0], speed[..., -1] = step[..., 0], step[..., -1]
+    np.maximum(step[..., 1:], step[..., :-1], out=speed[..., 1:-1])
+    if not central:
+        return speed
+    g = np.gradient(p, axis=2)
+    return speed, np.sqrt(g[..., 0] * g[..., 0] + g[..., 1] * g[..., 1] + g[..., 2] * g[..., 2]) * frame_rate
+
+
+def runs(mask):
+    """Starts and ends (exclusive) of the runs of True in a 1-d mask."""
+    edges = np.diff(np.r_[0, np.asarray(mask, bool).astype(np.int8), 0])
+    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+
+
+def plant_masks(heights, speed, central, th):
+    """Footplant masks of rows of samples (see mtcore.footskate.plant_masks), a row at a time in
+    whole-row numpy."""
+    heights, speed, central = (np.asarray(a, float) for a in (heights, speed, central))
+    sure = (heights < th.sure_height) & (central < th.sure_speed)
+    close = (heights < th.height) & (speed < th.speed) | sure
+    firm = (heights < th.firm_height) & (speed < th.firm_speed) | sure
+    slow = speed < th.merge_speed
+    out = np.zeros(heights.shape, bool)
+    n = heights.shape[1]
+    index = np.arange(n)
+    for r in range(len(heights)):
+        h, certain = heights[r], sure[r]
+        starts, ends = runs(close[r])
+        if not len(starts):
+            continue
+        firm_count = np.add.reduceat(firm[r].astype(np.int64), starts)
+        starts, ends = starts[firm_count > 0], ends[firm_count > 0]
+        if len(starts) > 1:  # merge short gaps that the point crosses slowly
+            fast = np.r_[0, np.cumsum(~slow[r])]
+            join = (starts[1:] - ends[:-1] <= th.gap) & (fast[starts[1:]] == fast[ends[:-1]])
+            starts, ends = starts[np.r_[True, ~join]], ends[np.r_[~join, True]]
+        if not len(starts):
+            continue
+        bounds = np.ravel(np.column_stack([starts, ends]))
+        bounds = bounds[:-1] if bounds[-1] == n else bounds
+        plant = np.searchsorted(starts, index, side="right") - 1
+        inside = (plant >= 0) & (index < ends[np.maximum(plant, 0)])
+        lowest = np.minimum.reduceat(h, bounds)[::2]
+        still = inside & ((h <= lowest[np.maximum(plant, 0)] + th.rise) | certain)
+        first = np.minimum.reduceat(np.where(still, index, n), bounds)[::2]
+        last = np.maximum.reduceat(np.where(still, index, -1), bounds)[::2] + 1
+        held = np.r_[0, np.cumsum(certain)]
+        keep = (last > first) & ((last - first >= th.shortest) | (held[np.maximum(last, first)] > held[first]))
+        edges = np.zeros(n + 1, np.int64)
+        np.add.at(edges, first[keep], 1)
+        np.add.at(edges, last[keep], -1)
+        out[r] = np.cumsum(edges[:-1]) > 0
+    return out
