@@ -153,7 +153,7 @@ class Manifest:
         if self._log is None:  # the manifest as found, compacted (atomically, like every output), then appended to
             with output(self.path) as f:
                 f.write(b"".join(_manifest_line(k, e) for k, e in self.entries.items() if k != key))
-            self._log = open(self.path, "ab")  # closed by close()
+            self._log = open(self.path, "ab")  # noqa: SIM115 (appended to line by line, closed by close())
         self._log.write(_manifest_line(key, entry))
         self._log.flush()
 
