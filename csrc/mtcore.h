@@ -347,10 +347,12 @@ int mt_unwrap_angles(double *values, size_t frames, size_t stride, const size_t 
                      double period, double *last, double *turns);
 
 /*
- * Angle channels put back into a range, in place (the inverse of mt_unwrap_angles once a take
- * is smoothed): each finite sample of the `columns` of (frames, stride) `values` outside
- * [low[k], high[k]] becomes v - period floor((v - low[k]) / period).  A column whose bounds
- * are NaN is left as it is.
+ * Angle channels put back into the range their take used, in place (the inverse of
+ * mt_unwrap_angles once a take is smoothed).  low[k] and high[k] are the take's least and
+ * greatest finite sample of column k (mt_finite_ranges): where they lie within [-P/2, P/2]
+ * (P the period) that is the column's range, else where they lie within [0, P] that one,
+ * else the column is left as it is.  Each finite sample of the `columns` of (frames, stride)
+ * `values` outside its column's range [a, a + P] becomes v - P floor((v - a) / P).
  */
 int mt_wrap_angles(double *values, size_t frames, size_t stride, const size_t *columns, size_t ncolumns,
                    const double *low, const double *high, double period);

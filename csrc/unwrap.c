@@ -99,14 +99,14 @@ int mt_finite_ranges(const double *values, size_t frames, size_t channels, doubl
     return MT_OK;
 }
 
-/* One row's run of n angle columns put into [low, high]: without a branch, as unwrap_run. */
-static MT_CLONES void wrap_run(double *restrict row, size_t n, const double *restrict low,
-                               const double *restrict high, double period)
+/* One row's run of n angle columns put into [least, least + period] (least NaN: left), as
+   unwrap_run without a branch. */
+static MT_CLONES void wrap_run(double *restrict row, size_t n, const double *restrict least, double period)
 {
     for (size_t k = 0; k < n; k++) {
         const double v = row[k];
-        const int outside = (v < low[k] || v > high[k]) && v - v == 0.0; /* rare: a mean across a wrap */
-        row[k] = outside ? v - period * floor((v - low[k]) / period) : v;
+        const int outside = (v < least[k] || v > least[k] + period) && v - v == 0.0; /* rare: a mean across a wrap */
+        row[k] = outside ? v - period * floor((v - least[k]) / period) : v;
     }
 }
 
@@ -122,17 +122,29 @@ int mt_wrap_angles(double *values, size_t frames, size_t stride, const size_t *c
     for (size_t k = 0; k < ncolumns; k++)
         if (columns[k] >= stride)
             return MT_EINVAL;
+    /* scratch: the runs of consecutive columns, then each column's least value */
     size_t *runs = malloc((ncolumns + 1) * sizeof *runs);
-    if (runs == NULL)
+    double *least = malloc(ncolumns * sizeof *least);
+    if (runs == NULL || least == NULL) {
+        free(runs);
+        free(least);
         return MT_ENOMEM;
+    }
+    const double half = period / 2;
+    for (size_t k = 0; k < ncolumns; k++) {
+        const int centred = low[k] >= -half && high[k] <= half;
+        const int positive = low[k] >= 0.0 && high[k] <= period;
+        least[k] = centred ? -half : positive ? 0.0 : NAN;
+    }
     const size_t count = column_runs(columns, ncolumns, runs);
     for (size_t t = 0; t < frames; t++) {
         double *row = values + t * stride;
         for (size_t r = 0; r < count; r++) {
             const size_t k = runs[r];
-            wrap_run(row + columns[k], runs[r + 1] - k, low + k, high + k, period);
+            wrap_run(row + columns[k], runs[r + 1] - k, least + k, period);
         }
     }
     free(runs);
+    free(least);
     return MT_OK;
 }

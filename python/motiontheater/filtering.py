@@ -52,7 +52,7 @@ class TakeStats:
     @property
     def base(self) -> np.ndarray:
         """What the means are taken relative to: each channel's first finite value (0 for none)."""
-        return np.nan_to_num(self.first, nan=0.0)
+        return np.where(np.isnan(self.first), 0.0, self.first)
 
 
 @dataclass
@@ -91,7 +91,7 @@ class Smoother:
         self.kind, self.size, self.mode, self.workers = kind, int(size), mode, workers
         self.period = skeleton.period
         chosen_joints = None if joints is None else tuple(joints)
-        self.rotations, self.others, self._chosen, self._turning = skeleton.derived(
+        self.rotations, self.others, self._chosen, self._turning, self._rotation_index = skeleton.derived(
             ("smoothed columns", chosen_joints, translation),
             lambda: _smoothed_columns(skeleton, chosen_joints, translation),
         )
@@ -111,7 +111,7 @@ class Smoother:
         frame).  ``state`` is what the frames before these left (None at the take's start)."""
         if not self.rotations or not len(values):
             return values.copy(), state
-        return unwrap_angles(values, self.period, state, self.rotations)
+        return unwrap_angles(values, self.period, state, self._rotation_index)
 
     def smooth(self, unwrapped: np.ndarray, stats: TakeStats) -> np.ndarray:
         """Smoothed frames (all channels; the chosen ones changed), rotations wrapped back."""
@@ -122,11 +122,11 @@ class Smoother:
             block = smooth(unwrapped[:, chosen])
         else:  # means relative to the take's first frame: exact for constants, no loss far from zero
             base = stats.base[chosen]
-            block = unwrapped[:, chosen] - base
-            smooth(block, output=block)
+            block = smooth(unwrapped[:, chosen] - base)  # into a new array: in place costs a copy
             block += base
-        if self._turning:
-            block = _wrap_into(block, stats.low[self.rotations], stats.high[self.rotations], self.period, self._turning)
+        if len(self._turning):
+            rotations = self._rotation_index
+            block = _wrap_into(block, stats.low[rotations], stats.high[rotations], self.period, self._turning)
         if every:
             return block
         values = unwrapped.copy()
@@ -136,9 +136,10 @@ class Smoother:
 
 def _smoothed_columns(
     skeleton: Skeleton, joints: Iterable[str] | None, translation: bool
-) -> tuple[list[int], list[int], slice | list[int], list[int]]:
+) -> tuple[list[int], list[int], slice | list[int], np.ndarray, np.ndarray]:
     """The rotation and other columns that a smoothing of ``joints`` changes, all of them (as a
-    slice where they run on, as a rule: no gather), and where the rotations are among them."""
+    slice where they run on, as a rule: no gather), where the rotations are among them, and
+    the rotations as an index array (lists would be converted on every take)."""
     rotations: list[int] = []
     others: list[int] = []
     for column in skeleton.columns_of(joints):
@@ -149,11 +150,13 @@ def _smoothed_columns(
     chosen = sorted(rotations + others)
     runs_on = bool(chosen) and chosen == list(range(chosen[0], chosen[-1] + 1))
     where = {c: i for i, c in enumerate(chosen)}
-    return rotations, others, slice(chosen[0], chosen[-1] + 1) if runs_on else chosen, [where[c] for c in rotations]
+    turning = np.array([where[c] for c in rotations], dtype=np.intp)
+    chosen_columns = slice(chosen[0], chosen[-1] + 1) if runs_on else chosen
+    return rotations, others, chosen_columns, turning, np.array(rotations, dtype=np.intp)
 
 
 def unwrap_angles(
-    raw: np.ndarray, period: float, state: Unwrapping | None = None, columns: Sequence[int] | None = None
+    raw: np.ndarray, period: float, state: Unwrapping | None = None, columns: Sequence[int] | np.ndarray | None = None
 ) -> tuple[np.ndarray, Unwrapping]:
     """Angle columns (all, or ``columns``) of (frames, channels) unwrapped, in a new array, and the
     state after the last frame.
@@ -207,18 +210,18 @@ def filter_motion(
 
 
 def _wrap_into(
-    filtered: np.ndarray, low: np.ndarray, high: np.ndarray, period: float, columns: Sequence[int] | None = None
+    filtered: np.ndarray,
+    low: np.ndarray,
+    high: np.ndarray,
+    period: float,
+    columns: Sequence[int] | np.ndarray | None = None,
 ) -> np.ndarray:
-    """Angle columns (all, or ``columns``) of filtered, each in the range its take used (``low`` ..
-    ``high``, one per column): [-P/2, P/2], [0, P], or none.  Changed in place where it is a
-    writeable C-contiguous float64 array (else a copy is); returned."""
+    """Angle columns (all, or ``columns``) of filtered, each in the range its take used (the
+    take's ``low`` .. ``high``, one per column): [-P/2, P/2], [0, P], or none.  Changed in place
+    where it is a writeable C-contiguous float64 array (else a copy is); returned."""
     if not (filtered.dtype == np.float64 and filtered.flags.c_contiguous and filtered.flags.writeable):
         filtered = np.array(filtered, dtype=np.float64, order="C")
-    half = period / 2
-    centred = (low >= -half) & (high <= half)
-    positive = ~centred & (low >= 0) & (high <= period)
-    least = np.where(centred, -half, np.where(positive, 0.0, np.nan))
-    mtcore.rotations.wrap_angles(filtered, least, least + period, period, columns)
+    mtcore.rotations.wrap_angles(filtered, low, high, period, columns)
     return filtered
 
 

@@ -279,7 +279,7 @@ def unwrap_angles(
         last, turns = (np.array(x, dtype=np.float64).reshape(-1) for x in state)
         if last.size != chosen.size or turns.size != chosen.size:
             raise ValueError(f"state must hold {chosen.size} last values and turns, one per column")
-    c_columns = ffi.new("size_t[]", chosen.tolist())
+    c_columns = _c_columns(chosen)
     check(
         lib.mt_unwrap_angles(
             c_array(out), out.shape[0], out.shape[1], c_columns, chosen.size, period, c_array(last), c_array(turns)
@@ -290,18 +290,29 @@ def unwrap_angles(
 
 
 def _columns(columns, channels: int) -> np.ndarray:
-    chosen = np.arange(channels) if columns is None else np.asarray(columns, dtype=np.intp).reshape(-1)
+    """The column indices as an array the kernels read as size_t[] (see _c_columns), checked."""
+    chosen = np.arange(channels, dtype=np.intp) if columns is None else np.asarray(columns, dtype=np.intp).reshape(-1)
     if chosen.size and (chosen.min() < 0 or chosen.max() >= channels):
         raise ValueError(f"columns must be channels of the {channels} there are, got {chosen.tolist()}")
     return chosen
 
 
+assert ffi.sizeof("size_t") == np.dtype(np.uintp).itemsize  # what _c_columns relies on
+
+
+def _c_columns(chosen: np.ndarray):
+    """Checked column indices (_columns) as the kernels' size_t[], without a copy (intp is its size)."""
+    return c_array(np.ascontiguousarray(chosen).view(np.uintp), "size_t[]")
+
+
 def wrap_angles(values: np.ndarray, low, high, period: float, columns=None) -> None:
     """Angle channels of ``values`` (frames, channels; C-contiguous float64, changed in place)
-    put back into a range: each finite sample of column ``columns[k]`` (default: all) outside
-    ``[low[k], high[k]]`` is moved into it by whole periods, ``v - period floor((v - low) /
-    period)``.  Where low or high is NaN the column is left.  The inverse of
-    :func:`unwrap_angles` once a take is smoothed."""
+    put back into the range their take used: ``low[k]`` and ``high[k]`` are the take's least and
+    greatest finite sample of column ``columns[k]`` (default: all; see :func:`finite_ranges`).
+    Where they lie within [-period/2, period/2], that is the column's range, else where they
+    lie within [0, period] that one, else the column is left; each finite sample outside its
+    column's range [a, a + period] becomes ``v - period floor((v - a) / period)``.  The inverse
+    of :func:`unwrap_angles` once a take is smoothed."""
     if not (isinstance(values, np.ndarray) and values.dtype == np.float64 and values.flags.c_contiguous):
         raise TypeError("values must be a C-contiguous float64 array (it is changed in place)")
     if values.ndim != 2:
@@ -309,13 +320,13 @@ def wrap_angles(values: np.ndarray, low, high, period: float, columns=None) -> N
     if not values.flags.writeable:
         raise ValueError("values must be writeable (it is changed in place)")
     chosen = _columns(columns, values.shape[1])
-    low, high = (np.array(x, dtype=np.float64).reshape(-1) for x in (low, high))
+    low, high = (np.ascontiguousarray(x, dtype=np.float64).reshape(-1) for x in (low, high))
     if low.size != chosen.size or high.size != chosen.size:
         raise ValueError(f"low and high must hold {chosen.size} bounds, one per column")
     period = float(period)
     if not (math.isfinite(period) and period > 0):
         raise ValueError(f"period must be a positive number, got {period}")
-    c_columns = ffi.new("size_t[]", chosen.tolist())
+    c_columns = _c_columns(chosen)
     check(
         lib.mt_wrap_angles(
             c_array(values),

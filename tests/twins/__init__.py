@@ -302,11 +302,13 @@ def wrap_cases(rng: np.random.Generator) -> list[tuple]:
     out = []
     for frames in (0, 1, 2, 7, 64):
         for period in (360.0, 2 * math.pi):
-            raw = np.cumsum(rng.normal(0, period / 4, (frames, 5)), axis=0)  # strays out of range
+            raw = np.cumsum(rng.normal(0, period / 4, (frames, 6)), axis=0)  # strays out of range
             raw[rng.random(raw.shape) < 0.08] = np.nan
             raw[rng.random(raw.shape) < 0.04] = -np.inf
-            low = np.array([-period / 2, 0.0, np.nan, -period / 2, 0.0])
-            out += [(raw, low, low + period, period, None), (raw, low[:3], low[:3] + period, period, [4, 0, 2])]
+            h = period / 2  # the take's ranges: centred, positive, neither, nothing finite, on the bounds
+            low = np.array([-h * 0.9, 0.1 * h, -h, np.inf, -h, 0.0])
+            high = np.array([h * 0.5, 1.9 * h, 1.5 * h, -np.inf, h, period])
+            out += [(raw, low, high, period, None), (raw, low[:3], high[:3], period, [4, 0, 2])]
     return out
 
 

@@ -272,14 +272,21 @@ def unwrap_angles(values, period: float, columns=None, state=None) -> tuple[np.n
 
 
 def wrap_angles(values, low, high, period: float, columns=None) -> np.ndarray:
-    """Wrapping sample by sample, into a copy: a finite sample outside its column's [low, high]
-    takes the whole turns that bring it to low or above (NaN bounds: the column is left)."""
+    """Wrapping sample by sample, into a copy: a column whose take's range (low, high) fits in
+    [-P/2, P/2] goes there, else one that fits in [0, P] there, else none is left; a finite
+    sample outside its range takes the whole turns that bring it to the range's start or above."""
     out = np.array(values, dtype=float)
     for k, c in enumerate(range(out.shape[1]) if columns is None else columns):
+        if -period / 2 <= low[k] and high[k] <= period / 2:
+            least = -period / 2
+        elif 0 <= low[k] and high[k] <= period:
+            least = 0.0
+        else:
+            continue
         for t in range(out.shape[0]):
             v = out[t, c]
-            if math.isfinite(v) and (v < low[k] or v > high[k]):
-                out[t, c] = v - period * math.floor((v - low[k]) / period)
+            if math.isfinite(v) and (v < least or v > least + period):
+                out[t, c] = v - period * math.floor((v - least) / period)
     return out
 
 
