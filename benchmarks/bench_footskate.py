@@ -55,7 +55,7 @@ def test_cleanup_mtcore(benchmark, record, take):
 
 
 def test_cleanup_numpy(benchmark, record, take):
-    result = benchmark.pedantic(numpy_clean, (take,), rounds=3, iterations=1, warmup_rounds=1)
+    result = benchmark.pedantic(numpy_clean, (take,), rounds=5, iterations=1, warmup_rounds=1)
     fast = clean_footskate(take)
     assert result.contacts == fast.contacts
     np.testing.assert_allclose(result.root_offsets, fast.root_offsets, rtol=0, atol=1e-9)
