@@ -121,32 +121,11 @@ static inline int short_decimal(double a, uint64_t bits, uint64_t *d, int *e)
     return 1;
 }
 
-static const uint64_t pow10_table[20] = {1u,
-                                         10u,
-                                         100u,
-                                         1000u,
-                                         10000u,
-                                         100000u,
-                                         1000000u,
-                                         10000000u,
-                                         100000000u,
-                                         1000000000u,
-                                         10000000000u,
-                                         100000000000u,
-                                         1000000000000u,
-                                         10000000000000u,
-                                         100000000000000u,
-                                         1000000000000000u,
-                                         10000000000000000u,
-                                         100000000000000000u,
-                                         1000000000000000000u,
-                                         10000000000000000000u};
-
 /* The count of decimal digits of v > 0. */
 static inline int decimal_length(uint64_t v)
 {
     const int guess = ((64 - __builtin_clzll(v)) * 1233) >> 12; /* floor(log10 v) or one more */
-    return guess + (guess < 20 && v >= pow10_table[guess]);
+    return guess + (guess < 20 && v >= pow10_u64[guess]);
 }
 
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__

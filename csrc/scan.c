@@ -85,8 +85,6 @@ static inline uint64_t digits_value(uint64_t w, int n)
     return x;
 }
 
-static const uint64_t pow10_u64[9] = {1, 10, 100, 1000, 10000, 100000, 1000000, 10000000, 100000000};
-
 /*
  * The digits of a decimal's whole and fractional parts at *p, eight bytes at a time, where at
  * least eight bytes are left at each step and there are fewer than 8 whole digits and at most

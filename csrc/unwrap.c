@@ -11,6 +11,18 @@
 #include <stddef.h>
 #include <stdlib.h>
 
+/* The arguments the angle kernels share, checked: columns within the rows, a finite period > 0. */
+static int valid_columns(const double *values, size_t frames, size_t stride, const size_t *columns, size_t ncolumns,
+                         double period)
+{
+    if (columns == NULL || (frames > 0 && values == NULL) || !(period > 0.0) || !isfinite(period))
+        return 0;
+    for (size_t k = 0; k < ncolumns; k++)
+        if (columns[k] >= stride)
+            return 0;
+    return 1;
+}
+
 /*
  * Where columns run on (c, c+1, ...): the index k of each run's first column, then the next
  * run's, ..., ncolumns last, into runs (ncolumns + 1 entries); returns how many runs.  A run is
@@ -50,13 +62,8 @@ int mt_unwrap_angles(double *values, size_t frames, size_t stride, const size_t 
 {
     if (ncolumns == 0)
         return MT_OK;
-    if (columns == NULL || last == NULL || turns == NULL || (frames > 0 && values == NULL))
+    if (last == NULL || turns == NULL || !valid_columns(values, frames, stride, columns, ncolumns, period))
         return MT_EINVAL;
-    if (!(period > 0.0) || !isfinite(period))
-        return MT_EINVAL;
-    for (size_t k = 0; k < ncolumns; k++)
-        if (columns[k] >= stride)
-            return MT_EINVAL;
     size_t *runs = malloc((ncolumns + 1) * sizeof *runs);
     if (runs == NULL)
         return MT_ENOMEM;
@@ -115,13 +122,8 @@ int mt_wrap_angles(double *values, size_t frames, size_t stride, const size_t *c
 {
     if (ncolumns == 0)
         return MT_OK;
-    if (columns == NULL || low == NULL || high == NULL || (frames > 0 && values == NULL))
+    if (low == NULL || high == NULL || !valid_columns(values, frames, stride, columns, ncolumns, period))
         return MT_EINVAL;
-    if (!(period > 0.0) || !isfinite(period))
-        return MT_EINVAL;
-    for (size_t k = 0; k < ncolumns; k++)
-        if (columns[k] >= stride)
-            return MT_EINVAL;
     /* scratch: the runs of consecutive columns, then each column's least value */
     size_t *runs = malloc((ncolumns + 1) * sizeof *runs);
     double *least = malloc(ncolumns * sizeof *least);
