@@ -61,6 +61,8 @@ def test_resume_redoes_takes_made_by_another_recipe_or_from_changed_inputs(cmu, 
     assert main(["batch", "--median", "5", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
     assert "0 processed, 2 skipped" in capsys.readouterr().out
     assert main(["batch", "--mean", "3", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
+    assert manifest.exists() and not (out / ".motiontheater-batch.json").exists()  # carried over
+    assert main(["batch", "--mean", "3", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
     assert "2 processed, 0 skipped" in capsys.readouterr().out
     expected = mt.read_amc(cmu / "02_01.amc", mt.read_asf(cmu / "02.asf")).mean(size=3)
     np.testing.assert_array_equal(mt.read_amc(out / "02_01.amc", expected.skeleton).values, expected.values)
@@ -86,9 +88,14 @@ def test_resume_trusts_the_manifest_lines_a_killed_run_wrote_whole(cmu, tmp_path
     assert "1 processed, 1 skipped" in capsys.readouterr().out
     assert len(manifest.read_bytes().splitlines()) == 2  # compacted: one whole line per output
     entries = [json.loads(line) for line in lines]
-    manifest.write_text(json.dumps({"version": 1, "outputs": {e.pop("output"): e for e in entries}}))  # as it was
+    manifest.unlink()  # as earlier releases wrote it, under its name then
+    (out / ".motiontheater-batch.json").write_text(
+        json.dumps({"version": 1, "outputs": {e.pop("output"): e for e in entries}})
+    )
     assert main(["batch", "--median", "5", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
     assert "0 processed, 2 skipped" in capsys.readouterr().out
+    assert main(["batch", "--mean", "3", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
+    assert manifest.exists() and not (out / ".motiontheater-batch.json").exists()  # carried over
 
 
 def test_the_output_suffix_decides_the_format(cmu, tmp_path, capsys):

@@ -47,7 +47,8 @@ from .streaming import CHUNK_FRAMES, stream, streamable
 
 STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed (when its pipeline allows)
 SUFFIXES = {"asf": ".amc", "bvh": ".bvh"}  # what a motion of each skeleton convention is written as
-MANIFEST = ".motiontheater-batch.json"
+MANIFEST = ".motiontheater-batch.jsonl"
+_OLD_MANIFEST = ".motiontheater-batch.json"  # version 1, one JSON object: read where there is no other
 
 
 @dataclass(frozen=True)
@@ -118,8 +119,10 @@ class Manifest:
         self.recipe = hashlib.sha256(recipe.encode()).hexdigest()
         self.entries: dict[str, dict[str, Any]] = {}
         self._log: Any = None
-        with contextlib.suppress(OSError, UnicodeDecodeError):
-            self.entries = _manifest_entries(self.path.read_text())
+        for path in (self.path, Path(folder) / _OLD_MANIFEST):
+            with contextlib.suppress(OSError, UnicodeDecodeError):
+                self.entries = _manifest_entries(path.read_text())
+                break
 
     def _key(self, job: Job) -> str:
         return os.path.relpath(job.output, self.path.parent)
@@ -153,6 +156,8 @@ class Manifest:
         if self._log is None:  # the manifest as found, compacted (atomically, like every output), then appended to
             with output(self.path) as f:
                 f.write(b"".join(_manifest_line(k, e) for k, e in self.entries.items() if k != key))
+            with contextlib.suppress(OSError):  # what a version-1 manifest held is in this one now
+                (self.path.parent / _OLD_MANIFEST).unlink(missing_ok=True)
             self._log = open(self.path, "ab")  # noqa: SIM115 (appended to line by line, closed by close())
         self._log.write(_manifest_line(key, entry))
         self._log.flush()
