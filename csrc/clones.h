@@ -15,7 +15,9 @@
 #define MT_CLONES
 #endif
 
-#if defined(__GNUC__)
+/* Forced only where clones need it: without them (MT_NO_CLONES, e.g. the sanitizer build) the
+ * compiler chooses, which keeps the instrumented build of the big solvers to seconds. */
+#if defined(__GNUC__) && !defined(MT_NO_CLONES)
 #define MT_INLINE inline __attribute__((always_inline))
 #else
 #define MT_INLINE inline
