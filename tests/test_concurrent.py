@@ -53,3 +53,17 @@ def test_threads_share_the_parallel_pool():
         results = list(pool.map(lambda i: mtcore.uniform_filter1d(x * (i + 1), 5, axis=0, workers=-1), range(THREADS)))
     for want, got in zip(serial, results):
         exact(got, want)
+
+
+@pytest.mark.parametrize(("processes", "share"), [(1, 8), (2, 4), (3, 2), (8, 1), (16, 1)])
+def test_a_process_that_shares_the_cores_splits_its_calls_over_its_share(monkeypatch, processes, share):
+    from mtcore import _parallel
+
+    monkeypatch.setattr(_parallel.os, "sched_getaffinity", lambda pid: set(range(8)), raising=False)
+    monkeypatch.setattr(_parallel, "_share", None)
+    assert mtcore.cpu_count() == 8
+    mtcore.share_cores(processes)
+    assert mtcore.cpu_count() == share
+    assert _parallel.thread_count(None, large=True) == share
+    mtcore.share_cores(1)  # a share is of the cores, not of an earlier share
+    assert mtcore.cpu_count() == 8

@@ -32,7 +32,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from mtcore import cpu_count
+from mtcore import cpu_count, share_cores
 
 from ._io import WRITE_ERRORS, OutputError, output, remove_stale_partials
 from .amc import read_amc
@@ -472,7 +472,7 @@ def _run_local(jobs: list[Job], workers: int) -> Generator[tuple[Job, Result]]:
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     previous = signal.signal(signal.SIGTERM, _interrupt)
-    pool = ProcessPoolExecutor(max_workers=count, initializer=_worker_start, initargs=(os.getpid(),))
+    pool = ProcessPoolExecutor(max_workers=count, initializer=_worker_start, initargs=(os.getpid(), count))
     try:
         futures = {pool.submit(run_job, job): job for job in jobs}
         for future in as_completed(futures):
@@ -484,9 +484,11 @@ def _run_local(jobs: list[Job], workers: int) -> Generator[tuple[Job, Result]]:
         signal.signal(signal.SIGTERM, previous)
 
 
-def _worker_start(parent: int) -> None:
-    """In each worker: Ctrl-C is the parent's to handle (it stops the workers), and a worker
-    whose parent is gone (killed outright) ends instead of running on alone."""
+def _worker_start(parent: int, processes: int) -> None:
+    """In each worker: Ctrl-C is the parent's to handle (it stops the workers), a worker
+    whose parent is gone (killed outright) ends instead of running on alone, and its C
+    calls take its share of the cores, not every core."""
+    share_cores(processes)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's handler, which a fork copies
 

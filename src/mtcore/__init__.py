@@ -14,7 +14,7 @@ polyphase resampling, gap filling; scipy.signal's signatures) in
 """
 
 from . import errors, signal
-from ._parallel import cpu_count
+from ._parallel import cpu_count, share_cores
 from .filters import MODES, binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
 from .text import format_frames, format_number, scan_frames
 
@@ -28,6 +28,7 @@ __all__ = [
     "median_filter1d",
     "pascal_weights",
     "scan_frames",
+    "share_cores",
     "signal",
     "uniform_filter1d",
 ]

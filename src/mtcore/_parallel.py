@@ -22,12 +22,25 @@ _pool: ThreadPoolExecutor | None = None
 _lock = threading.Lock()
 
 
+_share: int | None = None  # the cores of a process that divides them with others (share_cores)
+
+
 def cpu_count() -> int:
-    """Cores this process may run on (its affinity mask, where the OS has one)."""
+    """Cores this process may run on (its affinity mask, where the OS has one), or its share of them."""
     try:
-        return len(os.sched_getaffinity(0))
+        cores = len(os.sched_getaffinity(0))
     except AttributeError:
-        return os.cpu_count() or 1
+        cores = os.cpu_count() or 1
+    return min(cores, _share) if _share else cores
+
+
+def share_cores(processes: int) -> None:
+    """This process is one of ``processes`` that divide the cores between them (a batch's
+    workers): a call that splits over every core takes this process's share, as threads
+    beyond it would only contend with the other processes."""
+    global _share
+    _share = None
+    _share = max(1, cpu_count() // max(1, processes))
 
 
 def _get_pool() -> ThreadPoolExecutor:
