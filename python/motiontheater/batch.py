@@ -393,11 +393,10 @@ class Summary:
     def text(self) -> str:
         """The totals in a line, then a line per failure, and why the run ended early if it did."""
         d = self.as_dict()
-        lines = [
-            f"{d['processed']} processed, {d['skipped']} skipped (already done), {d['failed']} failed "
-            f"of {d['files']} takes; {d['megabytes']:.1f} MB in {d['seconds']:.1f} s "
-            f"({d['megabytes_per_second']:.1f} MB/s)"
-        ]
+        totals = f"{d['processed']} processed, {d['skipped']} skipped (already done), {d['failed']} failed of {d['files']} takes"
+        if d["processed"]:  # a rate of nothing done says nothing
+            totals += f"; {d['megabytes']:.1f} MB in {d['seconds']:.1f} s ({d['megabytes_per_second']:.1f} MB/s)"
+        lines = [totals]
         lines += [
             f"FAILED {f['error']}" if f["file"] in f["error"] else f"FAILED {f['file']}: {f['error']}"
             for f in d["failures"]
