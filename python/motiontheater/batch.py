@@ -508,15 +508,16 @@ def _run_dask(jobs: list[Job], workers: int, scheduler: str | None) -> Generator
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError:
         raise RuntimeError('Dask is not installed: pip install "motiontheater[dask]"') from None
+    processes = workers or cpu_count()
     cluster = (
         None
         if scheduler
-        else LocalCluster(
-            n_workers=workers or cpu_count(), threads_per_worker=1, processes=True, dashboard_address=None
-        )
+        else LocalCluster(n_workers=processes, threads_per_worker=1, processes=True, dashboard_address=None)
     )
     client = Client(scheduler or cluster)
     try:
+        if cluster is not None:  # a local cluster's workers share this machine's cores (a scheduler's may be anywhere)
+            client.run(share_cores, processes)
         futures = client.map(run_job, jobs, pure=False)
         job_of = {future.key: job for future, job in zip(futures, jobs)}
         for future in as_completed(futures):

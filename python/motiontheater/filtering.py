@@ -91,7 +91,7 @@ class Smoother:
         self.kind, self.size, self.mode, self.workers = kind, int(size), mode, workers
         self.period = skeleton.period
         chosen_joints = None if joints is None else tuple(joints)
-        self.rotations, self.others, self._chosen, self._turning, self._rotation_index = skeleton.derived(
+        self.rotations, self.others, self._chosen, self._turning = skeleton.derived(
             ("smoothed columns", chosen_joints, translation),
             lambda: _smoothed_columns(skeleton, chosen_joints, translation),
         )
@@ -109,9 +109,9 @@ class Smoother:
     def unwrap(self, values: np.ndarray, state: Unwrapping | None) -> tuple[np.ndarray, Unwrapping | None]:
         """(values with rotation channels unwrapped by :func:`unwrap_angles`, the state after the last
         frame).  ``state`` is what the frames before these left (None at the take's start)."""
-        if not self.rotations or not len(values):
+        if not len(self.rotations) or not len(values):
             return values.copy(), state
-        return unwrap_angles(values, self.period, state, self._rotation_index)
+        return unwrap_angles(values, self.period, state, self.rotations)
 
     def smooth(self, unwrapped: np.ndarray, stats: TakeStats) -> np.ndarray:
         """Smoothed frames (all channels; the chosen ones changed), rotations wrapped back."""
@@ -125,7 +125,7 @@ class Smoother:
             block = smooth(unwrapped[:, chosen] - base)  # into a new array: in place costs a copy
             block += base
         if len(self._turning):
-            rotations = self._rotation_index
+            rotations = self.rotations
             block = _wrap_into(block, stats.low[rotations], stats.high[rotations], self.period, self._turning)
         if every:
             return block
@@ -136,10 +136,10 @@ class Smoother:
 
 def _smoothed_columns(
     skeleton: Skeleton, joints: Iterable[str] | None, translation: bool
-) -> tuple[list[int], list[int], slice | list[int], np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, list[int], slice | list[int], np.ndarray]:
     """The rotation and other columns that a smoothing of ``joints`` changes, all of them (as a
-    slice where they run on, as a rule: no gather), where the rotations are among them, and
-    the rotations as an index array (lists would be converted on every take)."""
+    slice where they run on, as a rule: no gather), and where the rotations are among them; the
+    rotations' as index arrays (lists would be converted on every take)."""
     rotations: list[int] = []
     others: list[int] = []
     for column in skeleton.columns_of(joints):
@@ -152,7 +152,7 @@ def _smoothed_columns(
     where = {c: i for i, c in enumerate(chosen)}
     turning = np.array([where[c] for c in rotations], dtype=np.intp)
     chosen_columns = slice(chosen[0], chosen[-1] + 1) if runs_on else chosen
-    return rotations, others, chosen_columns, turning, np.array(rotations, dtype=np.intp)
+    return np.array(rotations, dtype=np.intp), others, chosen_columns, turning
 
 
 def unwrap_angles(
@@ -200,8 +200,7 @@ def filter_motion(
     exactly constant; the median only ever returns values of its window.
     """
     smoother = Smoother(motion.skeleton, kind, size, joints, translation=translation, mode=mode, workers=workers)
-    chosen = smoother.rotations + smoother.others
-    if not motion.frames or not chosen:
+    if not motion.frames or not (len(smoother.rotations) or smoother.others):
         return motion.replace(values=motion.values)
     unwrapped, _ = smoother.unwrap(motion.values, None)
     values = smoother.smooth(unwrapped, TakeStats.of(motion.values))

@@ -20,18 +20,12 @@ R = TypeVar("R")
 
 _pool: ThreadPoolExecutor | None = None
 _lock = threading.Lock()
-
-
 _share: int | None = None  # the cores of a process that divides them with others (share_cores)
 
 
 def cpu_count() -> int:
     """Cores this process may run on (its affinity mask, where the OS has one), or its share of them."""
-    try:
-        cores = len(os.sched_getaffinity(0))
-    except AttributeError:
-        cores = os.cpu_count() or 1
-    return min(cores, _share) if _share else cores
+    return min(_cores(), _share) if _share else _cores()
 
 
 def share_cores(processes: int) -> None:
@@ -39,8 +33,14 @@ def share_cores(processes: int) -> None:
     workers): a call that splits over every core takes this process's share, as threads
     beyond it would only contend with the other processes."""
     global _share
-    _share = None
-    _share = max(1, cpu_count() // max(1, processes))
+    _share = max(1, _cores() // max(1, processes))
+
+
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:
+        return os.cpu_count() or 1
 
 
 def _get_pool() -> ThreadPoolExecutor:

@@ -273,7 +273,7 @@ def unwrap_angles(values, period: float, columns=None, state=None) -> tuple[np.n
 
 def wrap_angles(values, low, high, period: float, columns=None) -> np.ndarray:
     """Wrapping sample by sample, into a copy: a column whose take's range (low, high) fits in
-    [-P/2, P/2] goes there, else one that fits in [0, P] there, else none is left; a finite
+    [-P/2, P/2] goes there, else one that fits in [0, P] there, else it is left as it is; a finite
     sample outside its range takes the whole turns that bring it to the range's start or above."""
     out = np.array(values, dtype=float)
     for k, c in enumerate(range(out.shape[1]) if columns is None else columns):
