@@ -8,6 +8,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#define ZEROS_WORD UINT64_C(0x3030303030303030) /* "00000000" */
+
 /* "00" "01" ... "99": two digits per division */
 static const char digit_pairs[201] = "00010203040506070809101112131415161718192021222324"
                                      "25262728293031323334353637383940414243444546474849"
@@ -55,7 +57,7 @@ struct line_end {
 };
 
 struct style {
-    int digits, exponent_digits;
+    int digits, exponent_digits, portable;
     struct line_end newline, frame_newline;
 };
 
@@ -79,13 +81,14 @@ static int unpack_line_end(int code, struct line_end *end)
 
 static int unpack_style(const struct mt_format_style *in, struct style *s)
 {
-    static const struct mt_format_style fallback = {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF};
+    static const struct mt_format_style fallback = {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF, 0};
     if (in == NULL)
         in = &fallback;
     if (in->digits < 0 || in->digits > 17 || in->exponent_digits < 1 || in->exponent_digits > 3)
         return 0;
     s->digits = in->digits;
     s->exponent_digits = in->exponent_digits;
+    s->portable = in->portable;
     return unpack_line_end(in->newline, &s->newline) && unpack_line_end(in->frame_newline, &s->frame_newline);
 }
 
@@ -140,7 +143,7 @@ static inline void put_eight_digits(char *p, uint32_t v)
     const uint64_t hundreds = ((merged - 100 * top) << 16) + top;
     uint64_t tens = ((hundreds * 103) >> 10) & UINT64_C(0x000f000f000f000f); /* / 10 */
     tens += (hundreds - 10 * tens) << 8;
-    tens += UINT64_C(0x3030303030303030);
+    tens += ZEROS_WORD;
     memcpy(p, &tens, 8);
 }
 
@@ -149,7 +152,7 @@ static inline int trailing_zeros8(const char *p)
 {
     uint64_t w;
     memcpy(&w, p, 8);
-    w ^= UINT64_C(0x3030303030303030); /* a '0' becomes 0 */
+    w ^= ZEROS_WORD; /* a '0' becomes 0 */
     return w == 0 ? 8 : __builtin_clzll(w) / 8;
 }
 #else
@@ -273,6 +276,217 @@ static inline char *put_number(double value, const struct style *s, char *out)
     return out + n + 1;
 }
 
+/*
+ * The texts of many values, worked out before the lines that hold them are laid out (which
+ * may take a row's values in any order): each in a slot of 32 bytes (of which a text takes
+ * MT_NUMBER_MAX at most), its length beside.
+ */
+enum { SLOTS = 512 };
+struct texts {
+    char text[SLOTS][32];
+    unsigned char len[SLOTS];
+};
+
+static inline void put_slot(double value, const struct style *s, struct texts *t, size_t i)
+{
+    t->len[i] = (unsigned char)(put_number(value, s, t->text[i]) - t->text[i]);
+}
+
+/* The text of slot i at out; returns its end.  Copies MT_NUMBER_MAX bytes, which the bounds
+   reserve for every number, whatever its length. */
+static inline char *copy_slot(const struct texts *t, size_t i, char *out)
+{
+    memcpy(out, t->text[i], MT_NUMBER_MAX);
+    return out + t->len[i];
+}
+
+#if MT_AVX512
+#include <immintrin.h>
+
+#define K(x) _mm512_set1_epi64((int64_t)(x)) /* x in every lane */
+
+/*
+ * The layouts of the vector code: the plain ones, one per decimal exponent e10 of -4 .. 14
+ * (row e10 + 4), then the exponent form (row 19).  Each says which of the 16 bytes lead digit,
+ * digits 2 .. 16 each byte of the text's first 16 takes (0x80: none), and what is put in where
+ * none is taken ('.', '0').  From e10 >= 0: the e10 + 1 digits before the point, the point,
+ * the others; below: "0.", -e10 - 1 zeros, the digits; the exponent form: the lead digit, the
+ * point, the others (and "e-05" after the last).
+ */
+#define EXPONENT_FORM -1000 /* the row's e10 */
+#define TAKE(j, e10)                                                                                 \
+    ((e10) == EXPONENT_FORM ? ((j) == 1 ? 0x80 : (j) - ((j) > 0))                                 \
+     : (e10) >= 0           ? ((j) <= (e10) ? (j) : (j) == (e10) + 1 ? 0x80 : (j) - 1)            \
+                            : ((j) <= -(e10) ? 0x80 : (j) - 1 + (e10)))
+#define PUT(j, e10)                                                                                  \
+    ((e10) == EXPONENT_FORM ? ((j) == 1 ? '.' : 0)                                                \
+     : (e10) >= 0           ? ((j) == (e10) + 1 ? '.' : 0)                                        \
+                            : ((j) == 1 ? '.' : (j) <= -(e10) ? '0' : 0))
+#define ROW(F, e10)                                                                                  \
+    {F(0, e10),  F(1, e10),  F(2, e10),  F(3, e10),  F(4, e10),  F(5, e10),  F(6, e10),  F(7, e10),      \
+     F(8, e10),  F(9, e10),  F(10, e10), F(11, e10), F(12, e10), F(13, e10), F(14, e10), F(15, e10)}
+#define ROWS(F)                                                                                      \
+    {ROW(F, -4), ROW(F, -3), ROW(F, -2), ROW(F, -1), ROW(F, 0),  ROW(F, 1),  ROW(F, 2),             \
+     ROW(F, 3),  ROW(F, 4),  ROW(F, 5),  ROW(F, 6),  ROW(F, 7),  ROW(F, 8),  ROW(F, 9),             \
+     ROW(F, 10), ROW(F, 11), ROW(F, 12), ROW(F, 13), ROW(F, 14), ROW(F, EXPONENT_FORM)}
+static const unsigned char layout_take[20][16] = ROWS(TAKE);
+static const unsigned char layout_put[20][16] = ROWS(PUT);
+#undef EXPONENT_FORM
+#undef TAKE
+#undef PUT
+#undef ROW
+#undef ROWS
+
+/* Lane by lane: x for x < 16 from table[0 .. 15] of two vectors, else from the third. */
+MT_AVX512_CODE static inline __m512i pick(__m512i x, __m512i t0, __m512i t1, __m512i t2)
+{
+    return _mm512_mask_permutexvar_epi64(_mm512_permutex2var_epi64(t0, x, t1),
+                                         _mm512_cmpge_epu64_mask(x, _mm512_set1_epi64(16)), x, t2);
+}
+
+/* eight_digits of each lane */
+MT_AVX512_CODE static inline __m512i eight_digits8(__m512i v)
+{
+    const __m512i high = _mm512_srli_epi64(_mm512_mullo_epi64(v, K(109951163)), 40); /* v / 10000 */
+    const __m512i merged = _mm512_or_si512(high, _mm512_slli_epi64(_mm512_sub_epi64(v, _mm512_mullo_epi64(high, K(10000))), 32));
+    const __m512i top = _mm512_and_si512(_mm512_srli_epi64(_mm512_mullo_epi64(merged, K(10486)), 20),
+                                         K((UINT64_C(0x7f) << 32) | 0x7f));
+    const __m512i hundreds = _mm512_add_epi64(_mm512_slli_epi64(_mm512_sub_epi64(merged, _mm512_mullo_epi64(top, K(100))), 16), top);
+    __m512i tens = _mm512_and_si512(_mm512_srli_epi64(_mm512_mullo_epi64(hundreds, K(103)), 10), K(0x000f000f000f000f));
+    tens = _mm512_add_epi64(tens, _mm512_slli_epi64(_mm512_sub_epi64(hundreds, _mm512_mullo_epi64(tens, K(10))), 8));
+    return _mm512_add_epi64(tens, K(ZEROS_WORD));
+}
+
+/* Each lane's q = x / unit and x - q unit, for x < 10 unit < 2^60, by a product in doubles
+   (off by one at most) and a correction. */
+MT_AVX512_CODE static inline __m512i divide8(__m512i x, uint64_t unit, __m512i *rest)
+{
+    __m512i q = _mm512_cvttpd_epu64(_mm512_mul_pd(_mm512_cvtepu64_pd(x), _mm512_set1_pd(1.0 / (double)unit)));
+    __m512i r = _mm512_sub_epi64(x, _mm512_mullo_epi64(q, K(unit)));
+    const __mmask8 under = _mm512_cmplt_epi64_mask(r, _mm512_setzero_si512());
+    q = _mm512_mask_sub_epi64(q, under, q, K(1));
+    r = _mm512_mask_add_epi64(r, under, r, K(unit));
+    const __mmask8 over = _mm512_cmpge_epi64_mask(r, K(unit));
+    *rest = _mm512_mask_sub_epi64(r, over, r, K(unit));
+    return _mm512_mask_add_epi64(q, over, q, K(1));
+}
+
+/*
+ * texts of values[0 .. count-1], eight at a time: the shortest decimals by number_shortest8,
+ * their digits in lanes, and each text by one byte shuffle from the layout of its exponent.
+ * What the lanes leave (see number_shortest8, and the exponent form) is put_number's.
+ * Returns how many were done (a multiple of 8).
+ */
+MT_AVX512_CODE static size_t texts_avx512(const double *values, size_t count, const struct style *s,
+                                          struct texts *t)
+{
+    const __m512i pow10_0 = _mm512_loadu_si512(pow10_u64), pow10_1 = _mm512_loadu_si512(pow10_u64 + 8);
+    const __m512i pow10_2 = _mm512_maskz_loadu_epi64(0x0f, pow10_u64 + 16);
+    size_t i = 0;
+    for (; i + 8 <= count; i += 8) {
+        uint64_t d[8];
+        int64_t e[8];
+        __mmask8 done = (__mmask8)number_shortest8(values + i, d, e);
+        const __m512i digits = _mm512_loadu_si512(d);
+        /* its length, then the digits scaled to 17: 10^16 <= full < 10^17 */
+        const __m512i guess = _mm512_srli_epi64(
+            _mm512_mullo_epi64(_mm512_sub_epi64(K(64), _mm512_lzcnt_epi64(digits)), K(1233)), 12);
+        const __m512i length = _mm512_mask_add_epi64(guess, _mm512_cmpge_epu64_mask(digits, pick(guess, pow10_0, pow10_1, pow10_2)),
+                                                     guess, K(1));
+        done &= _mm512_cmple_epu64_mask(length, K(17));
+        const __m512i full = _mm512_mullo_epi64(digits, pick(_mm512_sub_epi64(K(17), length), pow10_0, pow10_1, pow10_2));
+        __m512i rest, low;
+        const __m512i first = divide8(full, UINT64_C(10000000000000000), &rest);
+        const __m512i high = eight_digits8(divide8(rest, 100000000, &low));
+        low = eight_digits8(low);
+        /* significant digits: 17 less the trailing '0's */
+        const __m512i low_set = _mm512_xor_si512(low, K(ZEROS_WORD)), high_set = _mm512_xor_si512(high, K(ZEROS_WORD));
+        const __m512i n = _mm512_sub_epi64(
+            _mm512_sub_epi64(K(17), _mm512_srli_epi64(_mm512_lzcnt_epi64(low_set), 3)),
+            _mm512_maskz_srli_epi64(_mm512_cmpeq_epi64_mask(low_set, _mm512_setzero_si512()),
+                                    _mm512_lzcnt_epi64(high_set), 3));
+        const __m512i e10 = _mm512_add_epi64(_mm512_loadu_si512(e), _mm512_sub_epi64(length, K(1)));
+        /* plain from 1e-4 to below 1e15 (from there to 1e16 the point follows the 16th digit:
+           put_number's), else the exponent form */
+        const __mmask8 exponent_form = _mm512_cmplt_epi64_mask(e10, K(-4)) | _mm512_cmpge_epi64_mask(e10, K(16));
+        done &= exponent_form | _mm512_cmple_epi64_mask(e10, K(14));
+        /* plain: zeros after "0." (none from e10 >= 0), digits before the point, the length */
+        const __m512i zeros = _mm512_maskz_max_epi64((__mmask8)~exponent_form,
+                                                     _mm512_sub_epi64(_mm512_setzero_si512(), e10), _mm512_setzero_si512());
+        const __m512i whole = _mm512_max_epi64(_mm512_add_epi64(e10, K(1)), K(1));
+        const __m512i shown = _mm512_add_epi64(zeros, n);
+        const __m512i sign = _mm512_srli_epi64(_mm512_loadu_si512(values + i), 63);
+        __m512i len = _mm512_mask_add_epi64(whole, _mm512_cmpgt_epi64_mask(shown, whole), shown, K(1));
+        /* the exponent form: d.ddd (d alone for one digit), then "e", its sign and at least
+           exponent_digits digits, from where the suffix goes */
+        const __m512i mantissa = _mm512_mask_add_epi64(K(1), _mm512_cmpgt_epi64_mask(n, K(1)), n, K(1));
+        const __m512i power = _mm512_abs_epi64(e10);
+        const __m512i hundreds = _mm512_srli_epi64(_mm512_mullo_epi64(power, K(5243)), 19); /* / 100 */
+        const __m512i below = _mm512_sub_epi64(power, _mm512_mullo_epi64(hundreds, K(100)));
+        const __m512i tens = _mm512_srli_epi64(_mm512_mullo_epi64(below, K(103)), 10); /* / 10 */
+        const __m512i ones = _mm512_sub_epi64(below, _mm512_mullo_epi64(tens, K(10)));
+        const __m512i natural = _mm512_add_epi64(
+            K(1), _mm512_add_epi64(_mm512_maskz_mov_epi64(_mm512_cmpge_epi64_mask(power, K(10)), K(1)),
+                                   _mm512_maskz_mov_epi64(_mm512_cmpge_epi64_mask(power, K(100)), K(1))));
+        const __m512i width = _mm512_max_epi64(natural, K(s->exponent_digits));
+        /* "e-" then the digits of the width, hundreds first: as bytes of a word */
+        __m512i suffix = _mm512_mask_blend_epi64(_mm512_cmplt_epi64_mask(e10, _mm512_setzero_si512()), K('e' | '+' << 8),
+                                                 K('e' | '-' << 8));
+        const __m512i ascii = _mm512_or_si512(_mm512_or_si512(hundreds, _mm512_slli_epi64(tens, 8)), _mm512_slli_epi64(ones, 16));
+        /* ones, tens, hundreds in bytes 2, 1, 0 of ascii: the last `width` of them */
+        suffix = _mm512_or_si512(suffix, _mm512_slli_epi64(_mm512_add_epi64(_mm512_srlv_epi64(ascii, _mm512_slli_epi64(_mm512_sub_epi64(K(3), width), 3)),
+                                                                            K(0x303030)) , 16));
+        len = _mm512_mask_add_epi64(len, exponent_form, mantissa, _mm512_add_epi64(width, K(2)));
+        const __m512i suffix_at = _mm512_add_epi64(sign, _mm512_mask_mov_epi64(len, exponent_form, mantissa));
+        len = _mm512_add_epi64(len, sign);
+        /* the 16 bytes the shuffle takes from: the lead digit and digits 2 .. 16 */
+        const __m512i w0 = _mm512_or_si512(_mm512_add_epi64(first, K('0')), _mm512_slli_epi64(high, 8));
+        const __m512i w1 = _mm512_or_si512(_mm512_srli_epi64(high, 56), _mm512_slli_epi64(low, 8));
+        /* and the bytes of the text from its 17th: digits from the (16 - zeros)th */
+        const __m512i tail = _mm512_srlv_epi64(low, _mm512_sub_epi64(K(48), _mm512_slli_epi64(zeros, 3)));
+        uint64_t from[16], tails[8], lens[8], rows[8], signs[8], suffixes[8], suffix_ats[8];
+        _mm512_storeu_si512(from, _mm512_permutex2var_epi64(w0, _mm512_set_epi64(11, 3, 10, 2, 9, 1, 8, 0), w1));
+        _mm512_storeu_si512(from + 8, _mm512_permutex2var_epi64(w0, _mm512_set_epi64(15, 7, 14, 6, 13, 5, 12, 4), w1));
+        _mm512_storeu_si512(tails, tail);
+        _mm512_storeu_si512(lens, len);
+        _mm512_storeu_si512(rows, _mm512_mask_blend_epi64(exponent_form, _mm512_add_epi64(e10, K(4)), K(19)));
+        _mm512_storeu_si512(suffixes, suffix);
+        _mm512_storeu_si512(suffix_ats, suffix_at);
+        _mm512_storeu_si512(signs, sign);
+        for (int j = 0; j < 8; j++) {
+            char *slot = t->text[i + (size_t)j];
+            if (!((done >> j) & 1)) {
+                put_slot(values[i + (size_t)j], s, t, i + (size_t)j);
+                continue;
+            }
+            const __m128i text = _mm_or_si128(
+                _mm_shuffle_epi8(_mm_loadu_si128((const __m128i *)(from + 2 * j)),
+                                 _mm_loadu_si128((const __m128i *)layout_take[rows[j]])),
+                _mm_loadu_si128((const __m128i *)layout_put[rows[j]]));
+            slot[0] = '-';
+            _mm_storeu_si128((__m128i *)(slot + signs[j]), text);
+            memcpy(slot + signs[j] + 16, &tails[j], 8);
+            memcpy(slot + suffix_ats[j], &suffixes[j], 8); /* past the end of a plain text */
+            t->len[i + (size_t)j] = (unsigned char)lens[j];
+        }
+    }
+    return i;
+}
+#undef K
+#endif
+
+/* The texts of values[0 .. count-1] (count <= SLOTS) into the first count slots. */
+static void put_texts(const double *values, size_t count, const struct style *s, struct texts *t)
+{
+    size_t i = 0;
+#if MT_AVX512
+    if (s->digits == 0 && !s->portable && number_have_avx512())
+        i = texts_avx512(values, count, s, t);
+#endif
+    for (; i < count; i++)
+        put_slot(values[i], s, t, i);
+}
+
 int mt_format_double(double value, const struct mt_format_style *style, char *buf, size_t *written)
 {
     struct style s;
@@ -334,20 +548,31 @@ int mt_format_frames(const double *values, size_t frames, size_t channels, long 
     if (cap < mt_format_bound(frames, key_lens, counts, nkeys, style))
         return MT_ERANGE;
     char *out = buf;
-    for (size_t f = 0; f < frames; f++) {
-        char number[20];
-        const char *start = digits_before((uint64_t)first_frame + f, number + sizeof number);
-        memcpy(out, start, (size_t)(number + sizeof number - start));
-        out = put_newline(&s.frame_newline, out + (number + sizeof number - start));
-        const double *row = values + f * channels;
-        for (size_t k = 0; k < nkeys; k++) {
-            memcpy(out, keys[k], key_lens[k]);
-            out += key_lens[k];
-            for (size_t i = 0; i < counts[k]; i++) {
-                *out++ = ' ';
-                out = put_number(row[offsets[k] + i], &s, out);
+    /* the texts of as many whole frames as the slots hold, then their lines */
+    struct texts texts;
+    const size_t group = channels == 0 || channels > SLOTS ? 1 : SLOTS / channels;
+    for (size_t f0 = 0; f0 < frames; f0 += group) {
+        const size_t rows = frames - f0 < group ? frames - f0 : group;
+        const int slotted = channels > 0 && channels <= SLOTS;
+        if (slotted)
+            put_texts(values + f0 * channels, rows * channels, &s, &texts);
+        for (size_t f = f0; f < f0 + rows; f++) {
+            char number[20];
+            const char *start = digits_before((uint64_t)first_frame + f, number + sizeof number);
+            memcpy(out, start, (size_t)(number + sizeof number - start));
+            out = put_newline(&s.frame_newline, out + (number + sizeof number - start));
+            const double *row = values + f * channels;
+            const size_t slot = (f - f0) * channels;
+            for (size_t k = 0; k < nkeys; k++) {
+                memcpy(out, keys[k], key_lens[k]);
+                out += key_lens[k];
+                for (size_t i = 0; i < counts[k]; i++) {
+                    *out++ = ' ';
+                    out = slotted ? copy_slot(&texts, slot + offsets[k] + i, out)
+                                  : put_number(row[offsets[k] + i], &s, out);
+                }
+                out = put_newline(&s.newline, out);
             }
-            out = put_newline(&s.newline, out);
         }
     }
     *written = (size_t)(out - buf);
@@ -365,13 +590,22 @@ int mt_format_table(const double *values, size_t rows, size_t columns, const str
     if (cap < mt_format_table_bound(rows, columns, style))
         return MT_ERANGE;
     char *out = buf;
-    for (size_t r = 0; r < rows; r++) {
-        for (size_t c = 0; c < columns; c++) {
-            if (c > 0)
-                *out++ = ' ';
-            out = put_number(values[r * columns + c], &s, out);
+    struct texts texts;
+    const size_t group = columns == 0 || columns > SLOTS ? 1 : SLOTS / columns;
+    const int slotted = columns > 0 && columns <= SLOTS;
+    for (size_t r0 = 0; r0 < rows; r0 += group) {
+        const size_t n = rows - r0 < group ? rows - r0 : group;
+        if (slotted)
+            put_texts(values + r0 * columns, n * columns, &s, &texts);
+        for (size_t r = r0; r < r0 + n; r++) {
+            for (size_t c = 0; c < columns; c++) {
+                if (c > 0)
+                    *out++ = ' ';
+                out = slotted ? copy_slot(&texts, (r - r0) * columns + c, out)
+                              : put_number(values[r * columns + c], &s, out);
+            }
+            out = put_newline(&s.newline, out);
         }
-        out = put_newline(&s.newline, out);
     }
     *written = (size_t)(out - buf);
     return MT_OK;

@@ -205,7 +205,7 @@ struct mt_text_style {
 int mt_text_style(const char *text, size_t len, struct mt_text_style *style);
 
 /*
- * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF}.
+ * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF, 0}.
  *
  *   digits           0: the shortest text that reads back as exactly the value, of
  *                    those the nearest to it (the digits of Python's repr); exponent
@@ -219,12 +219,16 @@ int mt_text_style(const char *text, size_t len, struct mt_text_style *style);
  *   newline          the line ending of mt_format_frames and mt_format_table.
  *   frame_newline    the ending of the lines that hold only a frame number
  *                    (mt_format_frames): HDM05 ends those in LF, every other in CRLF.
+ *   portable         nonzero: the portable code only, not the vector code that some
+ *                    processors run (x86-64 with AVX-512).  The text is the same; this is
+ *                    for the tests and benchmarks that compare the two.
  */
 struct mt_format_style {
     int digits;
     int exponent_digits;
     int newline;
     int frame_newline;
+    int portable;
 };
 
 /* Bytes a number can take: -1.2345678901234567e-308. */

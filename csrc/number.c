@@ -378,6 +378,84 @@ uint64_t number_shortest(double a, int *exp10)
     return larger ? d * 10 : nearest;
 }
 
+#if MT_AVX512
+#include <immintrin.h>
+
+int number_have_avx512(void)
+{
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+           __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512dq") &&
+           __builtin_cpu_supports("avx512vl");
+}
+
+/* The high 64 bits of each lane's 128-bit a * b, and the low 64 to *lo (NULL: not wanted), from
+   the four 32 x 32-bit products (AVX-512 multiplies no wider). */
+MT_AVX512_CODE static inline __m512i mul_high(__m512i a, __m512i b, __m512i *lo)
+{
+    const __m512i low32 = _mm512_set1_epi64(0xffffffff);
+    const __m512i a_hi = _mm512_srli_epi64(a, 32), b_hi = _mm512_srli_epi64(b, 32);
+    const __m512i ll = _mm512_mul_epu32(a, b), lh = _mm512_mul_epu32(a, b_hi);
+    const __m512i hl = _mm512_mul_epu32(a_hi, b), hh = _mm512_mul_epu32(a_hi, b_hi);
+    const __m512i mid = _mm512_add_epi64(_mm512_add_epi64(_mm512_srli_epi64(ll, 32), _mm512_and_si512(lh, low32)),
+                                         _mm512_and_si512(hl, low32));
+    if (lo != NULL)
+        *lo = _mm512_or_si512(_mm512_slli_epi64(mid, 32), _mm512_and_si512(ll, low32));
+    return _mm512_add_epi64(_mm512_add_epi64(hh, _mm512_srli_epi64(lh, 32)),
+                            _mm512_add_epi64(_mm512_srli_epi64(hl, 32), _mm512_srli_epi64(mid, 32)));
+}
+
+/* floor(x k / 2^s) of each lane, for the fixed-point logarithms (x k within 64 bits, signed) */
+MT_AVX512_CODE static inline __m512i times_shift(__m512i x, int64_t k, int s)
+{
+    return _mm512_srai_epi64(_mm512_mullo_epi64(x, _mm512_set1_epi64(k)), (unsigned)s);
+}
+
+/* number_shortest's Dragonbox, lane by lane, for normal values other than powers of two. */
+MT_AVX512_CODE unsigned number_shortest8(const double *a, uint64_t *d, int64_t *exp10)
+{
+    const __m512i bits = _mm512_and_si512(_mm512_loadu_si512(a), _mm512_set1_epi64((int64_t)MASK63));
+    const __m512i biased = _mm512_srli_epi64(bits, 52), fraction = _mm512_and_si512(bits, _mm512_set1_epi64(MASK52));
+    __mmask8 done = _mm512_cmpneq_epi64_mask(biased, _mm512_setzero_si512()) &
+                    _mm512_cmpneq_epi64_mask(biased, _mm512_set1_epi64(0x7ff)) &
+                    _mm512_cmpneq_epi64_mask(fraction, _mm512_setzero_si512());
+    const __m512i c = _mm512_or_si512(fraction, _mm512_set1_epi64(INT64_C(1) << 52));
+    const __m512i q = _mm512_sub_epi64(biased, _mm512_set1_epi64(1075));
+    const __m512i minus_k = _mm512_sub_epi64(times_shift(q, 661971961083, 41), _mm512_set1_epi64(2));
+    const __m512i beta_minus_1 = _mm512_add_epi64(q, times_shift(_mm512_sub_epi64(_mm512_setzero_si512(), minus_k),
+                                                                 913124641741, 38)); /* 6 .. 9 */
+    /* phi(-minus_k): lanes outside the table (not done) read its first row */
+    __m512i row = _mm512_sub_epi64(_mm512_set1_epi64(-CACHE_MIN), minus_k);
+    row = _mm512_maskz_mov_epi64(done, _mm512_slli_epi64(row, 1));
+    const long long *table = (const long long *)&pow10_phi[0][0];
+    const __m512i phi0 = _mm512_i64gather_epi64(row, table, 8);
+    const __m512i phi1 = _mm512_i64gather_epi64(_mm512_add_epi64(row, _mm512_set1_epi64(1)), table, 8);
+    const __m512i delta = _mm512_srlv_epi64(phi0, _mm512_sub_epi64(_mm512_set1_epi64(63), beta_minus_1));
+    const __m512i x = _mm512_sllv_epi64(_mm512_add_epi64(_mm512_slli_epi64(c, 1), _mm512_set1_epi64(1)), beta_minus_1);
+    /* z = floor(x phi / 2^128) */
+    __m512i low0;
+    const __m512i high0 = mul_high(x, phi0, &low0), high1 = mul_high(x, phi1, NULL);
+    const __m512i middle = _mm512_add_epi64(low0, high1);
+    const __m512i z = _mm512_mask_add_epi64(high0, _mm512_cmplt_epu64_mask(middle, high1), high0,
+                                            _mm512_set1_epi64(1));
+    /* z / 1000 as compilers divide: (z / 8) 0x20c49ba5e353f7cf / 2^68 */
+    const __m512i quotient = _mm512_srli_epi64(
+        mul_high(_mm512_srli_epi64(z, 3), _mm512_set1_epi64(INT64_C(0x20c49ba5e353f7cf)), NULL), 4);
+    const __m512i r = _mm512_sub_epi64(z, _mm512_mullo_epi64(quotient, _mm512_set1_epi64(1000)));
+    const __mmask8 larger = _mm512_cmplt_epu64_mask(r, delta);
+    /* at the interval's ends number_shortest tests exactly */
+    done &= _mm512_cmpneq_epi64_mask(r, _mm512_setzero_si512()) & _mm512_cmpneq_epi64_mask(r, delta);
+    const __m512i dist = _mm512_add_epi64(_mm512_sub_epi64(r, _mm512_srli_epi64(delta, 1)), _mm512_set1_epi64(50));
+    const __m512i dist_q = _mm512_srli_epi64(_mm512_mullo_epi64(dist, _mm512_set1_epi64(5243)), 19); /* / 100 */
+    /* a tie or a step past the nearest: the parity tells, in number_shortest */
+    done &= ~(_mm512_cmpeq_epi64_mask(dist, _mm512_mullo_epi64(dist_q, _mm512_set1_epi64(100))) & ~larger);
+    const __m512i tens = _mm512_mullo_epi64(quotient, _mm512_set1_epi64(10));
+    _mm512_storeu_si512(d, _mm512_mask_add_epi64(tens, (__mmask8)~larger, tens, dist_q));
+    _mm512_storeu_si512(exp10, _mm512_add_epi64(minus_k, _mm512_set1_epi64(2)));
+    return done;
+}
+#endif
+
 uint64_t number_rounded(double a, int digits, int *exp10)
 {
     uint64_t c;

@@ -77,4 +77,22 @@ uint64_t number_shortest(double a, int *exp10);
  */
 uint64_t number_rounded(double a, int digits, int *exp10);
 
+#if defined(__x86_64__) && defined(__GNUC__)
+/* Code for x86-64 processors with AVX-512 (F, BW, CD, DQ, VL: the x86-64-v4 level), chosen at
+   run time where the processor has it; the portable code stays for every other. */
+#define MT_AVX512 1
+#define MT_AVX512_CODE __attribute__((target("avx512f,avx512bw,avx512cd,avx512dq,avx512vl")))
+
+/* Whether this processor runs MT_AVX512_CODE. */
+int number_have_avx512(void);
+
+/*
+ * number_shortest of |a[0]| .. |a[7]| at once, in the lanes of vectors: the decimals to d and
+ * exp10 for the lanes of the mask returned.  The other lanes are left to number_shortest: zero,
+ * subnormal, not finite, a power of two (its narrow interval), or one of the few whose interval
+ * ends or middle fall on a step of the decimals (about one value in a hundred).
+ */
+MT_AVX512_CODE unsigned number_shortest8(const double *a, uint64_t *d, int64_t *exp10);
+#endif
+
 #endif

@@ -198,6 +198,67 @@ def test_seventeen_digits_always_read_back(rng):
     assert_same_bits(read_back(written(values, digits=17)), values, values)
 
 
+def c_text(function: str, values: np.ndarray, portable: int, exponent_digits: int = 2, **frames) -> bytes:
+    """mt_format_table or mt_format_frames (keys a, b, ... of `counts` columns) called directly, with
+    the style's `portable` set or not: the vector code, where the processor has it, or the portable."""
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    rows, columns = values.shape
+    style = ffi.new("struct mt_format_style *", [0, exponent_digits, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_CRLF, portable])
+    written = ffi.new("size_t *")
+    c_values = ffi.from_buffer("double[]", values)
+    if function == "table":
+        cap = lib.mt_format_table_bound(rows, columns, style)
+        buf = ffi.new("char[]", cap)
+        assert lib.mt_format_table(c_values, rows, columns, style, buf, cap, written) == lib.MT_OK
+    else:
+        counts = frames["counts"]
+        keys = [ffi.new("char[]", bytes([97 + k % 26]) * (1 + k // 26)) for k in range(len(counts))]
+        key_lens = ffi.new("size_t[]", [len(ffi.string(k)) for k in keys])
+        offsets = ffi.new("size_t[]", [sum(counts[:k]) for k in range(len(counts))][::-1])  # lines in reverse
+        c_counts = ffi.new("size_t[]", counts[::-1])
+        cap = lib.mt_format_bound(rows, key_lens, c_counts, len(keys), style)
+        buf = ffi.new("char[]", cap)
+        status = lib.mt_format_frames(
+            c_values, rows, columns, 3, ffi.new("const char *[]", keys), key_lens, offsets, c_counts, len(keys),
+            style, buf, cap, written,
+        )  # fmt: skip
+        assert status == lib.MT_OK
+    return ffi.buffer(buf, written[0])[:]
+
+
+def vector_cases(rng) -> list[np.ndarray]:
+    """Values for the vector code: every class of bits, mocap-like values raw and smoothed (mostly 16
+    and 17 digits), every decimal exponent of the plain and the exponent forms, powers of two."""
+    patterns = rng.integers(0, 2**64, 100_000, dtype=np.uint64).view(np.float64)
+    magnitudes = rng.standard_normal(50_000) * 10.0 ** rng.integers(-8, 20, 50_000)
+    short = np.round(rng.uniform(-400, 400, 50_000) * 1e4) / 1e4
+    smoothed = np.convolve(short, np.ones(5) / 5, mode="same")
+    edges = [0.0, -0.0, np.inf, -np.inf, np.nan, -np.nan, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308]
+    decades = [s * y for e in range(-20, 25) for y in (10.0**e, math.nextafter(10.0**e, 0), 1.2345678901234567 * 10.0**e)
+               for s in (1, -1)]  # fmt: skip
+    powers = [2.0**e for e in range(-1074, 1024)]
+    return [patterns, magnitudes, short, smoothed, np.array(edges + decades + powers)]
+
+
+def test_vector_code_writes_what_the_portable_code_writes(rng):
+    """The vector code (x86-64 with AVX-512) against its twin, the portable code, byte for byte:
+    tables of one to 700 columns (more than a group of slots holds), frames with their lines out
+    of column order, every count of values left over from the lanes, every exponent width."""
+    for values in vector_cases(rng):
+        for columns in (1, 3, 7, 8, 9, 62, 700):
+            table = values[: len(values) // columns * columns].reshape(-1, columns)
+            assert c_text("table", table, 0) == c_text("table", table, 1), columns
+        for counts in ([1], [3, 3, 1], [6, 3, 3, 2, 1, 1, 3, 3, 3]):
+            frames = values[: len(values) // sum(counts) * sum(counts)].reshape(-1, sum(counts))
+            assert c_text("frames", frames, 0, counts=counts) == c_text("frames", frames, 1, counts=counts)
+    for exponent_digits in (1, 3):
+        table = vector_cases(rng)[0].reshape(-1, 4)
+        assert c_text("table", table, 0, exponent_digits) == c_text("table", table, 1, exponent_digits)
+    for n in range(20):  # fewer values than lanes, and what is left after them
+        table = rng.standard_normal((n, 1))
+        assert c_text("table", table, 0) == c_text("table", table, 1)
+
+
 def test_style_is_checked():
     for bad in (0, 18, -1):
         with pytest.raises(ValueError, match="digits must be None"):
