@@ -59,6 +59,25 @@ def test_corpus_on_a_dask_local_cluster(data_dir, tmp_path, corpus_expected):
     assert_outputs(out, corpus_expected)
 
 
+def test_takes_go_to_the_workers_in_groups_and_each_is_reported(data_dir, tmp_path):
+    """Many small takes: the workers get them a group at a time (several per message), and every
+    take still gets its own result, output and manifest line, as processed alone."""
+    src = tmp_path / "in"
+    src.mkdir()
+    for i in range(70):
+        shutil.copyfile(data_dir / "edge" / "test.asf", src / f"take{i:02d}.asf")
+        shutil.copyfile(data_dir / "edge" / "test.amc", src / f"take{i:02d}.amc")
+    jobs, settled = batch.plan_jobs([str(src)], tmp_path / "out", mt.Pipeline.of("mean", size=3))
+    groups = batch._groups(jobs, 2)
+    assert [job for group in groups for job in group] == jobs and max(map(len, groups)) > 1
+    summary = batch.run(jobs, settled, workers=2, out=tmp_path / "out")
+    assert not summary.failed and sorted(r.input for r in summary.results) == sorted(j.input for j in jobs)
+    expected = expected_bytes(data_dir / "edge" / "test.amc", "mean", 3)
+    assert all((tmp_path / "out" / f"take{i:02d}.amc").read_bytes() == expected for i in range(70))
+    manifest = batch.Manifest(tmp_path / "out", mt.Pipeline.of("mean", size=3).to_toml())
+    assert all(manifest.done(job) for job in jobs)
+
+
 def test_a_bad_take_is_reported_and_the_others_go_on(data_dir, tmp_path, capsys):
     src = tmp_path / "in"
     shutil.copytree(data_dir / "cmu", src)

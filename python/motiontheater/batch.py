@@ -49,6 +49,7 @@ STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed (when it
 SUFFIXES = {"asf": ".amc", "bvh": ".bvh"}  # what a motion of each skeleton convention is written as
 MANIFEST = ".motiontheater-batch.jsonl"
 _OLD_MANIFEST = ".motiontheater-batch.json"  # version 1, one JSON object: read where there is no other
+Stamp = tuple[int, int]  # a file's modification time (ns) and size: it has not changed while they hold
 
 
 @dataclass(frozen=True)
@@ -64,6 +65,7 @@ class Job:
     chunk_frames: int = CHUNK_FRAMES
     bytes: int = 0  # the take's size when planned
     unit: str | None = None  # the takes' length unit (--unit), when given
+    stamps: tuple[Stamp, Stamp | None] | None = None  # the take's and its skeleton's when planned
 
 
 @dataclass
@@ -80,6 +82,7 @@ class Result:
     frames: int = 0
     seconds: float = 0.0
     stop: str = ""  # an output problem that every take would meet: the run stops
+    written: int = 0  # the output's size
 
 
 def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
@@ -125,16 +128,14 @@ class Manifest:
                 break
 
     def _key(self, job: Job) -> str:
-        return os.path.relpath(job.output, self.path.parent)
+        return _relative(job.output, self.path.parent)
 
     def _stamps(self, job: Job) -> dict[str, Any]:
+        take, skeleton = job.stamps or (_stamp(job.input), _stamp(job.skeleton) if job.skeleton else None)
         return {
             "recipe": self.recipe,
             "input": os.path.abspath(job.input),
-            "stamps": [
-                list(_stamp(job.input)),
-                list(_stamp(job.skeleton)) if job.skeleton else None,
-            ],  # as JSON has them
+            "stamps": [list(take), list(skeleton) if skeleton else None],  # as JSON has them
         }
 
     def done(self, job: Job) -> bool:
@@ -150,8 +151,8 @@ class Manifest:
         key = self._key(job)
         self.entries[key] = entry = {
             **self._stamps(job),
-            "written": os.path.relpath(result.output, self.path.parent),
-            "size": os.path.getsize(result.output),
+            "written": _relative(result.output, self.path.parent),
+            "size": result.written or os.path.getsize(result.output),
         }
         if self._log is None:  # the manifest as found, compacted (atomically, like every output), then appended to
             with output(self.path) as f:
@@ -167,6 +168,12 @@ class Manifest:
         if self._log is not None:
             self._log.close()
             self._log = None
+
+
+def _relative(path: str, folder: Path) -> str:
+    """os.path.relpath of a path below the folder (as outputs are), without its system calls."""
+    prefix = os.path.join(folder, "")
+    return path[len(prefix) :] if path.startswith(prefix) else os.path.relpath(path, folder)
 
 
 def _manifest_line(key: str, entry: dict[str, Any]) -> bytes:
@@ -207,6 +214,7 @@ def plan_jobs(
     jobs, settled = [], []
     manifest = Manifest(out, pipeline.to_toml())
     folders: dict[Path, list[Path]] = {}  # the ASFs of each folder, listed once
+    skeleton_stamps: dict[Path, Stamp] = {}
     for take, relative in find_takes(inputs):
         target = Path(out) / relative
         if not in_place and target.exists() and os.path.samefile(take, target):
@@ -216,7 +224,9 @@ def plan_jobs(
             )
         try:
             asf = None if take.suffix.lower() == ".bvh" else skeleton_for(take, skeleton, folders)
-            size = take.stat().st_size
+            status = take.stat()
+            if asf is not None and asf not in skeleton_stamps:
+                skeleton_stamps[asf] = _stamp(str(asf))
         except FileNotFoundError as e:
             settled.append(Result(str(take), str(target), ok=False, error=str(e)))
             continue
@@ -228,11 +238,12 @@ def plan_jobs(
             frame_rate,
             stream_above,
             chunk_frames,
-            size,
+            status.st_size,
             unit,
+            ((status.st_mtime_ns, status.st_size), skeleton_stamps[asf] if asf else None),
         )
         if resume and manifest.done(job):
-            settled.append(Result(str(take), str(target), skipped=True, bytes=size))
+            settled.append(Result(str(take), str(target), skipped=True, bytes=status.st_size))
         else:
             jobs.append(job)
     return jobs, settled
@@ -258,6 +269,7 @@ def run_job(job: Job) -> Result:
             motion = require_frames(_read(job), job.input)
             result.output = _write(job, job.pipeline.apply(motion), motion)
             result.frames = motion.frames
+        result.written = os.path.getsize(result.output)
     except OutputError as e:
         result.ok, result.error = False, str(e)
         result.stop = str(e) if e.errno in WRITE_ERRORS else ""
@@ -296,7 +308,7 @@ def _write(job: Job, result: Motion, motion: Motion) -> str:
     return target
 
 
-def _stamp(path: str) -> tuple[int, int]:
+def _stamp(path: str) -> Stamp:
     status = os.stat(path)
     return status.st_mtime_ns, status.st_size
 
@@ -473,14 +485,27 @@ def _run_local(jobs: list[Job], workers: int) -> Generator[tuple[Job, Result]]:
     previous = signal.signal(signal.SIGTERM, _interrupt)
     pool = ProcessPoolExecutor(max_workers=count, initializer=_worker_start, initargs=(os.getpid(), count))
     try:
-        futures = {pool.submit(run_job, job): job for job in jobs}
+        futures = {pool.submit(_run_jobs, group): group for group in _groups(jobs, count)}
         for future in as_completed(futures):
-            yield futures[future], future.result()
+            yield from zip(futures[future], future.result())
     finally:
         for process in list(getattr(pool, "_processes", {}).values()):
             process.terminate()  # a half-written take dies with its worker; its partial file is removed
         pool.shutdown(wait=True, cancel_futures=True)
         signal.signal(signal.SIGTERM, previous)
+
+
+def _groups(jobs: list[Job], workers: int) -> list[list[Job]]:
+    """The jobs in groups, each sent to a worker at once: up to 8 takes, for the parent to handle
+    a message per group, not per take (over thousands of small takes that was a tenth of the
+    run's time), and at most a 1/16th of each worker's share, so that the workers finish close
+    together."""
+    size = max(1, min(8, len(jobs) // (16 * workers)))
+    return [jobs[i : i + size] for i in range(0, len(jobs), size)]
+
+
+def _run_jobs(jobs: list[Job]) -> list[Result]:
+    return [run_job(job) for job in jobs]
 
 
 def _worker_start(parent: int, processes: int) -> None:
