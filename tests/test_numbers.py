@@ -4,6 +4,7 @@ every bit pattern class, the grammar, the locale, frame numbers and the buffer b
 Python's repr, '%.Ng' and float() are the slow twins: correctly rounded, locale-free.
 """
 
+import functools
 import io
 import math
 import re
@@ -284,6 +285,39 @@ def test_newlines(newline):
     out.clear()
     format_frames(np.array([[1.5, -2.0], [3.0, 4.25]]), 7, [b"a", b"b"], [0, 1], [1, 1], out.append, newline=newline)
     assert b"".join(out) == newline.join([b"7", b"a 1.5", b"b -2", b"8", b"a 3", b"b 4.25", b""])
+
+
+class Trickle(io.RawIOBase):
+    """An unbuffered file that takes at most 1000 bytes a call, as a raw file may."""
+
+    def __init__(self):
+        self.data = bytearray()
+
+    def writable(self):
+        return True
+
+    def write(self, b):
+        taken = bytes(b[:1000])
+        self.data += taken
+        return len(taken)
+
+
+@pytest.mark.parametrize("writer", ["table", "frames"])
+def test_a_file_gets_the_text_a_function_gets(rng, tmp_path, writer):
+    """Chunks go to a file straight from the writer's buffer, to a function as bytes it may keep
+    (a list of them, joined after: the buffer is reused between chunks)."""
+    values = rng.standard_normal((1000, 7)) * 100  # four chunks
+    if writer == "table":
+        write = functools.partial(format_table, values)
+    else:
+        write = functools.partial(format_frames, values, 1, [b"a", b"bb"], [0, 3], [3, 4])
+    kept: list[bytes] = []
+    write(kept.append)
+    with open(tmp_path / "text", "wb") as f:
+        write(f)
+    trickle = Trickle()
+    write(trickle)
+    assert len(kept) == 4 and b"".join(kept) == (tmp_path / "text").read_bytes() == bytes(trickle.data)
 
 
 # ---- the bounds of the buffers ------------------------------------------------------------

@@ -233,9 +233,7 @@ def amc_writer(motion: Motion, target: Source) -> Iterator[Callable[[np.ndarray,
 
     def write(values: np.ndarray, first: int) -> None:
         nonlocal frames
-        format_frames(
-            values, first, keys, offsets, counts, f.write, frame_newline=style.frame_newline, **style.numbers()
-        )
+        format_frames(values, first, keys, offsets, counts, f, frame_newline=style.frame_newline, **style.numbers())
         frames += len(values)
 
     with output(target) as f:

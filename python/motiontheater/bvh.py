@@ -273,6 +273,6 @@ def write_bvh(motion: Motion, target: Source) -> None:
     style = motion.style
     with output(target) as f:
         f.write(style.lines(lines))
-        format_table(motion.values[:, columns], f.write, **style.numbers())
+        format_table(motion.values[:, columns], f, **style.numbers())
         if not style.final_newline and f.seekable():  # the file read ended without a line break
             f.truncate(f.tell() - len(style.newline))

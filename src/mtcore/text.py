@@ -15,13 +15,14 @@ never depend on the C locale.
 
 from __future__ import annotations
 
+import errno
 import functools
 import itertools
 import mmap
 import operator
 import re
 from collections.abc import Callable, Sequence
-from typing import Any, NamedTuple
+from typing import IO, Any, NamedTuple
 
 import numpy as np
 
@@ -335,20 +336,40 @@ def _describer(
     return describe
 
 
+def _sink(out: IO[bytes] | Callable[[bytes], object]) -> Callable[[np.ndarray], object]:
+    """How a chunk of text in the writers' buffer reaches ``out``: a file writes the buffer itself
+    before it is used again (a copy of each chunk cost a tenth of the writing); a function is given
+    bytes of its own, which it may keep."""
+    if callable(out):
+        return lambda chunk: out(chunk.tobytes())
+    file = out
+
+    def write(chunk: np.ndarray) -> None:
+        view = chunk.data
+        while view:  # an unbuffered file may take a part at a time
+            taken = file.write(view)
+            if taken is None:
+                raise BlockingIOError(errno.EAGAIN, "the file takes no more text now (non-blocking)")
+            view = view[taken:]
+
+    return write
+
+
 def format_frames(
     values: np.ndarray,
     first_frame: int,
     keys: Sequence[bytes],
     offsets: Sequence[int],
     counts: Sequence[int],
-    write: Callable[[bytes], object],
+    out: IO[bytes] | Callable[[bytes], object],
     *,
     digits: int | None = None,
     exponent_digits: int = 2,
     newline: bytes = b"\n",
     frame_newline: bytes | None = None,
 ) -> None:
-    """Write (frames, channels) values as frame text through ``write``, in chunks.
+    """Write (frames, channels) values as frame text to ``out``, in chunks: a binary file (as
+    ``open(path, "wb")`` gives), or a function given each chunk as bytes.
 
     Key lines come in the order of ``keys``; frames are numbered from
     ``first_frame`` (all numbers must lie in 0 .. FRAME_MAX, to be read back).
@@ -374,6 +395,7 @@ def format_frames(
     chunk = max(1, min(frames, _FORMAT_CHUNK))
     buf = np.empty(lib.mt_format_bound(chunk, table.c_lens, table.c_counts, table.n, style), np.uint8)  # not zeroed
     written = ffi.new("size_t *")
+    write = _sink(out)
     with c_array(values) as c_values, c_array(buf, "char[]") as c_buf:
         for f0 in range(0, frames, chunk):
             n = min(chunk, frames - f0)
@@ -393,7 +415,7 @@ def format_frames(
                 written,
             )
             check(status, "mt_format_frames")
-            write(buf[: written[0]].tobytes())
+            write(buf[: written[0]])
 
 
 def scan_table(text: bytes, rows: int, columns: int, *, start: int = 0, workers: int | None = None) -> np.ndarray:
@@ -474,14 +496,14 @@ def _table_pieces(text: bytes, start: int, rows: int, count: int) -> list[tuple[
 
 def format_table(
     values: np.ndarray,
-    write: Callable[[bytes], object],
+    out: IO[bytes] | Callable[[bytes], object],
     *,
     digits: int | None = None,
     exponent_digits: int = 2,
     newline: bytes = b"\n",
 ) -> None:
-    """Write (rows, columns) values as lines of numbers separated by a blank through ``write``,
-    in chunks; numbers and lines as for :func:`format_frames`."""
+    """Write (rows, columns) values as lines of numbers separated by a blank to ``out``, in chunks;
+    ``out``, numbers and lines as for :func:`format_frames`."""
     style = _style(digits, exponent_digits, newline)
     values = np.ascontiguousarray(values, dtype=np.float64)
     if values.ndim != 2:
@@ -490,12 +512,13 @@ def format_table(
     chunk = max(1, min(rows, _FORMAT_CHUNK))
     buf = np.empty(lib.mt_format_table_bound(chunk, columns, style), np.uint8)  # not zeroed
     written = ffi.new("size_t *")
+    write = _sink(out)
     with c_array(values) as c_values, c_array(buf, "char[]") as c_buf:
         for r0 in range(0, rows, chunk):
             n = min(chunk, rows - r0)
             status = lib.mt_format_table(c_values + r0 * columns, n, columns, style, c_buf, len(buf), written)
             check(status, "mt_format_table")
-            write(buf[: written[0]].tobytes())
+            write(buf[: written[0]])
 
 
 def format_number(value: float, *, digits: int | None = None, exponent_digits: int = 2) -> str:
