@@ -348,11 +348,14 @@ MT_AVX512_CODE static inline __m512i pick(__m512i x, __m512i t0, __m512i t1, __m
 MT_AVX512_CODE static inline __m512i eight_digits8(__m512i v)
 {
     const __m512i high = _mm512_srli_epi64(_mm512_mullo_epi64(v, K(109951163)), 40); /* v / 10000 */
-    const __m512i merged = _mm512_or_si512(high, _mm512_slli_epi64(_mm512_sub_epi64(v, _mm512_mullo_epi64(high, K(10000))), 32));
+    const __m512i low = _mm512_sub_epi64(v, _mm512_mullo_epi64(high, K(10000)));
+    const __m512i merged = _mm512_or_si512(high, _mm512_slli_epi64(low, 32));
     const __m512i top = _mm512_and_si512(_mm512_srli_epi64(_mm512_mullo_epi64(merged, K(10486)), 20),
-                                         K((UINT64_C(0x7f) << 32) | 0x7f));
-    const __m512i hundreds = _mm512_add_epi64(_mm512_slli_epi64(_mm512_sub_epi64(merged, _mm512_mullo_epi64(top, K(100))), 16), top);
-    __m512i tens = _mm512_and_si512(_mm512_srli_epi64(_mm512_mullo_epi64(hundreds, K(103)), 10), K(0x000f000f000f000f));
+                                         K((UINT64_C(0x7f) << 32) | 0x7f)); /* / 100 */
+    const __m512i hundreds =
+        _mm512_add_epi64(_mm512_slli_epi64(_mm512_sub_epi64(merged, _mm512_mullo_epi64(top, K(100))), 16), top);
+    __m512i tens = _mm512_and_si512(_mm512_srli_epi64(_mm512_mullo_epi64(hundreds, K(103)), 10),
+                                    K(0x000f000f000f000f)); /* / 10 */
     tens = _mm512_add_epi64(tens, _mm512_slli_epi64(_mm512_sub_epi64(hundreds, _mm512_mullo_epi64(tens, K(10))), 8));
     return _mm512_add_epi64(tens, K(ZEROS_WORD));
 }
@@ -361,7 +364,8 @@ MT_AVX512_CODE static inline __m512i eight_digits8(__m512i v)
    (off by one at most) and a correction. */
 MT_AVX512_CODE static inline __m512i divide8(__m512i x, uint64_t unit, __m512i *rest)
 {
-    __m512i q = _mm512_cvttpd_epu64(_mm512_mul_pd(_mm512_cvtepu64_pd(x), _mm512_set1_pd(1.0 / (double)unit)));
+    const __m512d estimate = _mm512_mul_pd(_mm512_cvtepu64_pd(x), _mm512_set1_pd(1.0 / (double)unit));
+    __m512i q = _mm512_cvttpd_epu64(estimate);
     __m512i r = _mm512_sub_epi64(x, _mm512_mullo_epi64(q, K(unit)));
     const __mmask8 under = _mm512_cmplt_epi64_mask(r, _mm512_setzero_si512());
     q = _mm512_mask_sub_epi64(q, under, q, K(1));
@@ -371,78 +375,95 @@ MT_AVX512_CODE static inline __m512i divide8(__m512i x, uint64_t unit, __m512i *
     return _mm512_mask_add_epi64(q, over, q, K(1));
 }
 
+/* 1 where the mask says, else 0 */
+MT_AVX512_CODE static inline __m512i ones_where(__mmask8 mask)
+{
+    return _mm512_maskz_mov_epi64(mask, K(1));
+}
+
+/* The bytes of each lane's exponent suffix: "e", the sign, then |e10| in at least `least` digits;
+   their count to *width. */
+MT_AVX512_CODE static inline __m512i exponent_suffix(__m512i e10, int least, __m512i *width)
+{
+    const __m512i power = _mm512_abs_epi64(e10); /* < 1000 */
+    const __m512i natural = _mm512_add_epi64(K(1), _mm512_add_epi64(ones_where(_mm512_cmpge_epi64_mask(power, K(10))),
+                                                                    ones_where(_mm512_cmpge_epi64_mask(power, K(100)))));
+    *width = _mm512_max_epi64(natural, K(least));
+    const __m512i hundreds = _mm512_srli_epi64(_mm512_mullo_epi64(power, K(5243)), 19); /* / 100 */
+    const __m512i below = _mm512_sub_epi64(power, _mm512_mullo_epi64(hundreds, K(100)));
+    const __m512i tens = _mm512_srli_epi64(_mm512_mullo_epi64(below, K(103)), 10); /* / 10 */
+    const __m512i ones = _mm512_sub_epi64(below, _mm512_mullo_epi64(tens, K(10)));
+    /* the three digits in bytes 0, 1, 2; the last `width` of them */
+    const __m512i three = _mm512_or_si512(_mm512_or_si512(hundreds, _mm512_slli_epi64(tens, 8)),
+                                          _mm512_slli_epi64(ones, 16));
+    const __m512i digits = _mm512_add_epi64(
+        _mm512_srlv_epi64(three, _mm512_slli_epi64(_mm512_sub_epi64(K(3), *width), 3)), K(0x303030));
+    const __m512i e_sign = _mm512_mask_blend_epi64(_mm512_cmplt_epi64_mask(e10, _mm512_setzero_si512()),
+                                                   K('e' | '+' << 8), K('e' | '-' << 8));
+    return _mm512_or_si512(e_sign, _mm512_slli_epi64(digits, 16));
+}
+
 /*
- * texts of values[0 .. count-1], eight at a time: the shortest decimals by number_shortest8,
- * their digits in lanes, and each text by one byte shuffle from the layout of its exponent.
- * What the lanes leave (see number_shortest8, and the exponent form) is put_number's.
- * Returns how many were done (a multiple of 8).
+ * The texts of values[0 .. count-1], eight at a time: the shortest decimals by number_shortest8,
+ * their digits in lanes (scaled to 17: the lead digit and two words of eight), and each text by
+ * one byte shuffle from the layout of its exponent, its 17th byte on from a shift, the exponent
+ * form's suffix stored after the digits.  What the lanes leave (see number_shortest8; and the
+ * plain texts from 1e15, whose point follows the 16th digit) is put_number's.  Returns how many
+ * were done (a multiple of 8).
  */
 MT_AVX512_CODE static size_t texts_avx512(const double *values, size_t count, const struct style *s,
                                           struct texts *t)
 {
     const __m512i pow10_0 = _mm512_loadu_si512(pow10_u64), pow10_1 = _mm512_loadu_si512(pow10_u64 + 8);
     const __m512i pow10_2 = _mm512_maskz_loadu_epi64(0x0f, pow10_u64 + 16);
+    const __m512i zero = _mm512_setzero_si512();
     size_t i = 0;
     for (; i + 8 <= count; i += 8) {
         uint64_t d[8];
         int64_t e[8];
         __mmask8 done = (__mmask8)number_shortest8(values + i, d, e);
         const __m512i digits = _mm512_loadu_si512(d);
-        /* its length, then the digits scaled to 17: 10^16 <= full < 10^17 */
-        const __m512i guess = _mm512_srli_epi64(
-            _mm512_mullo_epi64(_mm512_sub_epi64(K(64), _mm512_lzcnt_epi64(digits)), K(1233)), 12);
-        const __m512i length = _mm512_mask_add_epi64(guess, _mm512_cmpge_epu64_mask(digits, pick(guess, pow10_0, pow10_1, pow10_2)),
-                                                     guess, K(1));
+        /* the count of digits, from the bit length (or one more), then the digits scaled to 17 */
+        const __m512i bits = _mm512_sub_epi64(K(64), _mm512_lzcnt_epi64(digits));
+        const __m512i guess = _mm512_srli_epi64(_mm512_mullo_epi64(bits, K(1233)), 12);
+        const __mmask8 more = _mm512_cmpge_epu64_mask(digits, pick(guess, pow10_0, pow10_1, pow10_2));
+        const __m512i length = _mm512_add_epi64(guess, ones_where(more));
         done &= _mm512_cmple_epu64_mask(length, K(17));
-        const __m512i full = _mm512_mullo_epi64(digits, pick(_mm512_sub_epi64(K(17), length), pow10_0, pow10_1, pow10_2));
+        const __m512i scale = pick(_mm512_sub_epi64(K(17), length), pow10_0, pow10_1, pow10_2);
+        const __m512i full = _mm512_mullo_epi64(digits, scale); /* 10^16 <= full < 10^17 */
         __m512i rest, low;
         const __m512i first = divide8(full, UINT64_C(10000000000000000), &rest);
         const __m512i high = eight_digits8(divide8(rest, 100000000, &low));
         low = eight_digits8(low);
         /* significant digits: 17 less the trailing '0's */
-        const __m512i low_set = _mm512_xor_si512(low, K(ZEROS_WORD)), high_set = _mm512_xor_si512(high, K(ZEROS_WORD));
-        const __m512i n = _mm512_sub_epi64(
-            _mm512_sub_epi64(K(17), _mm512_srli_epi64(_mm512_lzcnt_epi64(low_set), 3)),
-            _mm512_maskz_srli_epi64(_mm512_cmpeq_epi64_mask(low_set, _mm512_setzero_si512()),
-                                    _mm512_lzcnt_epi64(high_set), 3));
+        const __m512i low_set = _mm512_xor_si512(low, K(ZEROS_WORD));
+        const __m512i high_set = _mm512_xor_si512(high, K(ZEROS_WORD));
+        const __m512i low_zeros = _mm512_srli_epi64(_mm512_lzcnt_epi64(low_set), 3);
+        const __m512i high_zeros = _mm512_maskz_srli_epi64(_mm512_cmpeq_epi64_mask(low_set, zero),
+                                                           _mm512_lzcnt_epi64(high_set), 3);
+        const __m512i n = _mm512_sub_epi64(_mm512_sub_epi64(K(17), low_zeros), high_zeros);
         const __m512i e10 = _mm512_add_epi64(_mm512_loadu_si512(e), _mm512_sub_epi64(length, K(1)));
         /* plain from 1e-4 to below 1e15 (from there to 1e16 the point follows the 16th digit:
            put_number's), else the exponent form */
         const __mmask8 exponent_form = _mm512_cmplt_epi64_mask(e10, K(-4)) | _mm512_cmpge_epi64_mask(e10, K(16));
         done &= exponent_form | _mm512_cmple_epi64_mask(e10, K(14));
-        /* plain: zeros after "0." (none from e10 >= 0), digits before the point, the length */
-        const __m512i zeros = _mm512_maskz_max_epi64((__mmask8)~exponent_form,
-                                                     _mm512_sub_epi64(_mm512_setzero_si512(), e10), _mm512_setzero_si512());
+        const __m512i sign = _mm512_srli_epi64(_mm512_loadu_si512(values + i), 63);
+        /* plain: "0." and zeros before the digits below 1, the point after `whole` digits */
+        const __m512i zeros = _mm512_maskz_max_epi64((__mmask8)~exponent_form, _mm512_sub_epi64(zero, e10), zero);
         const __m512i whole = _mm512_max_epi64(_mm512_add_epi64(e10, K(1)), K(1));
         const __m512i shown = _mm512_add_epi64(zeros, n);
-        const __m512i sign = _mm512_srli_epi64(_mm512_loadu_si512(values + i), 63);
-        __m512i len = _mm512_mask_add_epi64(whole, _mm512_cmpgt_epi64_mask(shown, whole), shown, K(1));
-        /* the exponent form: d.ddd (d alone for one digit), then "e", its sign and at least
-           exponent_digits digits, from where the suffix goes */
+        const __m512i plain = _mm512_mask_add_epi64(whole, _mm512_cmpgt_epi64_mask(shown, whole), shown, K(1));
+        /* the exponent form: d.ddd (d alone for one digit), then its suffix */
         const __m512i mantissa = _mm512_mask_add_epi64(K(1), _mm512_cmpgt_epi64_mask(n, K(1)), n, K(1));
-        const __m512i power = _mm512_abs_epi64(e10);
-        const __m512i hundreds = _mm512_srli_epi64(_mm512_mullo_epi64(power, K(5243)), 19); /* / 100 */
-        const __m512i below = _mm512_sub_epi64(power, _mm512_mullo_epi64(hundreds, K(100)));
-        const __m512i tens = _mm512_srli_epi64(_mm512_mullo_epi64(below, K(103)), 10); /* / 10 */
-        const __m512i ones = _mm512_sub_epi64(below, _mm512_mullo_epi64(tens, K(10)));
-        const __m512i natural = _mm512_add_epi64(
-            K(1), _mm512_add_epi64(_mm512_maskz_mov_epi64(_mm512_cmpge_epi64_mask(power, K(10)), K(1)),
-                                   _mm512_maskz_mov_epi64(_mm512_cmpge_epi64_mask(power, K(100)), K(1))));
-        const __m512i width = _mm512_max_epi64(natural, K(s->exponent_digits));
-        /* "e-" then the digits of the width, hundreds first: as bytes of a word */
-        __m512i suffix = _mm512_mask_blend_epi64(_mm512_cmplt_epi64_mask(e10, _mm512_setzero_si512()), K('e' | '+' << 8),
-                                                 K('e' | '-' << 8));
-        const __m512i ascii = _mm512_or_si512(_mm512_or_si512(hundreds, _mm512_slli_epi64(tens, 8)), _mm512_slli_epi64(ones, 16));
-        /* ones, tens, hundreds in bytes 2, 1, 0 of ascii: the last `width` of them */
-        suffix = _mm512_or_si512(suffix, _mm512_slli_epi64(_mm512_add_epi64(_mm512_srlv_epi64(ascii, _mm512_slli_epi64(_mm512_sub_epi64(K(3), width), 3)),
-                                                                            K(0x303030)) , 16));
-        len = _mm512_mask_add_epi64(len, exponent_form, mantissa, _mm512_add_epi64(width, K(2)));
-        const __m512i suffix_at = _mm512_add_epi64(sign, _mm512_mask_mov_epi64(len, exponent_form, mantissa));
-        len = _mm512_add_epi64(len, sign);
+        __m512i width;
+        const __m512i suffix = exponent_suffix(e10, s->exponent_digits, &width);
+        const __m512i suffix_at = _mm512_add_epi64(sign, _mm512_mask_mov_epi64(plain, exponent_form, mantissa));
+        const __m512i len = _mm512_add_epi64(
+            sign, _mm512_mask_add_epi64(plain, exponent_form, mantissa, _mm512_add_epi64(width, K(2))));
         /* the 16 bytes the shuffle takes from: the lead digit and digits 2 .. 16 */
         const __m512i w0 = _mm512_or_si512(_mm512_add_epi64(first, K('0')), _mm512_slli_epi64(high, 8));
         const __m512i w1 = _mm512_or_si512(_mm512_srli_epi64(high, 56), _mm512_slli_epi64(low, 8));
-        /* and the bytes of the text from its 17th: digits from the (16 - zeros)th */
+        /* and the text from its 17th byte: the digits from the (16 - zeros)th */
         const __m512i tail = _mm512_srlv_epi64(low, _mm512_sub_epi64(K(48), _mm512_slli_epi64(zeros, 3)));
         uint64_t from[16], tails[8], lens[8], rows[8], signs[8], suffixes[8], suffix_ats[8];
         _mm512_storeu_si512(from, _mm512_permutex2var_epi64(w0, _mm512_set_epi64(11, 3, 10, 2, 9, 1, 8, 0), w1));
@@ -453,21 +474,21 @@ MT_AVX512_CODE static size_t texts_avx512(const double *values, size_t count, co
         _mm512_storeu_si512(suffixes, suffix);
         _mm512_storeu_si512(suffix_ats, suffix_at);
         _mm512_storeu_si512(signs, sign);
-        for (int j = 0; j < 8; j++) {
-            char *slot = t->text[i + (size_t)j];
+        for (size_t j = 0; j < 8; j++) {
             if (!((done >> j) & 1)) {
-                put_slot(values[i + (size_t)j], s, t, i + (size_t)j);
+                put_slot(values[i + j], s, t, i + j);
                 continue;
             }
-            const __m128i text = _mm_or_si128(
-                _mm_shuffle_epi8(_mm_loadu_si128((const __m128i *)(from + 2 * j)),
-                                 _mm_loadu_si128((const __m128i *)layout_take[rows[j]])),
-                _mm_loadu_si128((const __m128i *)layout_put[rows[j]]));
-            slot[0] = '-';
+            char *slot = t->text[i + j];
+            const __m128i from_j = _mm_loadu_si128((const __m128i *)(from + 2 * j));
+            const __m128i take = _mm_loadu_si128((const __m128i *)layout_take[rows[j]]);
+            const __m128i put = _mm_loadu_si128((const __m128i *)layout_put[rows[j]]);
+            const __m128i text = _mm_or_si128(_mm_shuffle_epi8(from_j, take), put);
+            slot[0] = '-'; /* overwritten where there is no sign */
             _mm_storeu_si128((__m128i *)(slot + signs[j]), text);
             memcpy(slot + signs[j] + 16, &tails[j], 8);
             memcpy(slot + suffix_ats[j], &suffixes[j], 8); /* past the end of a plain text */
-            t->len[i + (size_t)j] = (unsigned char)lens[j];
+            t->len[i + j] = (unsigned char)lens[j];
         }
     }
     return i;
