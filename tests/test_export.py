@@ -86,7 +86,7 @@ def test_bvh_headers_carry_its_detected_unit(data_dir, tmp_path):
     mt.write_positions(walk, tmp_path / "w.trc")
     assert (tmp_path / "w.trc").read_text().split("\n")[2].split("\t")[4] == "cm"
     mt.write_positions(walk, tmp_path / "w.csv")
-    assert (tmp_path / "w.csv").read_text().split("\n")[0].split(",")[2] == "root.x [cm]"
+    assert (tmp_path / "w.csv").read_text().split("\n")[0].split(",")[2] == "Hips.x [cm]"  # its root's name
     mt.write_positions(walk, tmp_path / "w.npz")
     data = np.load(tmp_path / "w.npz")
     assert data["meters_per_unit"] == 0.01 and str(data["length_unit"]) == "cm"

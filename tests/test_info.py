@@ -165,4 +165,4 @@ def test_batch_reads_with_the_unit_given(data_dir, tmp_path):
     (tmp_path / "r.toml").write_text('[[step]]\nrun = "positions"\n')
     args = ["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--recipe", str(tmp_path / "r.toml")]
     assert main([*args, "--jobs", "1", "--quiet", "--unit", "mm"]) == 0
-    assert (tmp_path / "out" / "walk01.csv").read_text().split(",")[2] == "root.x [mm]"
+    assert (tmp_path / "out" / "walk01.csv").read_text().split(",")[2] == "Hips.x [mm]"

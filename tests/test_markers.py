@@ -158,7 +158,7 @@ def test_trc_opens_by_opensims_rules(tmp_path, path, capsys):
     assert header["Units"] == "m"
     assert float(header["DataRate"]) == pytest.approx(motion.frame_rate, rel=1e-5)  # written with %g
     assert int(header["NumFrames"]) == motion.frames == len(times)
-    assert labels == list(motion.skeleton.joint_names)
+    assert labels == list(motion.skeleton.point_names)  # a BVH's root as its file names it, as in its C3D
     np.testing.assert_allclose(data, motion.positions(meters=True), rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(times, motion.times, rtol=1e-9)
 

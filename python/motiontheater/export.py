@@ -42,7 +42,8 @@ def write_positions(
 
     The format is the target's suffix unless given.  CSV: one row per frame,
     columns ``frame``, ``time [s]``, ``<joint>.x [<unit>]``, ``<joint>.y
-    [<unit>]``, ``<joint>.z [<unit>]`` in the skeleton's joint order, 10
+    [<unit>]``, ``<joint>.z [<unit>]`` in the skeleton's joint order (the
+    root under its file's name: root, or a BVH's Hips), 10
     significant digits, the unit as :func:`length_unit_label` gives it (m,
     cm, mm, in, or in/0.45 for CMU and HDM05 units).  NPZ: positions
     (frames, joints, 3) exact, joint_names, frames, times, frame_rate,
@@ -65,7 +66,7 @@ def write_positions(
         )
     positions = motion.positions(meters=meters, workers=workers)
     frames = motion.first_frame + np.arange(motion.frames)
-    names = motion.skeleton.joint_names
+    names = motion.skeleton.point_names  # a BVH's root under its own name (Hips), as bvh-toolbox writes it
     with output(target) as f:
         if format == "npz":
             np.savez(

@@ -65,8 +65,9 @@ def write_take(motion: Motion, path: str | os.PathLike) -> None:
     suffix = take_suffix(path)
     if motion.skeleton.convention != CONVENTIONS[suffix]:
         other = ".bvh" if suffix == ".amc" else ".amc"
+        kind = "an ASF" if motion.skeleton.convention == "asf" else "a BVH"
         raise ValueError(
-            f"{os.fspath(path)}: this is a motion of a {motion.skeleton.convention.upper()} skeleton, written as "
-            f"{other}; name the output {other}, or convert it first (motiontheater convert)"
+            f"{os.fspath(path)}: this is a motion of {kind} skeleton, which is written as {other}, not {suffix}; "
+            f"name the output {other}, or convert it first (motiontheater convert)"
         )
     (write_bvh if suffix == ".bvh" else write_amc)(motion, path)
