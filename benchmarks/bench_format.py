@@ -31,6 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 WRITE = "write mean-5 filtered 100 MB AMC (Motion -> file)"
 RAW = "write the raw 100 MB AMC (Motion -> file)"
 SCAN = "scan {} 100 MB AMC frame text, 1 thread"
+CODE = "mt_format_frames of {} 100 MB AMC (in memory): vector code vs portable code"
 
 
 @pytest.fixture(scope="module")
@@ -184,3 +185,33 @@ def test_scan(benchmark, record, raw, texts, old, name, who):
     assert values.tobytes() == mt.read_amc(texts / f"{name}.amc", raw.skeleton).values.tobytes()
     case = SCAN.format("the raw" if name == "raw" else "a mean-5 filtered")
     record(case, who, len(body), unit="MB", target=f">= 1x {OLD} scanner" if who == "mtcore" else "")
+
+
+def format_in_memory(values: np.ndarray, keys, offsets, counts, portable: int) -> int:
+    """mt_format_frames over values in the chunks of mtcore.text.format_frames, into one reused
+    buffer (no file): the vector code, where the processor has it, or the portable code only."""
+    *table, _ = key_table(ffi, keys, offsets, counts)
+    style = ffi.new("struct mt_format_style *", [0, 2, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_LF, portable])
+    chunk, (frames, channels) = 256, values.shape
+    buf = ffi.new("char[]", lib.mt_format_bound(chunk, table[1], table[3], table[4], style))
+    written, total = ffi.new("size_t *"), 0
+    c_values = ffi.from_buffer("double[]", values)
+    for f0 in range(0, frames, chunk):
+        n = min(chunk, frames - f0)
+        status = lib.mt_format_frames(
+            c_values + f0 * channels, n, channels, f0 + 1, *table, style, buf, len(buf), written
+        )
+        assert status == lib.MT_OK
+        total += written[0]
+    return total
+
+
+@pytest.mark.parametrize("code", ["vector", "portable"])
+@pytest.mark.parametrize("name", ["raw", "smoothed"])
+def test_format_code(benchmark, record, raw, smoothed, name, code):
+    """The formatter alone, its vector code (x86-64 with AVX-512; elsewhere the same code runs
+    twice) against its portable code, on the same values."""
+    values = raw.values if name == "raw" else smoothed.values
+    size = benchmark.pedantic(format_in_memory, (values, *layout(raw), int(code == "portable")), **FAST)
+    case = CODE.format("the raw" if name == "raw" else "a mean-5 filtered")
+    record(case, "mtcore" if code == "vector" else "portable code", size, unit="MB")
