@@ -5,6 +5,7 @@ import pytest
 
 import motiontheater as mt
 from motiontheater.cli import main
+from motiontheater.filtering import Smoother, TakeStats
 
 
 @pytest.fixture
@@ -76,9 +77,25 @@ def test_edges_hold_by_default_and_modes_are_configurable(take):
     assert reflected[0] == pytest.approx((2 * channel[0] + 2 * channel[1] + channel[2]) / 5, abs=1e-12)
 
 
-def test_input_motion_is_untouched_and_metadata_kept(take):
+@pytest.mark.parametrize("kind", ["median", "mean", "binomial"])
+@pytest.mark.parametrize("joints", [None, ["lfemur", "lowerback"], ["rhumerus", "root"]])
+def test_the_means_scratch_space_changes_no_value(take, kind, joints):
+    """filter_motion lets the means work in its own unwrapped copy (scratch=True): the values are
+    those of working in a new array, for every column, chosen as a run or not."""
+    smoother = Smoother(take.skeleton, kind, 5, joints)
+    stats = TakeStats.of(take.values)
+    unwrapped, _ = smoother.unwrap(take.values, None)
+    kept = unwrapped.copy()
+    fresh = smoother.smooth(unwrapped, stats)
+    assert unwrapped.tobytes() == kept.tobytes()  # not scratch: left as it was
+    assert smoother.smooth(unwrapped, stats, scratch=True).tobytes() == fresh.tobytes()
+    assert take.filter(kind, 5, joints).values.tobytes() == fresh.tobytes()
+
+
+@pytest.mark.parametrize("kind", ["median", "mean", "binomial"])
+def test_input_motion_is_untouched_and_metadata_kept(take, kind):
     before = take.values.copy()
-    smoothed = take.filter("median", 3)
+    smoothed = take.filter(kind, 3)
     np.testing.assert_array_equal(take.values, before)
     assert (smoothed.frame_rate, smoothed.first_frame, smoothed.header, smoothed.line_order) == (
         take.frame_rate,

@@ -113,8 +113,10 @@ class Smoother:
             return values.copy(), state
         return unwrap_angles(values, self.period, state, self.rotations)
 
-    def smooth(self, unwrapped: np.ndarray, stats: TakeStats) -> np.ndarray:
-        """Smoothed frames (all channels; the chosen ones changed), rotations wrapped back."""
+    def smooth(self, unwrapped: np.ndarray, stats: TakeStats, *, scratch: bool = False) -> np.ndarray:
+        """Smoothed frames (all channels; the chosen ones changed), rotations wrapped back.
+        ``scratch``: the caller gives ``unwrapped`` up, and the means may work in its chosen
+        columns rather than in a new array (the same values, an array fewer)."""
         chosen = self._chosen
         every = chosen == slice(0, unwrapped.shape[1])
         smooth = partial(FILTERS[self.kind], size=self.size, axis=0, mode=self.mode, workers=self.workers)
@@ -122,7 +124,12 @@ class Smoother:
             block = smooth(unwrapped[:, chosen])
         else:  # means relative to the take's first frame: exact for constants, no loss far from zero
             base = stats.base[chosen]
-            block = smooth(unwrapped[:, chosen] - base)  # into a new array: in place costs a copy
+            if scratch:
+                relative = unwrapped[:, chosen]  # a view where the columns run on
+                relative -= base
+            else:
+                relative = unwrapped[:, chosen] - base
+            block = smooth(relative)  # into a new array: in place costs a copy
             block += base
         if len(self._turning):
             rotations = self.rotations
@@ -203,7 +210,7 @@ def filter_motion(
     if not motion.frames or not (len(smoother.rotations) or smoother.others):
         return motion.replace(values=motion.values)
     unwrapped, _ = smoother.unwrap(motion.values, None)
-    values = smoother.smooth(unwrapped, TakeStats.of(motion.values))
+    values = smoother.smooth(unwrapped, TakeStats.of(motion.values), scratch=True)  # unwrapped is ours
     values.flags.writeable = False
     return motion.replace(values=values)
 
