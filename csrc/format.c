@@ -303,8 +303,6 @@ static inline char *copy_slot(const struct texts *t, size_t i, char *out)
 #if MT_AVX512
 #include <immintrin.h>
 
-#define K(x) _mm512_set1_epi64((int64_t)(x)) /* x in every lane */
-
 /*
  * The layouts of the vector code: the plain ones, one per decimal exponent e10 of -4 .. 14
  * (row e10 + 4), then the exponent form (row 19).  Each says which of the 16 bytes lead digit,
@@ -336,6 +334,80 @@ static const unsigned char layout_put[20][16] = ROWS(PUT);
 #undef PUT
 #undef ROW
 #undef ROWS
+
+/* What the vector code works out in its lanes for each text: the 16 bytes the shuffle takes from
+   (the lead digit, digits 2 .. 16), the text from its 17th byte, its length, its layout row, its
+   sign (0 or 1), the exponent suffix and where it goes. */
+struct lanes {
+    uint64_t from[16], tail[8], len[8], row[8], sign[8], suffix[8], suffix_at[8];
+};
+
+/* The texts of values[i .. i + count - 1] from the lanes: those of `done` by one byte shuffle
+   each, the others by put_number.  SSSE3, which the vector code's processors have. */
+__attribute__((target("ssse3"), always_inline)) static inline void
+put_lanes(const double *values, size_t i, size_t count, unsigned done, const struct lanes *l, const struct style *s,
+          struct texts *t)
+{
+    for (size_t j = 0; j < count; j++) {
+        if (!((done >> j) & 1)) {
+            put_slot(values[i + j], s, t, i + j);
+            continue;
+        }
+        char *slot = t->text[i + j];
+        const __m128i from = _mm_loadu_si128((const __m128i *)(l->from + 2 * j));
+        const __m128i take = _mm_loadu_si128((const __m128i *)layout_take[l->row[j]]);
+        const __m128i put = _mm_loadu_si128((const __m128i *)layout_put[l->row[j]]);
+        const __m128i text = _mm_or_si128(_mm_shuffle_epi8(from, take), put);
+        slot[0] = '-'; /* overwritten where there is no sign */
+        _mm_storeu_si128((__m128i *)(slot + l->sign[j]), text);
+        memcpy(slot + l->sign[j] + 16, &l->tail[j], 8);
+        memcpy(slot + l->suffix_at[j], &l->suffix[j], 8); /* past the end of a plain text */
+        t->len[i + j] = (unsigned char)l->len[j];
+    }
+}
+
+/*
+ * The texts of values[0 .. count-1] by a vector code of `lanes` (<= 8) lanes: the shortest
+ * decimals of `lanes` values by `shortest`, the parts of their texts by `parts`, each text by
+ * put_lanes.  Each step for GROUPS groups of lanes before the next: one group's steps are a long
+ * chain of operations each waiting for the one before, which the processor runs beside another
+ * group's.  Returns how many were done (a multiple of `lanes`).
+ */
+typedef unsigned shortest_code(const double *a, uint64_t *d, int64_t *exp10);
+typedef unsigned parts_code(const double *values, const uint64_t *d, const int64_t *e, unsigned done,
+                            const struct style *s, struct lanes *l);
+enum { GROUPS = 2 };
+
+__attribute__((target("ssse3"), always_inline)) static inline size_t
+texts_vector(const double *values, size_t count, const struct style *s, struct texts *t, size_t lanes,
+             shortest_code *shortest, parts_code *parts)
+{
+    size_t i = 0;
+    for (; i + GROUPS * lanes <= count; i += GROUPS * lanes) {
+        uint64_t d[GROUPS * 8];
+        int64_t e[GROUPS * 8];
+        unsigned done[GROUPS];
+        struct lanes l[GROUPS];
+        for (size_t g = 0; g < GROUPS; g++)
+            done[g] = shortest(values + i + g * lanes, d + g * lanes, e + g * lanes);
+        for (size_t g = 0; g < GROUPS; g++)
+            done[g] = parts(values + i + g * lanes, d + g * lanes, e + g * lanes, done[g], s, &l[g]);
+        for (size_t g = 0; g < GROUPS; g++)
+            put_lanes(values, i + g * lanes, lanes, done[g], &l[g], s, t);
+    }
+    for (; i + lanes <= count; i += lanes) {
+        uint64_t d[8];
+        int64_t e[8];
+        struct lanes l;
+        const unsigned done = parts(values + i, d, e, shortest(values + i, d, e), s, &l);
+        put_lanes(values, i, lanes, done, &l, s, t);
+    }
+    return i;
+}
+#endif
+
+#if MT_AVX512
+#define K(x) _mm512_set1_epi64((int64_t)(x)) /* x in every lane */
 
 /* Lane by lane: x for x < 16 from table[0 .. 15] of two vectors, else from the third. */
 MT_AVX512_CODE static inline __m512i pick(__m512i x, __m512i t0, __m512i t1, __m512i t2)
@@ -386,8 +458,9 @@ MT_AVX512_CODE static inline __m512i ones_where(__mmask8 mask)
 MT_AVX512_CODE static inline __m512i exponent_suffix(__m512i e10, int least, __m512i *width)
 {
     const __m512i power = _mm512_abs_epi64(e10); /* < 1000 */
-    const __m512i natural = _mm512_add_epi64(K(1), _mm512_add_epi64(ones_where(_mm512_cmpge_epi64_mask(power, K(10))),
-                                                                    ones_where(_mm512_cmpge_epi64_mask(power, K(100)))));
+    const __m512i natural = _mm512_add_epi64(
+        K(1), _mm512_add_epi64(ones_where(_mm512_cmpge_epi64_mask(power, K(10))),
+                               ones_where(_mm512_cmpge_epi64_mask(power, K(100)))));
     *width = _mm512_max_epi64(natural, K(least));
     const __m512i hundreds = _mm512_srli_epi64(_mm512_mullo_epi64(power, K(5243)), 19); /* / 100 */
     const __m512i below = _mm512_sub_epi64(power, _mm512_mullo_epi64(hundreds, K(100)));
@@ -404,94 +477,78 @@ MT_AVX512_CODE static inline __m512i exponent_suffix(__m512i e10, int least, __m
 }
 
 /*
- * The texts of values[0 .. count-1], eight at a time: the shortest decimals by number_shortest8,
- * their digits in lanes (scaled to 17: the lead digit and two words of eight), and each text by
- * one byte shuffle from the layout of its exponent, its 17th byte on from a shift, the exponent
- * form's suffix stored after the digits.  What the lanes leave (see number_shortest8; and the
- * plain texts from 1e15, whose point follows the 16th digit) is put_number's.  Returns how many
- * were done (a multiple of 8).
+ * The parts of the texts of values[0 .. 7] in lanes, for put_lanes: their shortest decimals d and
+ * exponents e from number_shortest8 (done: its mask), their digits scaled to 17 (the lead digit and
+ * two words of eight), the layout of their exponent, their 17th byte on from a shift, the exponent
+ * form's suffix.  Returns done less what the lanes leave to put_number: besides number_shortest8's,
+ * the plain texts from 1e15, whose point follows the 16th digit.
  */
-MT_AVX512_CODE static size_t texts_avx512(const double *values, size_t count, const struct style *s,
-                                          struct texts *t)
+MT_AVX512_CODE static inline unsigned lanes_avx512(const double *values, const uint64_t *d, const int64_t *e,
+                                                   unsigned done_by_shortest, const struct style *s, struct lanes *l)
 {
     const __m512i pow10_0 = _mm512_loadu_si512(pow10_u64), pow10_1 = _mm512_loadu_si512(pow10_u64 + 8);
     const __m512i pow10_2 = _mm512_maskz_loadu_epi64(0x0f, pow10_u64 + 16);
     const __m512i zero = _mm512_setzero_si512();
-    size_t i = 0;
-    for (; i + 8 <= count; i += 8) {
-        uint64_t d[8];
-        int64_t e[8];
-        __mmask8 done = (__mmask8)number_shortest8(values + i, d, e);
-        const __m512i digits = _mm512_loadu_si512(d);
-        /* the count of digits, from the bit length (or one more), then the digits scaled to 17 */
-        const __m512i bits = _mm512_sub_epi64(K(64), _mm512_lzcnt_epi64(digits));
-        const __m512i guess = _mm512_srli_epi64(_mm512_mullo_epi64(bits, K(1233)), 12);
-        const __mmask8 more = _mm512_cmpge_epu64_mask(digits, pick(guess, pow10_0, pow10_1, pow10_2));
-        const __m512i length = _mm512_add_epi64(guess, ones_where(more));
-        done &= _mm512_cmple_epu64_mask(length, K(17));
-        const __m512i scale = pick(_mm512_sub_epi64(K(17), length), pow10_0, pow10_1, pow10_2);
-        const __m512i full = _mm512_mullo_epi64(digits, scale); /* 10^16 <= full < 10^17 */
-        __m512i rest, low;
-        const __m512i first = divide8(full, UINT64_C(10000000000000000), &rest);
-        const __m512i high = eight_digits8(divide8(rest, 100000000, &low));
-        low = eight_digits8(low);
-        /* significant digits: 17 less the trailing '0's */
-        const __m512i low_set = _mm512_xor_si512(low, K(ZEROS_WORD));
-        const __m512i high_set = _mm512_xor_si512(high, K(ZEROS_WORD));
-        const __m512i low_zeros = _mm512_srli_epi64(_mm512_lzcnt_epi64(low_set), 3);
-        const __m512i high_zeros = _mm512_maskz_srli_epi64(_mm512_cmpeq_epi64_mask(low_set, zero),
-                                                           _mm512_lzcnt_epi64(high_set), 3);
-        const __m512i n = _mm512_sub_epi64(_mm512_sub_epi64(K(17), low_zeros), high_zeros);
-        const __m512i e10 = _mm512_add_epi64(_mm512_loadu_si512(e), _mm512_sub_epi64(length, K(1)));
-        /* plain from 1e-4 to below 1e15 (from there to 1e16 the point follows the 16th digit:
-           put_number's), else the exponent form */
-        const __mmask8 exponent_form = _mm512_cmplt_epi64_mask(e10, K(-4)) | _mm512_cmpge_epi64_mask(e10, K(16));
-        done &= exponent_form | _mm512_cmple_epi64_mask(e10, K(14));
-        const __m512i sign = _mm512_srli_epi64(_mm512_loadu_si512(values + i), 63);
-        /* plain: "0." and zeros before the digits below 1, the point after `whole` digits */
-        const __m512i zeros = _mm512_maskz_max_epi64((__mmask8)~exponent_form, _mm512_sub_epi64(zero, e10), zero);
-        const __m512i whole = _mm512_max_epi64(_mm512_add_epi64(e10, K(1)), K(1));
-        const __m512i shown = _mm512_add_epi64(zeros, n);
-        const __m512i plain = _mm512_mask_add_epi64(whole, _mm512_cmpgt_epi64_mask(shown, whole), shown, K(1));
-        /* the exponent form: d.ddd (d alone for one digit), then its suffix */
-        const __m512i mantissa = _mm512_mask_add_epi64(K(1), _mm512_cmpgt_epi64_mask(n, K(1)), n, K(1));
-        __m512i width;
-        const __m512i suffix = exponent_suffix(e10, s->exponent_digits, &width);
-        const __m512i suffix_at = _mm512_add_epi64(sign, _mm512_mask_mov_epi64(plain, exponent_form, mantissa));
-        const __m512i len = _mm512_add_epi64(
-            sign, _mm512_mask_add_epi64(plain, exponent_form, mantissa, _mm512_add_epi64(width, K(2))));
-        /* the 16 bytes the shuffle takes from: the lead digit and digits 2 .. 16 */
-        const __m512i w0 = _mm512_or_si512(_mm512_add_epi64(first, K('0')), _mm512_slli_epi64(high, 8));
-        const __m512i w1 = _mm512_or_si512(_mm512_srli_epi64(high, 56), _mm512_slli_epi64(low, 8));
-        /* and the text from its 17th byte: the digits from the (16 - zeros)th */
-        const __m512i tail = _mm512_srlv_epi64(low, _mm512_sub_epi64(K(48), _mm512_slli_epi64(zeros, 3)));
-        uint64_t from[16], tails[8], lens[8], rows[8], signs[8], suffixes[8], suffix_ats[8];
-        _mm512_storeu_si512(from, _mm512_permutex2var_epi64(w0, _mm512_set_epi64(11, 3, 10, 2, 9, 1, 8, 0), w1));
-        _mm512_storeu_si512(from + 8, _mm512_permutex2var_epi64(w0, _mm512_set_epi64(15, 7, 14, 6, 13, 5, 12, 4), w1));
-        _mm512_storeu_si512(tails, tail);
-        _mm512_storeu_si512(lens, len);
-        _mm512_storeu_si512(rows, _mm512_mask_blend_epi64(exponent_form, _mm512_add_epi64(e10, K(4)), K(19)));
-        _mm512_storeu_si512(suffixes, suffix);
-        _mm512_storeu_si512(suffix_ats, suffix_at);
-        _mm512_storeu_si512(signs, sign);
-        for (size_t j = 0; j < 8; j++) {
-            if (!((done >> j) & 1)) {
-                put_slot(values[i + j], s, t, i + j);
-                continue;
-            }
-            char *slot = t->text[i + j];
-            const __m128i from_j = _mm_loadu_si128((const __m128i *)(from + 2 * j));
-            const __m128i take = _mm_loadu_si128((const __m128i *)layout_take[rows[j]]);
-            const __m128i put = _mm_loadu_si128((const __m128i *)layout_put[rows[j]]);
-            const __m128i text = _mm_or_si128(_mm_shuffle_epi8(from_j, take), put);
-            slot[0] = '-'; /* overwritten where there is no sign */
-            _mm_storeu_si128((__m128i *)(slot + signs[j]), text);
-            memcpy(slot + signs[j] + 16, &tails[j], 8);
-            memcpy(slot + suffix_ats[j], &suffixes[j], 8); /* past the end of a plain text */
-            t->len[i + j] = (unsigned char)lens[j];
-        }
-    }
-    return i;
+    __mmask8 done = (__mmask8)done_by_shortest;
+    const __m512i digits = _mm512_loadu_si512(d);
+    /* the count of digits, from the bit length (or one more), then the digits scaled to 17 */
+    const __m512i bits = _mm512_sub_epi64(K(64), _mm512_lzcnt_epi64(digits));
+    const __m512i guess = _mm512_srli_epi64(_mm512_mullo_epi64(bits, K(1233)), 12);
+    const __mmask8 more = _mm512_cmpge_epu64_mask(digits, pick(guess, pow10_0, pow10_1, pow10_2));
+    const __m512i length = _mm512_add_epi64(guess, ones_where(more));
+    done &= _mm512_cmple_epu64_mask(length, K(17));
+    const __m512i scale = pick(_mm512_sub_epi64(K(17), length), pow10_0, pow10_1, pow10_2);
+    const __m512i full = _mm512_mullo_epi64(digits, scale); /* 10^16 <= full < 10^17 */
+    __m512i rest, low;
+    const __m512i first = divide8(full, UINT64_C(10000000000000000), &rest);
+    const __m512i high = eight_digits8(divide8(rest, 100000000, &low));
+    low = eight_digits8(low);
+    /* significant digits: 17 less the trailing '0's */
+    const __m512i low_set = _mm512_xor_si512(low, K(ZEROS_WORD));
+    const __m512i high_set = _mm512_xor_si512(high, K(ZEROS_WORD));
+    const __m512i low_zeros = _mm512_srli_epi64(_mm512_lzcnt_epi64(low_set), 3);
+    const __m512i high_zeros = _mm512_maskz_srli_epi64(_mm512_cmpeq_epi64_mask(low_set, zero),
+                                                       _mm512_lzcnt_epi64(high_set), 3);
+    const __m512i n = _mm512_sub_epi64(_mm512_sub_epi64(K(17), low_zeros), high_zeros);
+    const __m512i e10 = _mm512_add_epi64(_mm512_loadu_si512(e), _mm512_sub_epi64(length, K(1)));
+    /* plain from 1e-4 to below 1e15 (from there to 1e16 the point follows the 16th digit:
+       put_number's), else the exponent form */
+    const __mmask8 exponent_form = _mm512_cmplt_epi64_mask(e10, K(-4)) | _mm512_cmpge_epi64_mask(e10, K(16));
+    done &= exponent_form | _mm512_cmple_epi64_mask(e10, K(14));
+    const __m512i sign = _mm512_srli_epi64(_mm512_loadu_si512(values), 63);
+    /* plain: "0." and zeros before the digits below 1, the point after `whole` digits */
+    const __m512i zeros = _mm512_maskz_max_epi64((__mmask8)~exponent_form, _mm512_sub_epi64(zero, e10), zero);
+    const __m512i whole = _mm512_max_epi64(_mm512_add_epi64(e10, K(1)), K(1));
+    const __m512i shown = _mm512_add_epi64(zeros, n);
+    const __m512i plain = _mm512_mask_add_epi64(whole, _mm512_cmpgt_epi64_mask(shown, whole), shown, K(1));
+    /* the exponent form: d.ddd (d alone for one digit), then its suffix */
+    const __m512i mantissa = _mm512_mask_add_epi64(K(1), _mm512_cmpgt_epi64_mask(n, K(1)), n, K(1));
+    __m512i width;
+    const __m512i suffix = exponent_suffix(e10, s->exponent_digits, &width);
+    const __m512i suffix_at = _mm512_add_epi64(sign, _mm512_mask_mov_epi64(plain, exponent_form, mantissa));
+    const __m512i len = _mm512_add_epi64(
+        sign, _mm512_mask_add_epi64(plain, exponent_form, mantissa, _mm512_add_epi64(width, K(2))));
+    /* the 16 bytes the shuffle takes from: the lead digit and digits 2 .. 16 */
+    const __m512i w0 = _mm512_or_si512(_mm512_add_epi64(first, K('0')), _mm512_slli_epi64(high, 8));
+    const __m512i w1 = _mm512_or_si512(_mm512_srli_epi64(high, 56), _mm512_slli_epi64(low, 8));
+    /* and the text from its 17th byte: the digits from the (16 - zeros)th */
+    const __m512i tail = _mm512_srlv_epi64(low, _mm512_sub_epi64(K(48), _mm512_slli_epi64(zeros, 3)));
+    _mm512_storeu_si512(l->from, _mm512_permutex2var_epi64(w0, _mm512_set_epi64(11, 3, 10, 2, 9, 1, 8, 0), w1));
+    _mm512_storeu_si512(l->from + 8, _mm512_permutex2var_epi64(w0, _mm512_set_epi64(15, 7, 14, 6, 13, 5, 12, 4), w1));
+    _mm512_storeu_si512(l->tail, tail);
+    _mm512_storeu_si512(l->len, len);
+    _mm512_storeu_si512(l->row, _mm512_mask_blend_epi64(exponent_form, _mm512_add_epi64(e10, K(4)), K(19)));
+    _mm512_storeu_si512(l->suffix, suffix);
+    _mm512_storeu_si512(l->suffix_at, suffix_at);
+    _mm512_storeu_si512(l->sign, sign);
+    return done;
+}
+
+/* The texts of values[0 .. count-1] by the AVX-512 code, eight at a time (texts_vector). */
+MT_AVX512_CODE static size_t texts_avx512(const double *values, size_t count, const struct style *s,
+                                          struct texts *t)
+{
+    return texts_vector(values, count, s, t, 8, number_shortest8, lanes_avx512);
 }
 #undef K
 #endif
