@@ -84,7 +84,8 @@ static int unpack_style(const struct mt_format_style *in, struct style *s)
     static const struct mt_format_style fallback = {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF, 0};
     if (in == NULL)
         in = &fallback;
-    if (in->digits < 0 || in->digits > 17 || in->exponent_digits < 1 || in->exponent_digits > 3)
+    if (in->digits < 0 || in->digits > 17 || in->exponent_digits < 1 || in->exponent_digits > 3 ||
+        (in->portable != MT_CODE_WIDEST && in->portable != MT_CODE_PORTABLE && in->portable != MT_CODE_AVX2))
         return 0;
     s->digits = in->digits;
     s->exponent_digits = in->exponent_digits;
@@ -300,7 +301,7 @@ static inline char *copy_slot(const struct texts *t, size_t i, char *out)
     return out + t->len[i];
 }
 
-#if MT_AVX512
+#if MT_AVX512 || MT_AVX2
 #include <immintrin.h>
 
 /*
@@ -553,14 +554,195 @@ MT_AVX512_CODE static size_t texts_avx512(const double *values, size_t count, co
 #undef K
 #endif
 
+#if MT_AVX2
+#define K4(x) _mm256_set1_epi64x((int64_t)(x)) /* x in every lane */
+
+/* Each lane as a double, correctly rounded: its two halves exact, then one addition. */
+MT_AVX2_CODE static inline __m256d to_double4(__m256i x)
+{
+    const __m256i high = _mm256_or_si256(_mm256_srli_epi64(x, 32), K4(0x4530000000000000)); /* 2^84 + high 2^32 */
+    const __m256i low = _mm256_blend_epi32(x, K4(0x4330000000000000), 0xaa);                 /* 2^52 + low */
+    const __m256d high_part = _mm256_sub_pd(_mm256_castsi256_pd(high), _mm256_set1_pd(0x1p84 + 0x1p52));
+    return _mm256_add_pd(high_part, _mm256_castsi256_pd(low));
+}
+
+/* The eight digits of each lane v < 10^8 in its bytes, as eight_digits8, in 32- and 16-bit lanes. */
+MT_AVX2_CODE static inline __m256i eight_digits4(__m256i v)
+{
+    const __m256i high = _mm256_srli_epi64(_mm256_mul_epu32(v, K4(109951163)), 40); /* v / 10000 */
+    const __m256i low = _mm256_sub_epi64(v, _mm256_mul_epu32(high, K4(10000)));
+    const __m256i merged = _mm256_or_si256(high, _mm256_slli_epi64(low, 32)); /* x < 10000 in each 32 bits */
+    const __m256i top = _mm256_srli_epi16(_mm256_mulhi_epu16(merged, _mm256_set1_epi16(5243)), 3); /* x / 100 */
+    const __m256i hundreds = _mm256_add_epi32(
+        _mm256_slli_epi32(_mm256_sub_epi16(merged, _mm256_mullo_epi16(top, _mm256_set1_epi16(100))), 16), top);
+    __m256i tens = _mm256_mulhi_epu16(hundreds, _mm256_set1_epi16(6554)); /* x / 10 for x < 100 */
+    tens = _mm256_add_epi16(
+        tens, _mm256_slli_epi16(_mm256_sub_epi16(hundreds, _mm256_mullo_epi16(tens, _mm256_set1_epi16(10))), 8));
+    return _mm256_add_epi64(tens, K4(ZEROS_WORD));
+}
+
+/* How many of the eight digits in each lane's bytes are '0' at the end (the last byte is the last
+   digit): from the exponent of the lane whose bytes are 1 where a digit is not '0', as a double
+   (its bits are eight apart: rounding never reaches the next power of two). */
+MT_AVX2_CODE static inline __m256i trailing_zeros4(__m256i digits)
+{
+    const __m256i set = _mm256_andnot_si256(_mm256_cmpeq_epi8(digits, K4(ZEROS_WORD)), K4(0x0101010101010101));
+    const __m256i exponent = _mm256_srli_epi64(_mm256_castpd_si256(to_double4(set)), 52); /* 1023 + 8 top, or 0 */
+    return _mm256_min_epu32(_mm256_srli_epi64(_mm256_sub_epi64(K4(1023 + 63), exponent), 3), K4(8));
+}
+
+/* Each lane's q = x / unit and x - q unit, for q < 2^31, by a product in doubles (off by one at
+   most) and a correction. */
+MT_AVX2_CODE static inline __m256i divide4(__m256i x, uint32_t unit, __m256i *rest)
+{
+    const __m256d estimate = _mm256_mul_pd(to_double4(x), _mm256_set1_pd(1.0 / unit));
+    __m256i q = _mm256_cvtepi32_epi64(_mm256_cvttpd_epi32(estimate));
+    __m256i r = _mm256_sub_epi64(x, _mm256_mul_epu32(q, K4(unit)));
+    const __m256i under = _mm256_cmpgt_epi64(_mm256_setzero_si256(), r); /* all ones: -1 */
+    q = _mm256_add_epi64(q, under);
+    r = _mm256_add_epi64(r, _mm256_and_si256(under, K4(unit)));
+    const __m256i over = _mm256_cmpgt_epi64(r, K4(unit - 1));
+    *rest = _mm256_sub_epi64(r, _mm256_and_si256(over, K4(unit)));
+    return _mm256_sub_epi64(q, over);
+}
+
+/* exponent_suffix in AVX2 lanes (|e10| < 1000, so 32-bit operations serve). */
+MT_AVX2_CODE static inline __m256i exponent_suffix4(__m256i e10, int least, __m256i *width)
+{
+    const __m256i power = _mm256_and_si256(_mm256_abs_epi32(e10), K4(0xffffffff));
+    const __m256i natural = _mm256_sub_epi64(_mm256_sub_epi64(K4(1), _mm256_cmpgt_epi64(power, K4(9))),
+                                             _mm256_cmpgt_epi64(power, K4(99)));
+    *width = _mm256_max_epi32(natural, K4(least));
+    const __m256i hundreds = _mm256_srli_epi64(_mm256_mul_epu32(power, K4(5243)), 19); /* / 100 */
+    const __m256i below = _mm256_sub_epi64(power, _mm256_mul_epu32(hundreds, K4(100)));
+    const __m256i tens = _mm256_srli_epi64(_mm256_mul_epu32(below, K4(103)), 10); /* / 10 */
+    const __m256i ones = _mm256_sub_epi64(below, _mm256_mul_epu32(tens, K4(10)));
+    const __m256i three = _mm256_or_si256(_mm256_or_si256(hundreds, _mm256_slli_epi64(tens, 8)),
+                                          _mm256_slli_epi64(ones, 16));
+    const __m256i digits = _mm256_add_epi64(
+        _mm256_srlv_epi64(three, _mm256_slli_epi64(_mm256_sub_epi64(K4(3), *width), 3)), K4(0x303030));
+    const __m256i e_sign = _mm256_blendv_epi8(K4('e' | '+' << 8), K4('e' | '-' << 8),
+                                              _mm256_cmpgt_epi64(_mm256_setzero_si256(), e10));
+    return _mm256_or_si256(e_sign, _mm256_slli_epi64(digits, 16));
+}
+
+/*
+ * lanes_avx512 in four AVX2 lanes, after number_shortest4.  AVX2 lacks much of what that code uses:
+ * for masks, lanes of all ones; for 64-bit products, 32- and 16-bit ones, as the values allow; for
+ * lzcnt and conversions between 64-bit integers and doubles, the exponents of doubles made from
+ * two exact halves; for picks from a table in registers, gathers; for the exponent suffix, work
+ * only where a lane needs it.
+ */
+MT_AVX2_CODE static inline unsigned lanes_avx2(const double *values, const uint64_t *d, const int64_t *e,
+                                               unsigned done, const struct style *s, struct lanes *l)
+{
+    const long long *pow10 = (const long long *)pow10_u64;
+    const __m256i zero = _mm256_setzero_si256();
+    const __m256i digits = _mm256_loadu_si256((const __m256i *)d);
+    /* the count of digits, from the bit length (that of the nearest double: one more at most, the
+       guess the same or one less), then the digits scaled to 17 */
+    const __m256i exponent = _mm256_srli_epi64(_mm256_castpd_si256(to_double4(digits)), 52);
+    const __m256i bits = _mm256_max_epi32(_mm256_sub_epi64(exponent, K4(1022)), zero); /* 0 for 0 */
+    const __m256i guess = _mm256_srli_epi64(_mm256_mul_epu32(bits, K4(1233)), 12);    /* <= 19 */
+    const __m256i less = _mm256_cmpgt_epi64(_mm256_i64gather_epi64(pow10, guess, 8), digits);
+    const __m256i length = _mm256_add_epi64(_mm256_add_epi64(guess, K4(1)), less);
+    const __m256i too_long = _mm256_cmpgt_epi64(length, K4(17));
+    done &= ~(unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(too_long));
+    const __m256i scale =
+        _mm256_i64gather_epi64(pow10, _mm256_andnot_si256(too_long, _mm256_sub_epi64(K4(17), length)), 8);
+    /* full = digits scale, 10^16 <= full < 10^17, from 32-bit products (scale < 2^54) */
+    const __m256i cross = _mm256_add_epi64(_mm256_mul_epu32(_mm256_srli_epi64(digits, 32), scale),
+                                           _mm256_mul_epu32(digits, _mm256_srli_epi64(scale, 32)));
+    const __m256i full = _mm256_add_epi64(_mm256_mul_epu32(digits, scale), _mm256_slli_epi64(cross, 32));
+    __m256i low;
+    const __m256i upper = divide4(full, 100000000, &low); /* < 10^9: the lead digit and eight */
+    const __m256i first = _mm256_srli_epi64(_mm256_mul_epu32(upper, K4(1441151881)), 57); /* / 10^8 */
+    const __m256i high = eight_digits4(_mm256_sub_epi64(upper, _mm256_mul_epu32(first, K4(100000000))));
+    low = eight_digits4(low);
+    /* significant digits: 17 less the trailing '0's */
+    const __m256i low_zeros = trailing_zeros4(low);
+    const __m256i high_zeros = _mm256_and_si256(_mm256_cmpeq_epi64(low_zeros, K4(8)), trailing_zeros4(high));
+    const __m256i n = _mm256_sub_epi64(_mm256_sub_epi64(K4(17), low_zeros), high_zeros);
+    const __m256i e10 = _mm256_add_epi64(_mm256_loadu_si256((const __m256i *)e), _mm256_sub_epi64(length, K4(1)));
+    /* plain from 1e-4 to below 1e15 (from there to 1e16: put_number's), else the exponent form */
+    const __m256i exponent_form = _mm256_or_si256(_mm256_cmpgt_epi64(K4(-4), e10), _mm256_cmpgt_epi64(e10, K4(15)));
+    const __m256i shown_here = _mm256_or_si256(exponent_form, _mm256_cmpgt_epi64(K4(15), e10));
+    done &= (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(shown_here));
+    const __m256i sign = _mm256_srli_epi64(_mm256_loadu_si256((const __m256i *)values), 63);
+    /* plain: "0." and zeros before the digits below 1, the point after `whole` digits.  The maxima
+       of 64-bit lanes that 32 bits hold by 32-bit maxima: a negative lane's high half (all ones)
+       against a constant's (zero) gives zero. */
+    const __m256i zeros = _mm256_andnot_si256(exponent_form, _mm256_max_epi32(_mm256_sub_epi64(zero, e10), zero));
+    const __m256i whole = _mm256_max_epi32(_mm256_add_epi64(e10, K4(1)), K4(1));
+    const __m256i shown = _mm256_add_epi64(zeros, n);
+    const __m256i plain = _mm256_blendv_epi8(whole, _mm256_add_epi64(shown, K4(1)), _mm256_cmpgt_epi64(shown, whole));
+    /* the exponent form: d.ddd (d alone for one digit), then its suffix */
+    const __m256i mantissa = _mm256_blendv_epi8(K4(1), _mm256_add_epi64(n, K4(1)), _mm256_cmpgt_epi64(n, K4(1)));
+    __m256i width = zero, suffix = zero;
+    if (!_mm256_testz_si256(exponent_form, exponent_form))
+        suffix = exponent_suffix4(e10, s->exponent_digits, &width);
+    const __m256i suffix_at = _mm256_add_epi64(sign, _mm256_blendv_epi8(plain, mantissa, exponent_form));
+    const __m256i len = _mm256_add_epi64(
+        sign, _mm256_blendv_epi8(plain, _mm256_add_epi64(mantissa, _mm256_add_epi64(width, K4(2))), exponent_form));
+    /* the 16 bytes the shuffle takes from, and the text from its 17th byte, as lanes_avx512's */
+    const __m256i w0 = _mm256_or_si256(_mm256_add_epi64(first, K4('0')), _mm256_slli_epi64(high, 8));
+    const __m256i w1 = _mm256_or_si256(_mm256_srli_epi64(high, 56), _mm256_slli_epi64(low, 8));
+    const __m256i tail = _mm256_srlv_epi64(low, _mm256_sub_epi64(K4(48), _mm256_slli_epi64(zeros, 3)));
+    const __m256i from01 = _mm256_unpacklo_epi64(w0, w1), from23 = _mm256_unpackhi_epi64(w0, w1);
+    _mm256_storeu_si256((__m256i *)l->from, _mm256_permute2x128_si256(from01, from23, 0x20));
+    _mm256_storeu_si256((__m256i *)(l->from + 4), _mm256_permute2x128_si256(from01, from23, 0x31));
+    _mm256_storeu_si256((__m256i *)l->tail, tail);
+    _mm256_storeu_si256((__m256i *)l->len, len);
+    _mm256_storeu_si256((__m256i *)l->row, _mm256_blendv_epi8(_mm256_add_epi64(e10, K4(4)), K4(19), exponent_form));
+    _mm256_storeu_si256((__m256i *)l->suffix, suffix);
+    _mm256_storeu_si256((__m256i *)l->suffix_at, suffix_at);
+    _mm256_storeu_si256((__m256i *)l->sign, sign);
+    return done;
+}
+
+/* The texts of values[0 .. count-1] by the AVX2 code, four at a time (texts_vector). */
+MT_AVX2_CODE static size_t texts_avx2(const double *values, size_t count, const struct style *s, struct texts *t)
+{
+    return texts_vector(values, count, s, t, 4, number_shortest4, lanes_avx2);
+}
+#undef K4
+#endif
+
+/* The vector code that writes the texts of a style: 512 (AVX-512), 2 (AVX2) or 0 (none: the
+   portable code), the widest the processor runs that the style allows. */
+static int vector_code(const struct style *s)
+{
+    if (s->digits != 0 || s->portable == MT_CODE_PORTABLE)
+        return 0;
+#if MT_AVX512
+    if (s->portable == MT_CODE_WIDEST && number_have_avx512())
+        return 512;
+#endif
+#if MT_AVX2
+    if (number_have_avx2())
+        return 2;
+#endif
+    return 0;
+}
+
 /* The texts of values[0 .. count-1] (count <= SLOTS) into the first count slots. */
 static void put_texts(const double *values, size_t count, const struct style *s, struct texts *t)
 {
     size_t i = 0;
+    switch (vector_code(s)) {
 #if MT_AVX512
-    if (s->digits == 0 && !s->portable && number_have_avx512())
+    case 512:
         i = texts_avx512(values, count, s, t);
+        break;
 #endif
+#if MT_AVX2
+    case 2:
+        i = texts_avx2(values, count, s, t);
+        break;
+#endif
+    default:
+        break;
+    }
     for (; i < count; i++)
         put_slot(values[i], s, t, i);
 }

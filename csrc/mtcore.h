@@ -204,6 +204,13 @@ struct mt_text_style {
 /* The style of text[0 .. len-1]; MT_EIO where it is a mapping whose file has shrunk. */
 int mt_text_style(const char *text, size_t len, struct mt_text_style *style);
 
+/* Which code writes numbers (struct mt_format_style's `portable`). */
+enum mt_code {
+    MT_CODE_WIDEST = 0,
+    MT_CODE_PORTABLE = 1,
+    MT_CODE_AVX2 = 2
+};
+
 /*
  * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF, 0}.
  *
@@ -219,9 +226,14 @@ int mt_text_style(const char *text, size_t len, struct mt_text_style *style);
  *   newline          the line ending of mt_format_frames and mt_format_table.
  *   frame_newline    the ending of the lines that hold only a frame number
  *                    (mt_format_frames): HDM05 ends those in LF, every other in CRLF.
- *   portable         nonzero: the portable code only, not the vector code that some
- *                    processors run (x86-64 with AVX-512).  The text is the same; this is
- *                    for the tests and benchmarks that compare the two.
+ *   portable         which code writes the shortest texts (digits 0), enum mt_code:
+ *                    MT_CODE_WIDEST (0) the widest vector code the processor runs (x86-64:
+ *                    AVX-512, else AVX2 with BMI1, BMI2, FMA and LZCNT, else none);
+ *                    MT_CODE_PORTABLE (1) the portable code only; MT_CODE_AVX2 (2) vector
+ *                    code no wider than AVX2 (the portable code where the processor has
+ *                    no AVX2).  The text is the same; this is for the tests and benchmarks
+ *                    that compare the codes on one processor.  Other values are refused as
+ *                    the other fields' are (MT_EINVAL).
  */
 struct mt_format_style {
     int digits;

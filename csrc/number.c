@@ -456,6 +456,89 @@ MT_AVX512_CODE unsigned number_shortest8(const double *a, uint64_t *d, int64_t *
 }
 #endif
 
+#if MT_AVX2
+#include <immintrin.h>
+
+int number_have_avx2(void)
+{
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") &&
+           __builtin_cpu_supports("fma") && __builtin_cpu_supports("lzcnt");
+}
+
+#define K4(x) _mm256_set1_epi64x((int64_t)(x)) /* x in every lane */
+
+/* mul_high in AVX2 lanes: the high 64 bits of each lane's a * b, the low 64 to *lo (NULL: not wanted). */
+MT_AVX2_CODE static inline __m256i mul_high4(__m256i a, __m256i b, __m256i *lo)
+{
+    const __m256i low32 = K4(0xffffffff);
+    const __m256i a_hi = _mm256_srli_epi64(a, 32), b_hi = _mm256_srli_epi64(b, 32);
+    const __m256i ll = _mm256_mul_epu32(a, b), lh = _mm256_mul_epu32(a, b_hi);
+    const __m256i hl = _mm256_mul_epu32(a_hi, b), hh = _mm256_mul_epu32(a_hi, b_hi);
+    const __m256i mid = _mm256_add_epi64(_mm256_add_epi64(_mm256_srli_epi64(ll, 32), _mm256_and_si256(lh, low32)),
+                                         _mm256_and_si256(hl, low32));
+    if (lo != NULL)
+        *lo = _mm256_or_si256(_mm256_slli_epi64(mid, 32), _mm256_and_si256(ll, low32));
+    return _mm256_add_epi64(_mm256_add_epi64(hh, _mm256_srli_epi64(lh, 32)),
+                            _mm256_add_epi64(_mm256_srli_epi64(hl, 32), _mm256_srli_epi64(mid, 32)));
+}
+
+/* floor(x k / 2^s) of each lane, where x k fits in 32 bits, signed: floor_log10_pow2 and
+   floor_log2_pow10 with Jeon's smaller constants (checked equal over the exponents of doubles).
+   The product of the low halves is exact in 64 bits; its high half, all sign, stays so shifted. */
+MT_AVX2_CODE static inline __m256i times_shift4(__m256i x, int32_t k, int s)
+{
+    return _mm256_srai_epi32(_mm256_mul_epi32(x, _mm256_set1_epi32(k)), s);
+}
+
+/*
+ * number_shortest8's Dragonbox in four lanes.  AVX2 has neither 64-bit products (from 32-bit
+ * ones, as there), unsigned 64-bit comparisons (signed ones with the sign bit flipped), nor masks
+ * (lanes of all ones), nor 64-bit arithmetic shifts (the logarithms' products fit in 32 bits).
+ */
+MT_AVX2_CODE unsigned number_shortest4(const double *a, uint64_t *d, int64_t *exp10)
+{
+    const __m256i zero = _mm256_setzero_si256();
+    const __m256i bits = _mm256_and_si256(_mm256_loadu_si256((const __m256i *)a), K4(MASK63));
+    const __m256i biased = _mm256_srli_epi64(bits, 52), fraction = _mm256_and_si256(bits, K4(MASK52));
+    __m256i skip = _mm256_or_si256(_mm256_cmpeq_epi64(biased, zero), _mm256_cmpeq_epi64(biased, K4(0x7ff)));
+    skip = _mm256_or_si256(skip, _mm256_cmpeq_epi64(fraction, zero));
+    const __m256i c = _mm256_or_si256(fraction, K4(UINT64_C(1) << 52));
+    const __m256i q = _mm256_sub_epi64(biased, K4(1075));
+    const __m256i minus_k = _mm256_sub_epi64(times_shift4(q, 315653, 20), K4(2));
+    const __m256i beta_minus_1 = _mm256_add_epi64(q, times_shift4(_mm256_sub_epi64(zero, minus_k), 1741647, 19));
+    /* phi(-minus_k): lanes outside the table (skipped) read its first row */
+    const __m256i row = _mm256_andnot_si256(skip, _mm256_slli_epi64(_mm256_sub_epi64(K4(-CACHE_MIN), minus_k), 1));
+    const long long *table = (const long long *)&pow10_phi[0][0];
+    const __m256i phi0 = _mm256_i64gather_epi64(table, row, 8);
+    const __m256i phi1 = _mm256_i64gather_epi64(table + 1, row, 8);
+    const __m256i delta = _mm256_srlv_epi64(phi0, _mm256_sub_epi64(K4(63), beta_minus_1));
+    const __m256i x = _mm256_sllv_epi64(_mm256_add_epi64(_mm256_slli_epi64(c, 1), K4(1)), beta_minus_1);
+    /* z = floor(x phi / 2^128); middle < high1 (unsigned) is the carry */
+    __m256i low0;
+    const __m256i high0 = mul_high4(x, phi0, &low0), high1 = mul_high4(x, phi1, NULL);
+    const __m256i middle = _mm256_add_epi64(low0, high1), sign = K4(UINT64_C(1) << 63);
+    const __m256i carry = _mm256_cmpgt_epi64(_mm256_xor_si256(high1, sign), _mm256_xor_si256(middle, sign));
+    const __m256i z = _mm256_sub_epi64(high0, carry);
+    /* z / 1000 as compilers divide; the remainder (< 1000) from the low 32 bits alone */
+    const __m256i quotient = _mm256_srli_epi64(mul_high4(_mm256_srli_epi64(z, 3), K4(0x20c49ba5e353f7cf), NULL), 4);
+    const __m256i r = _mm256_and_si256(_mm256_sub_epi64(z, _mm256_mul_epu32(quotient, K4(1000))), K4(0xffffffff));
+    const __m256i larger = _mm256_cmpgt_epi64(delta, r);
+    /* at the interval's ends number_shortest tests exactly */
+    skip = _mm256_or_si256(skip, _mm256_or_si256(_mm256_cmpeq_epi64(r, zero), _mm256_cmpeq_epi64(r, delta)));
+    const __m256i dist = _mm256_add_epi64(_mm256_sub_epi64(r, _mm256_srli_epi64(delta, 1)), K4(50));
+    const __m256i dist_q = _mm256_srli_epi64(_mm256_mul_epu32(dist, K4(5243)), 19); /* / 100 (unused where larger) */
+    /* a tie or a step past the nearest: the parity tells, in number_shortest */
+    const __m256i step = _mm256_cmpeq_epi64(dist, _mm256_mul_epu32(dist_q, K4(100)));
+    skip = _mm256_or_si256(skip, _mm256_andnot_si256(larger, step));
+    const __m256i tens = _mm256_add_epi64(_mm256_slli_epi64(quotient, 3), _mm256_slli_epi64(quotient, 1));
+    _mm256_storeu_si256((__m256i *)d, _mm256_add_epi64(tens, _mm256_andnot_si256(larger, dist_q)));
+    _mm256_storeu_si256((__m256i *)exp10, _mm256_add_epi64(minus_k, K4(2)));
+    return ~(unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(skip)) & 15u;
+}
+#undef K4
+#endif
+
 uint64_t number_rounded(double a, int digits, int *exp10)
 {
     uint64_t c;

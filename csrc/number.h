@@ -78,13 +78,17 @@ uint64_t number_shortest(double a, int *exp10);
 uint64_t number_rounded(double a, int digits, int *exp10);
 
 #if defined(__x86_64__) && defined(__GNUC__)
-/* Code for x86-64 processors with AVX-512 (F, BW, CD, DQ, VL: the x86-64-v4 level), chosen at
-   run time where the processor has it; the portable code stays for every other. */
+/* Code for x86-64 processors with AVX-512 (F, BW, CD, DQ, VL: the x86-64-v4 level), and for those
+   with AVX2 (and BMI1, BMI2, FMA, LZCNT: the x86-64-v3 level), chosen at run time where the
+   processor has it; the portable code stays for every other. */
 #define MT_AVX512 1
 #define MT_AVX512_CODE __attribute__((target("avx512f,avx512bw,avx512cd,avx512dq,avx512vl")))
+#define MT_AVX2 1
+#define MT_AVX2_CODE __attribute__((target("avx2,bmi,bmi2,fma,lzcnt")))
 
-/* Whether this processor runs MT_AVX512_CODE. */
+/* Whether this processor runs MT_AVX512_CODE; MT_AVX2_CODE. */
 int number_have_avx512(void);
+int number_have_avx2(void);
 
 /*
  * number_shortest of |a[0]| .. |a[7]| at once, in the lanes of vectors: the decimals to d and
@@ -93,6 +97,9 @@ int number_have_avx512(void);
  * ends or middle fall on a step of the decimals (about one value in a hundred).
  */
 MT_AVX512_CODE unsigned number_shortest8(const double *a, uint64_t *d, int64_t *exp10);
+
+/* The same for |a[0]| .. |a[3]|, in the lanes of AVX2 vectors. */
+MT_AVX2_CODE unsigned number_shortest4(const double *a, uint64_t *d, int64_t *exp10);
 #endif
 
 #endif

@@ -201,7 +201,7 @@ def test_seventeen_digits_always_read_back(rng):
 
 def c_text(function: str, values: np.ndarray, portable: int, exponent_digits: int = 2, **frames) -> bytes:
     """mt_format_table or mt_format_frames (keys a, b, ... of `counts` columns) called directly, with
-    the style's `portable` set or not: the vector code, where the processor has it, or the portable."""
+    the style's `portable` (enum mt_code) as given: the code the test wants, where the processor has it."""
     values = np.ascontiguousarray(values, dtype=np.float64)
     rows, columns = values.shape
     style = ffi.new("struct mt_format_style *", [0, exponent_digits, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_CRLF, portable])
@@ -229,35 +229,43 @@ def c_text(function: str, values: np.ndarray, portable: int, exponent_digits: in
 
 def vector_cases(rng) -> list[np.ndarray]:
     """Values for the vector code: every class of bits, mocap-like values raw and smoothed (mostly 16
-    and 17 digits), every decimal exponent of the plain and the exponent forms, powers of two."""
+    and 17 digits), every decimal exponent of the plain and the exponent forms, powers of two, subnormals."""
     patterns = rng.integers(0, 2**64, 100_000, dtype=np.uint64).view(np.float64)
     magnitudes = rng.standard_normal(50_000) * 10.0 ** rng.integers(-8, 20, 50_000)
     short = np.round(rng.uniform(-400, 400, 50_000) * 1e4) / 1e4
     smoothed = np.convolve(short, np.ones(5) / 5, mode="same")
+    subnormals = rng.integers(1, 2**52, 2_000, dtype=np.uint64) | rng.choice([0, 2**63], 2_000).astype(np.uint64)
     edges = [0.0, -0.0, np.inf, -np.inf, np.nan, -np.nan, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308]
-    decades = [s * y for e in range(-20, 25) for y in (10.0**e, math.nextafter(10.0**e, 0), 1.2345678901234567 * 10.0**e)
-               for s in (1, -1)]  # fmt: skip
+    near = [(10.0**e, math.nextafter(10.0**e, 0), 1.2345678901234567 * 10.0**e) for e in range(-20, 25)]
+    decades = [s * y for ys in near for y in ys for s in (1, -1)]
     powers = [2.0**e for e in range(-1074, 1024)]
-    return [patterns, magnitudes, short, smoothed, np.array(edges + decades + powers)]
+    return [patterns, magnitudes, short, smoothed, np.array(edges + decades + powers), subnormals.view(np.float64)]
 
 
-def test_vector_code_writes_what_the_portable_code_writes(rng):
-    """The vector code (x86-64 with AVX-512) against its twin, the portable code, byte for byte:
-    tables of one to 700 columns (more than a group of slots holds), frames with their lines out
-    of column order, every count of values left over from the lanes, every exponent width."""
+# The vector codes of the style's `portable` (enum mt_code): the widest the processor runs (x86-64:
+# AVX-512, else AVX2), and no wider than AVX2; each the portable code where the processor lacks it.
+VECTOR_CODES = {"widest": lib.MT_CODE_WIDEST, "avx2": lib.MT_CODE_AVX2}
+
+
+@pytest.mark.parametrize("code", list(VECTOR_CODES))
+def test_vector_code_writes_what_the_portable_code_writes(rng, code):
+    """Each vector code against its twin, the portable code, byte for byte: tables of one to 700
+    columns (more than a group of slots holds), frames with their lines out of column order, every
+    count of values left over from the lanes, every exponent width."""
+    vector, portable = VECTOR_CODES[code], lib.MT_CODE_PORTABLE
     for values in vector_cases(rng):
-        for columns in (1, 3, 7, 8, 9, 62, 700):
+        for columns in (1, 3, 4, 5, 7, 8, 9, 62, 512, 513, 700):
             table = values[: len(values) // columns * columns].reshape(-1, columns)
-            assert c_text("table", table, 0) == c_text("table", table, 1), columns
+            assert c_text("table", table, vector) == c_text("table", table, portable), columns
         for counts in ([1], [3, 3, 1], [6, 3, 3, 2, 1, 1, 3, 3, 3]):
             frames = values[: len(values) // sum(counts) * sum(counts)].reshape(-1, sum(counts))
-            assert c_text("frames", frames, 0, counts=counts) == c_text("frames", frames, 1, counts=counts)
-    for exponent_digits in (1, 3):
-        table = vector_cases(rng)[0].reshape(-1, 4)
-        assert c_text("table", table, 0, exponent_digits) == c_text("table", table, 1, exponent_digits)
+            assert c_text("frames", frames, vector, counts=counts) == c_text("frames", frames, portable, counts=counts)
+        for exponent_digits in (1, 3):
+            table = values.reshape(-1, 1)
+            assert c_text("table", table, vector, exponent_digits) == c_text("table", table, portable, exponent_digits)
     for n in range(20):  # fewer values than lanes, and what is left after them
-        table = rng.standard_normal((n, 1))
-        assert c_text("table", table, 0) == c_text("table", table, 1)
+        table = rng.standard_normal((n, 1)) * 10.0 ** rng.integers(-30, 30, (n, 1))
+        assert c_text("table", table, vector) == c_text("table", table, portable)
 
 
 def test_style_is_checked():
@@ -275,6 +283,9 @@ def test_style_is_checked():
     buf, n = ffi.new("char[]", 64), ffi.new("size_t *")
     assert lib.mt_format_double(1.0, style, buf, n) == lib.MT_EINVAL
     assert lib.mt_format_table_bound(1, 1, style) == 2**64 - 1  # a bound no buffer meets
+    for bad_code in (-1, 3):  # the style's `portable` is one of enum mt_code
+        style = ffi.new("struct mt_format_style *", [0, 2, 0, 0, bad_code])
+        assert lib.mt_format_double(1.0, style, buf, n) == lib.MT_EINVAL
 
 
 @pytest.mark.parametrize("newline", [b"\n", b"\r\n", b"\r"])

@@ -7,6 +7,9 @@ class _Lib:
     MT_BLEND_ALIGNED_EXPMAP: int
     MT_BLEND_EXPMAP: int
     MT_BLEND_SLERP: int
+    MT_CODE_AVX2: int
+    MT_CODE_PORTABLE: int
+    MT_CODE_WIDEST: int
     MT_CONTINUITY_NONE: int
     MT_CONTINUITY_PATH: int
     MT_CONTINUITY_REFERENCE: int
