@@ -189,7 +189,7 @@ def test_scan(benchmark, record, raw, texts, old, name, who):
 
 def format_in_memory(values: np.ndarray, keys, offsets, counts, code: int) -> int:
     """mt_format_frames over values in the chunks of mtcore.text.format_frames, into one reused
-    buffer (no file), with the style's `portable` set to `code` (see mtcore.h)."""
+    buffer (no file), with the style's `code` as given (see mtcore.h)."""
     *table, _ = key_table(ffi, keys, offsets, counts)
     style = ffi.new("struct mt_format_style *", [0, 2, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_LF, code])
     chunk, (frames, channels) = 256, values.shape
@@ -206,7 +206,7 @@ def format_in_memory(values: np.ndarray, keys, offsets, counts, code: int) -> in
     return total
 
 
-# the style's `portable` (enum mt_code) of each code, and its name in the table
+# the style's `code` (enum mt_code) of each code, and its name in the table
 CODES = {"vector": (lib.MT_CODE_WIDEST, "mtcore"), "avx2": (lib.MT_CODE_AVX2, "AVX2 code"),
          "portable": (lib.MT_CODE_PORTABLE, "portable code")}  # fmt: skip
 
@@ -218,8 +218,8 @@ def test_format_code(benchmark, record, raw, smoothed, name, code):
     portable code, on the same values; where the processor lacks a vector code, the portable code runs
     in its place."""
     values = raw.values if name == "raw" else smoothed.values
-    portable, who = CODES[code]
-    size = benchmark.pedantic(format_in_memory, (values, *layout(raw), portable), **FAST)
+    style_code, who = CODES[code]
+    size = benchmark.pedantic(format_in_memory, (values, *layout(raw), style_code), **FAST)
     case = CODE.format("the raw" if name == "raw" else "a mean-5 filtered")
     record(case, who, size, unit="MB")
     NOTES.append(f"{case}: {who} {benchmark.stats.stats.min / values.size * 1e9:.1f} ns a value (fastest round)")

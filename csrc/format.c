@@ -57,7 +57,7 @@ struct line_end {
 };
 
 struct style {
-    int digits, exponent_digits, portable;
+    int digits, exponent_digits, code;
     struct line_end newline, frame_newline;
 };
 
@@ -85,11 +85,11 @@ static int unpack_style(const struct mt_format_style *in, struct style *s)
     if (in == NULL)
         in = &fallback;
     if (in->digits < 0 || in->digits > 17 || in->exponent_digits < 1 || in->exponent_digits > 3 ||
-        (in->portable != MT_CODE_WIDEST && in->portable != MT_CODE_PORTABLE && in->portable != MT_CODE_AVX2))
+        (in->code != MT_CODE_WIDEST && in->code != MT_CODE_PORTABLE && in->code != MT_CODE_AVX2))
         return 0;
     s->digits = in->digits;
     s->exponent_digits = in->exponent_digits;
-    s->portable = in->portable;
+    s->code = in->code;
     return unpack_line_end(in->newline, &s->newline) && unpack_line_end(in->frame_newline, &s->frame_newline);
 }
 
@@ -712,10 +712,10 @@ MT_AVX2_CODE static size_t texts_avx2(const double *values, size_t count, const 
    portable code), the widest the processor runs that the style allows. */
 static int vector_code(const struct style *s)
 {
-    if (s->digits != 0 || s->portable == MT_CODE_PORTABLE)
+    if (s->digits != 0 || s->code == MT_CODE_PORTABLE)
         return 0;
 #if MT_AVX512
-    if (s->portable == MT_CODE_WIDEST && number_have_avx512())
+    if (s->code == MT_CODE_WIDEST && number_have_avx512())
         return 512;
 #endif
 #if MT_AVX2

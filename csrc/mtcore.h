@@ -204,7 +204,7 @@ struct mt_text_style {
 /* The style of text[0 .. len-1]; MT_EIO where it is a mapping whose file has shrunk. */
 int mt_text_style(const char *text, size_t len, struct mt_text_style *style);
 
-/* Which code writes numbers (struct mt_format_style's `portable`). */
+/* Which code writes numbers (struct mt_format_style's `code`). */
 enum mt_code {
     MT_CODE_WIDEST = 0,
     MT_CODE_PORTABLE = 1,
@@ -226,7 +226,7 @@ enum mt_code {
  *   newline          the line ending of mt_format_frames and mt_format_table.
  *   frame_newline    the ending of the lines that hold only a frame number
  *                    (mt_format_frames): HDM05 ends those in LF, every other in CRLF.
- *   portable         which code writes the shortest texts (digits 0), enum mt_code:
+ *   code             which code writes the shortest texts (digits 0), enum mt_code:
  *                    MT_CODE_WIDEST (0) the widest vector code the processor runs (x86-64:
  *                    AVX-512, else AVX2 with BMI1, BMI2, FMA and LZCNT, else none);
  *                    MT_CODE_PORTABLE (1) the portable code only; MT_CODE_AVX2 (2) vector
@@ -240,7 +240,7 @@ struct mt_format_style {
     int exponent_digits;
     int newline;
     int frame_newline;
-    int portable;
+    int code;
 };
 
 /* Bytes a number can take: -1.2345678901234567e-308. */

@@ -199,12 +199,12 @@ def test_seventeen_digits_always_read_back(rng):
     assert_same_bits(read_back(written(values, digits=17)), values, values)
 
 
-def c_text(function: str, values: np.ndarray, portable: int, exponent_digits: int = 2, **frames) -> bytes:
+def c_text(function: str, values: np.ndarray, code: int, exponent_digits: int = 2, **frames) -> bytes:
     """mt_format_table or mt_format_frames (keys a, b, ... of `counts` columns) called directly, with
-    the style's `portable` (enum mt_code) as given: the code the test wants, where the processor has it."""
+    the style's `code` (enum mt_code) as given: the code the test wants, where the processor has it."""
     values = np.ascontiguousarray(values, dtype=np.float64)
     rows, columns = values.shape
-    style = ffi.new("struct mt_format_style *", [0, exponent_digits, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_CRLF, portable])
+    style = ffi.new("struct mt_format_style *", [0, exponent_digits, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_CRLF, code])
     written = ffi.new("size_t *")
     c_values = ffi.from_buffer("double[]", values)
     if function == "table":
@@ -242,7 +242,7 @@ def vector_cases(rng) -> list[np.ndarray]:
     return [patterns, magnitudes, short, smoothed, np.array(edges + decades + powers), subnormals.view(np.float64)]
 
 
-# The vector codes of the style's `portable` (enum mt_code): the widest the processor runs (x86-64:
+# The vector codes of the style's `code` (enum mt_code): the widest the processor runs (x86-64:
 # AVX-512, else AVX2), and no wider than AVX2; each the portable code where the processor lacks it.
 VECTOR_CODES = {"widest": lib.MT_CODE_WIDEST, "avx2": lib.MT_CODE_AVX2}
 
@@ -283,7 +283,7 @@ def test_style_is_checked():
     buf, n = ffi.new("char[]", 64), ffi.new("size_t *")
     assert lib.mt_format_double(1.0, style, buf, n) == lib.MT_EINVAL
     assert lib.mt_format_table_bound(1, 1, style) == 2**64 - 1  # a bound no buffer meets
-    for bad_code in (-1, 3):  # the style's `portable` is one of enum mt_code
+    for bad_code in (-1, 3):  # the style's `code` is one of enum mt_code
         style = ffi.new("struct mt_format_style *", [0, 2, 0, 0, bad_code])
         assert lib.mt_format_double(1.0, style, buf, n) == lib.MT_EINVAL
 
