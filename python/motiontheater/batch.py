@@ -152,7 +152,7 @@ class Manifest:
         self.entries[key] = entry = {
             **self._stamps(job),
             "written": _relative(result.output, self.path.parent),
-            "size": result.written or os.path.getsize(result.output),
+            "size": result.written,  # measured by the worker that wrote it
         }
         if self._log is None:  # the manifest as found, compacted (atomically, like every output), then appended to
             with output(self.path) as f:
