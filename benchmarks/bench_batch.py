@@ -17,7 +17,8 @@ from pathlib import Path
 import pytest
 
 from conftest import DATA
-from motiontheater import Pipeline, batch
+from motiontheater import Pipeline
+from motiontheater.databases import batch
 
 COPIES = 75
 

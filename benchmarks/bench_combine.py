@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater.combine import _root_offsets, combine, plan
+from motiontheater.editing.combine import _root_offsets, combine, plan
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from conftest import DATA
@@ -68,7 +68,7 @@ def _numpy_rules(old, new, options):
     extra = {}
     if p.preserve:
         # the root's turn on numpy's Euler conversions, not the C ones
-        with mock.patch.object(importlib.import_module("motiontheater.combine"), "rot", euler_twin):
+        with mock.patch.object(importlib.import_module("motiontheater.editing.combine"), "rot", euler_twin):
             rows, offsets, channels = _root_offsets(old, new, p, "y")
         extra = dict(offset_row=rows, offsets=offsets, offset_channels=channels)
     rows = (p.old_row, p.new_row, p.weight)

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater.footskate import clean_footskate
+from motiontheater.feet.footskate import clean_footskate
 from mtcore import footskate as kernels
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater.retarget import _cached_plan, _rest_channels, _root_positions, _unroll
+from motiontheater.characters.retarget import _cached_plan, _rest_channels, _root_positions, _unroll
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from conftest import DATA

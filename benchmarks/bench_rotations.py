@@ -32,10 +32,10 @@ import pytest
 import motiontheater as mt
 from conftest import DATA
 from motiontheater import interpolate
-from motiontheater.combine import combine, plan
+from motiontheater.editing.combine import combine, plan
 from mtcore import rotations as rot
 
-combine_module = importlib.import_module("motiontheater.combine")  # the package's `combine` is the function
+combine_module = importlib.import_module("motiontheater.editing.combine")  # the package's `combine` is the function
 ROOT = Path(__file__).resolve().parents[1]
 PREVIOUS = "814c4eb"
 FAST = dict(rounds=20, iterations=1, warmup_rounds=2)

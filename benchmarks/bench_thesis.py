@@ -13,7 +13,7 @@ import pytest
 
 import motiontheater as mt
 from conftest import DATA
-from motiontheater import bench
+from motiontheater.cli import bench
 
 SIZES = [3, 5, 7]
 PEERS = bench.peers()

@@ -21,7 +21,7 @@ import pytest
 
 import motiontheater as mt
 from conftest import DATA, NOTES
-from motiontheater.view import page
+from motiontheater.views.viewer import page
 
 webdriver = pytest.importorskip("selenium.webdriver", reason="selenium is not installed")
 BROWSER = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)

@@ -250,12 +250,12 @@ def test_bad_rate_line(tmp_path):
 def test_failed_write_leaves_no_file(tmp_path, monkeypatch):
     skeleton = mt.read_asf(write(tmp_path, "t.asf", ASF))
     motion = mt.read_amc(write(tmp_path, "a.amc", AMC), skeleton).median(size=3)  # new values: formatted
-    import motiontheater.amc
+    import motiontheater.formats.amc
 
     def broken(*args, **kwargs):
         raise OSError("disk full")
 
-    monkeypatch.setattr(motiontheater.amc, "format_frames", broken)
+    monkeypatch.setattr(motiontheater.formats.amc, "format_frames", broken)
     with pytest.raises(OSError, match="disk full"):
         mt.write_amc(motion, tmp_path / "out.amc")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.amc", "t.asf"]

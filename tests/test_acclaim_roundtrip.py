@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 import motiontheater as mt
-from motiontheater.skeleton import BONE_DOFS, ROOT_DOFS, settle_length_unit
+from motiontheater.model.skeleton import BONE_DOFS, ROOT_DOFS, settle_length_unit
 from mtcore import format_number
 
 names = st.text(string.ascii_letters + string.digits + "_.:", min_size=1, max_size=12).filter(

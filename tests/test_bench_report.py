@@ -5,8 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from motiontheater import bench
-from motiontheater.cli import main
+from motiontheater.cli import bench, main
 
 
 @pytest.mark.parametrize("kind", bench.KINDS)

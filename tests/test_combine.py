@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater.combine import combine, plan
+from motiontheater.editing.combine import combine, plan
 from twins import combine as twin
 from twins import rotations as euler_twin
 

@@ -5,7 +5,7 @@ import pytest
 
 import motiontheater as mt
 from motiontheater.cli import main
-from motiontheater.filtering import Smoother, TakeStats
+from motiontheater.editing.filtering import Smoother, TakeStats
 
 
 @pytest.fixture
@@ -28,8 +28,8 @@ def test_a_real_root_crossing_180_degrees_is_smoothed_as_the_small_step_it_is(ta
     values[:, column] = wrap(continuous)
     assert np.abs(np.diff(values[:, column])).max() > 300  # the wrapped channel jumps
     wrapped = take.replace(values=values)
-    got = wrapped.filter(kind, 5).channel("root", "rx")
-    expected = wrap(take.filter(kind, 5).channel("root", "rx"))
+    got = mt.filter_motion(wrapped, kind, size=5).channel("root", "rx")
+    expected = wrap(mt.filter_motion(take, kind, size=5).channel("root", "rx"))
     near_edge = np.abs(np.abs(expected) - 180) < 1e-9  # -180 and 180 are the same angle
     np.testing.assert_allclose(got[~near_edge], expected[~near_edge], rtol=0, atol=1e-9)
     assert np.abs(got).max() <= 180
@@ -41,7 +41,7 @@ def test_179_to_minus_179_gives_values_near_180_not_0(take):
     values[:, column] = np.where(np.arange(take.frames) % 2 == 0, 179.0, -179.0)
     motion = take.replace(values=values)
     for kind in ("mean", "binomial", "median"):
-        smoothed = motion.filter(kind, 3).channel("lfemur", "rz")
+        smoothed = mt.filter_motion(motion, kind, size=3).channel("lfemur", "rz")
         assert (np.abs(smoothed) > 178.9).all(), kind
 
 
@@ -50,30 +50,30 @@ def test_constant_in_constant_out(take):
     motion = take.replace(values=values)
     for kind in ("median", "mean", "binomial"):
         for size in (3, 5, 7):
-            np.testing.assert_array_equal(motion.filter(kind, size).values, values)
+            np.testing.assert_array_equal(mt.filter_motion(motion, kind, size=size).values, values)
 
 
 def test_median_never_invents_values(take):
-    smoothed = take.filter("median", 7)
+    smoothed = take.median(size=7)
     for c in range(take.values.shape[1]):
         assert np.isin(smoothed.values[:, c], take.values[:, c]).all(), take.channels[c]
 
 
 def test_selected_joints_leave_every_other_channel_bit_identical(take):
-    smoothed = take.filter("binomial", 5, ["lhumerus", "rhumerus", "root"], translation=False)
+    smoothed = take.binomial(size=5, joints=["lhumerus", "rhumerus", "root"], translation=False)
     changed = {take.channels[c] for c in np.where((smoothed.values != take.values).any(axis=0))[0]}
     assert changed == {(j, d) for j in ("lhumerus", "rhumerus") for d in ("rx", "ry", "rz")} | {
         ("root", d) for d in ("rx", "ry", "rz")
     }
     assert smoothed.values.tobytes() != take.values.tobytes()
-    assert take.filter("mean", 3, []).values.tobytes() == take.values.tobytes()
+    assert take.mean(size=3, joints=[]).values.tobytes() == take.values.tobytes()
 
 
 def test_edges_hold_by_default_and_modes_are_configurable(take):
     channel = take.channel("lfemur", "rx")
-    held = take.filter("mean", 5, ["lfemur"]).channel("lfemur", "rx")
+    held = take.mean(size=5, joints=["lfemur"]).channel("lfemur", "rx")
     assert held[0] == pytest.approx((3 * channel[0] + channel[1] + channel[2]) / 5, abs=1e-12)
-    reflected = take.filter("mean", 5, ["lfemur"], mode="reflect").channel("lfemur", "rx")
+    reflected = take.mean(size=5, joints=["lfemur"], mode="reflect").channel("lfemur", "rx")
     assert reflected[0] == pytest.approx((2 * channel[0] + 2 * channel[1] + channel[2]) / 5, abs=1e-12)
 
 
@@ -84,18 +84,18 @@ def test_the_means_scratch_space_changes_no_value(take, kind, joints):
     those of working in a new array, for every column, chosen as a run or not."""
     smoother = Smoother(take.skeleton, kind, 5, joints)
     stats = TakeStats.of(take.values)
-    unwrapped, _ = smoother.unwrap(take.values, None)
+    unwrapped, _ = smoother.prepare(take.values, None)
     kept = unwrapped.copy()
-    fresh = smoother.smooth(unwrapped, stats)
+    fresh = smoother.process(unwrapped, stats)
     assert unwrapped.tobytes() == kept.tobytes()  # not scratch: left as it was
-    assert smoother.smooth(unwrapped, stats, scratch=True).tobytes() == fresh.tobytes()
-    assert take.filter(kind, 5, joints).values.tobytes() == fresh.tobytes()
+    assert smoother.process(unwrapped, stats, scratch=True).tobytes() == fresh.tobytes()
+    assert mt.filter_motion(take, kind, size=5, joints=joints).values.tobytes() == fresh.tobytes()
 
 
 @pytest.mark.parametrize("kind", ["median", "mean", "binomial"])
 def test_input_motion_is_untouched_and_metadata_kept(take, kind):
     before = take.values.copy()
-    smoothed = take.filter(kind, 3)
+    smoothed = mt.filter_motion(take, kind, size=3)
     np.testing.assert_array_equal(take.values, before)
     assert (smoothed.frame_rate, smoothed.first_frame, smoothed.header, smoothed.line_order) == (
         take.frame_rate,
@@ -108,7 +108,7 @@ def test_input_motion_is_untouched_and_metadata_kept(take, kind):
 @pytest.mark.parametrize(
     "kind,size,joints,message",
     [
-        ("gauss", 3, None, "no step 'gauss'; the steps are: "),
+        ("gauss", 3, None, "filter kind must be one of median, mean, binomial, got 'gauss'"),
         ("median", 4, None, "filter size must be an odd number of frames"),
         ("median", 0, None, "filter size must be an odd number of frames"),
         ("mean", 3, ["lelbow"], "no bone 'lelbow'"),
@@ -116,7 +116,7 @@ def test_input_motion_is_untouched_and_metadata_kept(take, kind):
 )
 def test_bad_arguments(take, kind, size, joints, message):
     with pytest.raises(ValueError, match=message):
-        take.filter(kind, size, joints)
+        mt.filter_motion(take, kind, size=size, joints=joints)
 
 
 def test_filter_command(data_dir, tmp_path, capsys):
@@ -140,7 +140,7 @@ def test_filter_command(data_dir, tmp_path, capsys):
     )
     assert capsys.readouterr().out.strip() == f"median 5 over 2751 frames of lhumerus, rhumerus: wrote {out}"
     skeleton = mt.read_asf(data_dir / "cmu" / "01.asf")
-    expected = mt.read_amc(data_dir / "cmu" / "01_01.amc", skeleton).filter("median", 5, ["lhumerus", "rhumerus"])
+    expected = mt.read_amc(data_dir / "cmu" / "01_01.amc", skeleton).median(size=5, joints=["lhumerus", "rhumerus"])
     assert mt.read_amc(out, skeleton).values.tobytes() == expected.values.tobytes()
 
 
@@ -164,7 +164,7 @@ def test_filter_command_finds_the_skeleton_and_writes_nothing_on_failure(data_di
 def test_filter_command_on_bvh(data_dir, tmp_path, capsys):
     out = tmp_path / "w.bvh"
     assert main(["filter", "--median", "3", str(data_dir / "bvh" / "walk01.bvh"), "-o", str(out)]) == 0
-    expected = mt.read_bvh(data_dir / "bvh" / "walk01.bvh").filter("median", 3)
+    expected = mt.read_bvh(data_dir / "bvh" / "walk01.bvh").median(size=3)
     assert mt.read_bvh(out).values.tobytes() == expected.values.tobytes()
 
 
@@ -176,8 +176,8 @@ def test_a_bad_sample_spoils_only_the_windows_that_hold_it(take, kind, bad):
     size, frame, column = 7, 1000, take.columns("lfemur", "rz")[0]
     values = take.values.copy()
     values[frame, column] = bad
-    spoiled = take.replace(values=values).filter(kind, size)
-    clean = take.filter(kind, size)
+    spoiled = mt.filter_motion(take.replace(values=values), kind, size=size)
+    clean = mt.filter_motion(take, kind, size=size)
     outside = np.r_[0 : frame - size // 2, frame + size // 2 + 1 : take.frames]
     if kind == "mean":  # its running sum is summed afresh once the bad sample leaves: the last bit may differ
         np.testing.assert_allclose(spoiled.values[outside], clean.values[outside], rtol=1e-13, atol=0)
@@ -190,7 +190,7 @@ def test_a_bad_sample_spoils_only_the_windows_that_hold_it(take, kind, bad):
 @pytest.mark.parametrize("frames", [1, 2, 7, 300])
 def test_unwrapping_in_any_chunks_equals_its_twin(frames):
     """Jumps, NaN and inf anywhere (first frames included), cut into chunks of any length."""
-    from motiontheater.filtering import unwrap_angles
+    from motiontheater.editing.filtering import unwrap_angles
     from twins.rotations import unwrap_angles as twin
 
     rng = np.random.default_rng(frames)

@@ -13,10 +13,10 @@ import pytest
 import motiontheater as mt
 from conftest import DATA
 from motiontheater.cli import main
-from motiontheater.contacts import Contacts, Plant
-from motiontheater.footskate import clean_footskate, contacts_of, prepare
-from motiontheater.legs import find_legs, leg_arrays, resolve_legs
-from motiontheater.skate import knee_bends, measure, skate_metrics
+from motiontheater.feet.contacts import Contacts, Plant
+from motiontheater.feet.footskate import clean_footskate, contacts_of, prepare
+from motiontheater.feet.legs import find_legs, leg_arrays, resolve_legs
+from motiontheater.feet.skate import knee_bends, measure, skate_metrics
 
 CMU = 0.0254 / 0.45  # metres per CMU/HDM05 unit
 TAKES = {  # take: (skeleton, file, metres per unit for BVH)
@@ -73,7 +73,7 @@ def state_of(take: str, state: str) -> tuple[mt.Motion, float | None]:
         values[:, motion.columns("root", "tx")[0]] += 0.03 / unit * np.sin(2 * np.pi * motion.times / 2.0)
         motion = motion.replace(values=values)
     elif state == "smoothed":
-        motion = motion.filter("mean", 15)
+        motion = motion.mean(size=15)
     elif state == "spliced":  # the take laid over itself 20 frames on, blended over 10 frames
         a, last = motion.first_frame + motion.frames // 3, motion.last_frame
         motion = mt.combine(motion, motion, cut=(a + 20, last), scale=(a, last - 20), blend=10)
@@ -434,7 +434,7 @@ def test_the_step_is_a_method_a_pipeline_step_and_a_recipe(tmp_path):
     recipe.write_text('[[step]]\nrun = "mean"\nsize = 15\n\n[[step]]\nrun = "cleanup"\nblend = 0.25\n')
     smoothed_clean = mt.Pipeline.read(recipe).apply(motion)
     np.testing.assert_array_equal(
-        smoothed_clean.values, clean_footskate(motion.filter("mean", 15), blend=0.25).motion.values
+        smoothed_clean.values, clean_footskate(motion.mean(size=15), blend=0.25).motion.values
     )
 
 

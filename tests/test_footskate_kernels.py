@@ -9,8 +9,8 @@ import pytest
 
 import motiontheater as mt
 from conftest import DATA
-from motiontheater.contacts import plant_targets, runs
-from motiontheater.footskate import contacts_of, prepare
+from motiontheater.feet.contacts import plant_targets, runs
+from motiontheater.feet.footskate import contacts_of, prepare
 from mtcore import footskate as fs
 from mtcore._mtcore import ffi, lib
 from twins import footskate as twin

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater import batch
+from motiontheater.databases import batch
 
 
 def test_an_amc_cut_inside_its_header_reads_as_no_frames(data_dir):
@@ -77,7 +77,7 @@ def test_a_take_that_vanishes_during_a_batch_fails_alone(data_dir, tmp_path):
 def test_a_filter_of_an_impossible_size_is_refused_at_once(data_dir, kind):
     motion = mt.read_amc(data_dir / "cmu" / "02_01.amc", mt.read_asf(data_dir / "cmu" / "02.asf"))
     with pytest.raises(ValueError):
-        motion.filter(kind, 1152921504606846977)
+        mt.filter_motion(motion, kind, size=1152921504606846977)
 
 
 def test_a_bvh_header_claiming_more_frames_than_the_file_can_hold_allocates_nothing(data_dir, tmp_path):
@@ -95,7 +95,7 @@ def test_a_take_that_shrinks_while_it_is_read_is_an_error_not_a_crash(data_dir, 
     script = f"""
 import mmap, os, shutil
 import motiontheater as mt
-from motiontheater.amc import _layout, _read
+from motiontheater.formats.amc import _layout, _read
 from mtcore.errors import ChangedFileError
 from mtcore.text import scan_frames, scan_table
 original, take = {str(data_dir / "cmu" / "01_01.amc")!r}, {str(tmp_path / "t.amc")!r}

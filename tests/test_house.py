@@ -11,34 +11,70 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater import registry
 from motiontheater.cli import build_parser, main
+from motiontheater.model import registry
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGE = ROOT / "python" / "motiontheater"
+PACKAGES = {"motiontheater": ROOT / "python" / "motiontheater", "mtcore": ROOT / "src" / "mtcore"}
+# The mocap floor's groups, bottom up (ARCHITECTURE.md): a module imports from its own group and
+# the ones below it, never from one above.  The package's private plumbing (_io, _version,
+# _optional) is the ground floor; the package root and __main__ stand on top.
+GROUPS = ["", "model", "formats", "editing", "feet", "characters", "views", "databases", "cli"]
 
 
-def imports_of(path: Path) -> set[str]:
-    """The package's modules that ``path`` imports, anywhere in it (functions included)."""
-    found = set()
-    for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.ImportFrom) and node.level == 1:
-            if node.module:
-                found.add(node.module.split(".")[0])
-            else:  # from . import x: a submodule when there is one, else the package root
-                found |= {a.name if (PACKAGE / f"{a.name}.py").exists() else "__init__" for a in node.names}
-        elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith("motiontheater"):
-            found.add((node.module or "").split(".")[1] if "." in (node.module or "") else "__init__")
-        elif isinstance(node, ast.Import):
-            found |= {a.name.split(".")[1] for a in node.names if a.name.startswith("motiontheater.")}
-            found |= {"__init__" for a in node.names if a.name == "motiontheater"}
+def modules(package: str) -> dict[str, Path]:
+    """Every module of a package by dotted name (a folder's __init__ named as the folder)."""
+    folder = PACKAGES[package]
+    found = {}
+    for path in folder.rglob("*.py"):
+        parts = [package, *path.relative_to(folder).with_suffix("").parts]
+        found[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
     return found
 
 
+def imports_of(name: str, path: Path, known: dict[str, Path]) -> set[str]:
+    """The modules of ``known`` that module ``name`` (at ``path``) imports, anywhere in it."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+
+    def add(target: str, names=()):
+        submodules = {f"{target}.{alias}" for alias in names} & known.keys()  # from package import module
+        found.update(submodules)
+        if target in known and (len(submodules) < len(names) or not names):
+            found.add(target)
+
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - node.level + 1]
+                target = ".".join([*base, *([node.module] if node.module else [])])
+            else:
+                target = node.module or ""
+            add(target, [a.name for a in node.names])
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                add(alias.name)
+    return found
+
+
+def group_of(name: str) -> int:
+    parts = name.split(".")
+    if len(parts) == 1 or parts[1] == "__main__":
+        return len(GROUPS)  # the package root and __main__
+    return GROUPS.index(parts[1]) if parts[1] in GROUPS else 0
+
+
+def import_graph() -> dict[str, set[str]]:
+    known = {**modules("motiontheater"), **modules("mtcore")}
+    return {name: imports_of(name, path, known) for name, path in known.items()}
+
+
 def test_imports_flow_one_way():
-    graph = {p.stem: imports_of(p) for p in PACKAGE.glob("*.py")}
+    graph = import_graph()
     for module, imported in graph.items():
-        assert module == "__init__" or "__init__" not in imported, f"{module} imports the package root"
+        root = module.split(".")[0]
+        assert module == root or root not in imported, f"{module} imports the package root {root}"
     order, done = [], set()
 
     def visit(module, path):
@@ -52,7 +88,57 @@ def test_imports_flow_one_way():
 
     for module in sorted(graph):
         visit(module, [])
-    assert order.index("registry") < order.index("motion") < order.index("filtering")
+    assert order.index("motiontheater.model.registry") < order.index("motiontheater.model.motion")
+    assert order.index("motiontheater.model.motion") < order.index("motiontheater.editing.filtering")
+
+
+def test_no_group_imports_one_above_it():
+    graph = import_graph()
+    upward = [
+        f"{module} ({GROUPS[group_of(module)] or 'ground'}) imports {target} ({GROUPS[group_of(target)]})"
+        for module, imported in graph.items()
+        if module.startswith("motiontheater.")
+        for target in imported
+        if target.startswith("motiontheater.") and group_of(target) > group_of(module)
+    ]
+    assert not upward, "\n".join(upward)
+
+
+def test_every_module_lives_in_a_group():
+    strays = [
+        name
+        for name in modules("motiontheater")
+        if name.count(".") == 1 and name.split(".")[1] not in GROUPS and not name.split(".")[1].startswith("_")
+    ]
+    assert not strays, f"modules outside the groups of ARCHITECTURE.md: {strays}"
+
+
+def cffi_uses(path: Path) -> list[str]:
+    """Where a module reaches the cffi module: imports of _mtcore, and attributes named lib or ffi."""
+    tree = ast.parse(path.read_text())
+    uses = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and (
+            "_mtcore" in (node.module or "") or any(a.name in ("lib", "ffi", "_mtcore") for a in node.names)
+        ):
+            uses.append(f"line {node.lineno}: from {node.module} import ...")
+        elif isinstance(node, ast.Import) and any("_mtcore" in a.name for a in node.names):
+            uses.append(f"line {node.lineno}: import _mtcore")
+        elif isinstance(node, ast.Attribute) and node.attr in ("lib", "ffi", "_mtcore"):
+            uses.append(f"line {node.lineno}: .{node.attr}")
+    return uses
+
+
+def test_only_mtcore_calls_the_c_core():
+    found = {name: cffi_uses(path) for name, path in modules("motiontheater").items()}
+    found = {name: uses for name, uses in found.items() if uses}
+    assert not found, f"the mocap floor reaches the cffi module directly (call an mtcore function): {found}"
+
+
+def test_the_house_test_sees_a_use_of_lib(tmp_path):
+    bad = tmp_path / "bad.py"
+    bad.write_text("import mtcore\n\ndef f():\n    return mtcore.filters.lib.mt_filter1d_block(5)\n")
+    assert cffi_uses(bad) == ["line 4: .lib"]
 
 
 def test_the_cffi_stub_is_generated_from_the_header(tmp_path):
@@ -99,7 +185,14 @@ def test_a_registered_step_is_a_method_a_pipeline_step_a_verb_a_recipe_and_a_bat
     expected = toy(motion, amount=2.5, joints=("Hips",))
     # a method
     np.testing.assert_array_equal(motion.toy_offset(amount=2.5, joints=("Hips",)).values, expected.values)
-    np.testing.assert_array_equal(motion.apply("toy_offset", amount=2.5, joints=("Hips",)).values, expected.values)
+    with pytest.warns(
+        DeprecationWarning, match=r"motion.apply\('toy_offset', ...\) is deprecated: write motion.toy_offset\(...\)"
+    ):
+        np.testing.assert_array_equal(motion.apply("toy_offset", amount=2.5, joints=("Hips",)).values, expected.values)
+    with pytest.warns(
+        DeprecationWarning, match=r"motion.filter\('median', 3, ...\) is deprecated: write motion.median\(size=3, ...\)"
+    ):
+        np.testing.assert_array_equal(motion.filter("median", 3).values, motion.median(size=3).values)
     # a pipeline step, over a range of frames too
     pipeline = mt.Pipeline().then("toy_offset", amount=2.5, joints=["Hips"], frames=(3, 5))
     ranged = pipeline.apply(motion)

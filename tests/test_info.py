@@ -9,7 +9,7 @@ import pytest
 import motiontheater as mt
 from conftest import ids, real_files
 from motiontheater.cli import main
-from motiontheater.info import as_text, describe
+from motiontheater.cli.info import as_text, describe
 
 TAKES = real_files("*/*.bvh") + real_files("*/*.amc")
 

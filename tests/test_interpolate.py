@@ -91,7 +91,7 @@ def test_pipeline_applies_steps_in_order(data_dir):
         .then("binomial", frames=(200, 300), size=5)
     )
     expected = interpolate(median3(motion), "slerp", frames=(100, 140), joints=["lfemur"])
-    piece = expected.replace(values=expected.values[199:300], first_frame=200).filter("binomial", 5)
+    piece = expected.replace(values=expected.values[199:300], first_frame=200).binomial(size=5)
     values = expected.values.copy()
     values[199:300] = piece.values
     np.testing.assert_array_equal(pipeline.apply(motion).values, values)

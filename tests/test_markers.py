@@ -9,7 +9,7 @@ import pytest
 import motiontheater as mt
 from conftest import ids, real_files
 from motiontheater.cli import main
-from motiontheater.markers import c3d_points, write_c3d
+from motiontheater.views.markers import c3d_points, write_c3d
 
 TAKES = real_files("cmu/01_01.amc") + real_files("cmu/01_01.bvh") + real_files("bvh/walk01.bvh")
 

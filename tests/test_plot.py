@@ -15,8 +15,8 @@ from motiontheater.cli import main
 pytest.importorskip("matplotlib", reason="matplotlib is not installed (pip install 'motiontheater[plot]')")
 Image = pytest.importorskip("PIL.Image", reason="pillow is not installed (pip install 'motiontheater[plot]')")
 
-from motiontheater.plot import figure, plot
-from motiontheater.render import render
+from motiontheater.views.plot import figure, plot
+from motiontheater.views.render import render
 
 
 def walk(frames: int = 60, rate: float = 30.0) -> mt.Motion:
@@ -47,7 +47,7 @@ def image(data: bytes) -> np.ndarray:
 
 def test_figure_holds_the_channels_of_each_take():
     before = walk()
-    after = before.filter("mean", 9)
+    after = before.mean(size=9)
     fig = figure([before, after], joints=["lfemur", "spine"], names=["before", "after"])
     axes = fig.get_axes()
     assert [a.get_ylabel().split("\n")[0] for a in axes] == [
@@ -81,7 +81,7 @@ def test_compared_takes_are_aligned_in_time_and_framed():
 def test_plot_writes_valid_files(tmp_path, fmt):
     target = tmp_path / f"fig.{fmt}"
     before = walk()
-    plot([before, before.filter("median", 5)], target, joints=["lfemur", "ltibia"], dpi=100)
+    plot([before, before.median(size=5)], target, joints=["lfemur", "ltibia"], dpi=100)
     data = target.read_bytes()
     if fmt == "png":
         picture = image(data)
@@ -138,7 +138,7 @@ def test_render_gif_has_a_frame_per_instant_and_shows_the_walk(tmp_path):
 def test_render_of_a_range_with_a_compared_take(tmp_path):
     motion = walk(60, 30.0)
     target = tmp_path / "part.gif"
-    written = render([motion, motion.filter("mean", 9)], target, fps=10, frames=(11, 40), size=(120, 90))
+    written = render([motion, motion.mean(size=9)], target, fps=10, frames=(11, 40), size=(120, 90))
     assert written == len(gif_frames(target, 100)) == 10  # frames 11..40 at 30 Hz: 0.967 s
 
 

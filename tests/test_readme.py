@@ -28,7 +28,7 @@ def test_the_toml_examples_read(tmp_path):
     """Every TOML example reads: a recipe of steps through the registry, a retargeting map file
     ([joints]) through the map reader."""
     import motiontheater as mt
-    from motiontheater.rigs import read_map
+    from motiontheater.characters.rigs import read_map
 
     examples = blocks("toml")
     recipes = [text for text in examples if "[[step]]" in text]

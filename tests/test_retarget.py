@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater.errors import DuplicateError, UnknownNameError
-from motiontheater.retarget import RetargetPlan, _cleanup_options
-from motiontheater.rigs import CHAINS, match_chain, recognise
-from motiontheater.skeleton import Skeleton
+from motiontheater.characters.retarget import RetargetPlan, _cleanup_options
+from motiontheater.characters.rigs import CHAINS, match_chain, recognise
+from motiontheater.model.errors import DuplicateError, UnknownNameError
+from motiontheater.model.skeleton import Skeleton
 
 UNITS = {"cmu/01_01.bvh": "0.45"}  # the CMU BVH conversion is in the ASF's unit, which its size does not tell
 
@@ -387,8 +387,8 @@ FEET = [
 def test_after_the_cleanup_the_feet_hold_the_cleanups_bounds(data_dir, pair):
     """Kovar et al.: retargeting to other proportions leaves skating, which the cleanup removes.
     Measured, as the cleanup's own tests do, on the footplants and floor it enforced."""
-    footskate = pytest.importorskip("motiontheater.footskate", reason="this version has no footskate cleanup")
-    from motiontheater.skate import skate_metrics
+    footskate = pytest.importorskip("motiontheater.feet.footskate", reason="this version has no footskate cleanup")
+    from motiontheater.feet.skate import skate_metrics
 
     take, target = read(data_dir, pair[0]), skeleton(data_dir, pair[1])
     plan = mt.plan_retarget(take.skeleton, target)
@@ -407,6 +407,6 @@ def test_after_the_cleanup_the_feet_hold_the_cleanups_bounds(data_dir, pair):
     assert after.worst("sliding_mean_mm") <= 1.0
     assert after.worst("sliding_max_mm") <= 5.0
     # (the papers' skating ratio counts swing near the floor too: real walks score 10-40 % on it before a
-    # cleanup and after, see motiontheater.skate; the sliding above is the planted feet's own measure)
+    # cleanup and after, see motiontheater.feet.skate; the sliding above is the planted feet's own measure)
     assert after.worst("penetration_mm") <= 5.0
     assert cleaned.skeleton is target

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater import registry
+from motiontheater.characters.retarget import read_target
 from motiontheater.cli import main
-from motiontheater.retarget import read_target
+from motiontheater.model import registry
 
 
 @pytest.fixture
@@ -97,7 +97,7 @@ def test_dry_run_prints_the_plan_and_writes_nothing(data_dir, tmp_path, capsys):
         ("bvh/walk01.bvh", '[joints]\nlfemur = "Nowhere"\n', "map.toml: 'Nowhere' is not a joint of the target"),
         ("furlong.asf", None, "unknown length unit 'furlong'"),
         ("missing.bvh", None, "missing.bvh: no such target skeleton file"),
-        ("cmu/01_01.amc", None, "the target must be an .asf or a .bvh file"),
+        ("cmu/01_01.amc", None, "the target must be a skeleton file (.asf or .bvh)"),
         ("cmu/01_01.bvh", None, "the target skeleton '01_01' has no known length unit"),
     ],
 )

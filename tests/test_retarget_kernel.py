@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater.skeleton import Skeleton
+from motiontheater.model.skeleton import Skeleton
 from mtcore.kinematics import forward_kinematics
 from mtcore.retarget import RetargetPlan, retarget_rotations
 from twins import retarget as twin

@@ -8,6 +8,7 @@ import pytest
 import scipy.signal as ss
 
 import motiontheater as mt
+from motiontheater.model import registry
 from mtcore import signal as sg
 from twins.signal import sosfilt_zi_twin, sosfiltfilt_twin
 
@@ -238,7 +239,7 @@ def test_butterworth_step_errors_name_the_option(take):
 
 def test_residuals_exporter_writes_each_channel(take, tmp_path):
     target = tmp_path / "residuals.csv"
-    mt.registry.lookup("residuals")(take, target)
+    registry.lookup("residuals")(take, target)
     lines = target.read_text().splitlines()
     assert lines[0] == "joint,dof,cutoff_hz,noise"
     assert len(lines) == len(take.channels) + 2

@@ -10,7 +10,7 @@ import pytest
 
 import motiontheater as mt
 from conftest import real_files
-from motiontheater.view import DEFAULT_MAX_FRAMES, EDIT_STEPS, page, write_page
+from motiontheater.views.viewer import DEFAULT_MAX_FRAMES, EDIT_STEPS, page, write_page
 
 
 def page_data(html: str) -> dict:
@@ -126,7 +126,7 @@ def test_compared_takes_and_footplants():
 def test_a_contacts_table_marks_heels_and_balls(data_dir):
     """A Contacts table gives a row per foot point: the ball at the ball, a derived heel (CMU has no
     heel joint) at the ankle above it, with the table's plants as spans of frame indices."""
-    from motiontheater.contacts import Contacts, Plant
+    from motiontheater.feet.contacts import Contacts, Plant
 
     motion = mt.read_amc(data_dir / "cmu" / "01_01.amc", mt.read_asf(data_dir / "cmu" / "01.asf"))
     table = Contacts([Plant("lfoot", "heel", 11, 50), Plant("rfoot", "ball", 2000, 2751)], 1, motion.frames)
@@ -147,7 +147,7 @@ def test_a_contacts_table_marks_heels_and_balls(data_dir):
 
 
 def test_editor_steps_are_registered_steps():
-    from motiontheater.registry import lookup
+    from motiontheater.model.registry import lookup
 
     kinds = [s["kind"] for s in EDIT_STEPS]
     assert kinds == ["slerp", "euler", "expmap", "aligned_expmap", "median3", "median", "mean", "binomial"]

@@ -14,7 +14,7 @@ import pytest
 
 import motiontheater as mt
 from conftest import ids, real_files
-from motiontheater.view import write_page
+from motiontheater.views.viewer import write_page
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -335,7 +335,7 @@ def test_curves_seek_on_click(browser, data_dir, tmp_path):
 
 def test_compared_takes_are_overlaid_and_aligned(browser, data_dir, tmp_path):
     motion = cmu(data_dir)
-    smooth = motion.filter("median", 9)
+    smooth = motion.median(size=9)
     open_page(browser, tmp_path, [motion, smooth], names=["01_01.amc", "median 9"])
     legend = browser.find_element(By.ID, "legend").text
     assert "01_01.amc" in legend and "median 9" in legend
@@ -388,7 +388,7 @@ def test_detected_footplants_are_shown_on_the_feet_the_clock_and_the_timeline(br
     (marked at the ankle: CMU has no heel joint) and ball are green, listed beside the clock and
     inked on their timeline rows; in its swing, none of it."""
     from motiontheater.cli import main
-    from motiontheater.footskate import contacts_of, prepare
+    from motiontheater.feet.footskate import contacts_of, prepare
 
     take = data_dir / "cmu" / "07_05-walk.amc"
     motion = mt.read_amc(take, mt.read_asf(data_dir / "cmu" / "07-walk.asf"))

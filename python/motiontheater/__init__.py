@@ -11,38 +11,31 @@ here.
 
 from mtcore import binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
 
-from . import (  # noqa: F401 (importing them registers their steps)
-    convert,
-    errors,
-    export,
-    filtering,
-    footskate,
-    interpolators,
-    markers,
-    signal,
-)
 from ._version import __version__
-from .amc import read_amc, skeleton_path_for, write_amc
-from .asf import read_asf, write_asf
-from .bvh import read_bvh, write_bvh
-from .combine import combine
-from .contacts import Contacts, Plant, detect_contacts
-from .convert import to_asf, to_bvh
-from .errors import *  # the exceptions, errors.__all__
-from .export import write_positions
-from .filtering import filter_motion
-from .footskate import Cleanup, clean_footskate
-from .formats import read_take, write_take
-from .interpolators import interpolate, median3
-from .legs import find_legs
-from .motion import DEFAULT_FRAME_RATE, Motion
-from .pipeline import Pipeline
-from .registry import StepError, steps
-from .retarget import plan_retarget, retarget
-from .rigs import joint_map
-from .scene import Scene, Track, read_recipe
-from .skate import skate_metrics
-from .skeleton import Bone, Root, Skeleton
+from .characters.retarget import plan_retarget, retarget
+from .characters.rigs import joint_map
+from .editing import convert, filtering, interpolators, signal  # noqa: F401 (importing them registers their steps)
+from .editing.combine import combine
+from .editing.convert import to_asf, to_bvh
+from .editing.filtering import filter_motion
+from .editing.interpolators import interpolate, median3
+from .editing.pipeline import Pipeline
+from .editing.scene import Scene, Track, read_recipe
+from .feet.contacts import Contacts, Plant, detect_contacts
+from .feet.footskate import Cleanup, clean_footskate
+from .feet.legs import find_legs
+from .feet.skate import skate_metrics
+from .formats.amc import read_amc, skeleton_path_for, write_amc
+from .formats.asf import read_asf, write_asf
+from .formats.bvh import read_bvh, write_bvh
+from .formats.table import read_take, write_take
+from .model import errors
+from .model.errors import *  # the exceptions, errors.__all__
+from .model.motion import DEFAULT_FRAME_RATE, Motion
+from .model.registry import StepError, steps
+from .model.skeleton import Bone, Root, Skeleton
+from .views import markers  # noqa: F401 (registers the c3d exporter)
+from .views.positions import write_positions
 
 __all__ = [
     "DEFAULT_FRAME_RATE",

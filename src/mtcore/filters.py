@@ -57,6 +57,7 @@ __all__ = [
     "MAX_SIZE",
     "MODES",
     "binomial_filter1d",
+    "filter_block",
     "median_filter1d",
     "pascal_weights",
     "uniform_filter1d",
@@ -112,6 +113,13 @@ def pascal_weights(size: int) -> np.ndarray:
     :data:`MAX_BINOMIAL_SIZE`.
     """
     return _pascal(_check_size(size, MAX_BINOMIAL_SIZE, "binomial ")).copy()
+
+
+def filter_block(size: int) -> int:
+    """The frames of the blocks the filters of window ``size`` work in: a call on frames that begin
+    at a multiple of it gives, bit for bit, what one call over all frames gives there (the running
+    sums of the mean restart at those multiples), so that a take can be filtered in pieces."""
+    return int(lib.mt_filter1d_block(_check_size(size)))
 
 
 def median_filter1d(

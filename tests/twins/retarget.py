@@ -1,5 +1,5 @@
 """Retargeting in vectorised numpy: the twin of ``mt_retarget`` (and, in the benchmark, of the
-whole of ``motiontheater.retarget.retarget``).
+whole of ``motiontheater.characters.retarget.retarget``).
 
 One numpy call per joint over all frames: the source's forward kinematics
 (the twin of mt_forward_kinematics), then each target joint, parents first,

@@ -1,0 +1,257 @@
+"""Footskate cleanup (Kovar, Schreiner & Gleicher, SCA 2002): feet that should stand still, do.
+
+Given a motion and its footplants (detected, or a table the user edited:
+:mod:`motiontheater.feet.contacts`), each planted heel and ball is held at one
+target per plant, on the floor; the legs and the root are adjusted frame by
+frame, analytically, to reach them; the adjustments fade in and out around
+the plants.  Only the root's translation and the legs' joints change: every
+other channel of the result is the input's, bit for bit, and so is every leg
+channel of a frame that needed no change.
+
+The phases (the per-frame work is C, :mod:`mtcore.footskate`):
+
+1. Targets.  A point planted at the frame before keeps its target; a new
+   plant's target is the point's mean position over the plant, put on the
+   floor at the point's resting clearance; when the foot's other point is
+   planted too (or was, a moment before: a roll from heel to ball), the new
+   target is set at the foot's heel-to-ball length from the other's, so that
+   the foot keeps its shape.
+2. Ankles.  Both points planted: the foot turns by the smallest rotation
+   that takes its heel -> ball onto the targets' (its roll about that axis
+   kept) and the ankle follows the heel target.  One point planted: the foot
+   keeps its turn (and turns up about the planted point if the other would
+   go below the floor) and the ankle follows the planted point.  Turns and
+   moves fade to nothing over ``blend`` seconds on either side of a
+   constraint.
+3. Root.  Where a leg cannot reach its ankle target with the knee bent at
+   least ``knee_soft`` degrees (or as little as the input's knee, if
+   straighter) and half as much as the input's knee, the root moves by the
+   least that lets it: a projection onto the sphere of reach, or onto two
+   spheres' intersection.  The moves are smoothed over ``root_window``
+   seconds so that the root does not pop, and what is still short after
+   smoothing is moved frame by frame.
+4. Legs.  Two-bone IK per leg: the knee bends about its hinge so that hip ->
+   ankle has the target's length (never past straight, to the side it bends
+   in the take), the hip turns the leg onto the target, the ankle takes the
+   foot's turn.  A joint takes the nearest rotation its channels allow: a
+   one-channel knee (CMU's tibia: rx) is a hinge about its channel's axis; a
+   knee with more channels bends about the take's mean bend axis; a
+   two-channel joint (CMU's foot: rx rz) turns its segment exactly where asked
+   and gives up the roll about it (the ankle target is then re-aimed once so
+   that the planted point lands, to a few micrometres); a three-channel
+   joint takes any rotation, as Euler angles in its own channel order, each
+   the nearest to the input's.  No bone is stretched: the skeleton's lengths
+   stay, the root moves instead.
+5. Floor.  A foot planted nowhere whose heel or ball would go below the
+   floor is lifted (smoothly, by the upper envelope of its depths), the leg
+   solved again; toe tips below the floor bend the toes up.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Literal
+
+import numpy as np
+
+from mtcore import footskate as kernels
+
+from ..model.motion import Motion
+from ..model.registry import Joints, step
+from .contacts import DEFAULT, Contacts, Thresholds, detect_contacts, plant_targets
+from .legs import Ground, LegArrays, Legs, fit_ground, leg_arrays, resolve_legs
+
+UP_AXES = ("x", "y", "z", "-x", "-y", "-z")
+
+
+@dataclass(frozen=True, eq=False)
+class Cleanup:
+    """A cleanup's result and what it stood on.
+
+    ``motion`` is the cleaned motion; ``contacts`` the footplants enforced;
+    ``ground`` the floor and the contact points' clearances; ``legs`` the legs
+    (their heels derived where the skeleton has none); ``root_offsets``
+    (frames, 3) what was added to the root's translation, file units;
+    ``targets`` (legs, frames, 2, 3) where each heel and ball was held (NaN
+    where not planted); ``meters_per_unit`` the unit of both.
+    """
+
+    motion: Motion
+    contacts: Contacts
+    ground: Ground
+    legs: Legs
+    root_offsets: np.ndarray
+    targets: np.ndarray
+    meters_per_unit: float
+
+    def root_rms_mm(self) -> float:
+        """Root-mean-square length of the root's change over the frames, in millimetres."""
+        if not len(self.root_offsets):
+            return 0.0
+        return float(np.sqrt(np.mean(np.sum(self.root_offsets**2, axis=-1)))) * self.meters_per_unit * 1000
+
+
+def prepare(
+    motion: Motion,
+    *,
+    legs: Legs | Joints = None,
+    up: str | None = None,
+    floor: float | None = None,
+    meters_per_unit: float | None = None,
+) -> tuple[LegArrays, Ground, float]:
+    """A motion's legs as arrays, its ground, and its metres per file unit (the skeleton's, or
+    ``meters_per_unit``).  ``legs``: resolved :class:`~motiontheater.feet.legs.Legs` (so that a
+    cleaned motion is measured with the heels of its input), joint names, or None to find them."""
+    mpu = motion.skeleton.meters_per_unit if meters_per_unit is None else float(meters_per_unit)
+    if not (mpu > 0 and math.isfinite(mpu)):
+        raise ValueError(f"meters_per_unit must be a positive number, got {meters_per_unit!r}")
+    found = legs if isinstance(legs, Legs) else resolve_legs(motion.skeleton, legs)
+    if found.skeleton.joint_names != motion.skeleton.joint_names:
+        raise ValueError("the legs given are of another skeleton than the motion's")
+    arrays = leg_arrays(motion, found, up=up, meters_per_unit=mpu)
+    return arrays, fit_ground(arrays, motion.frame_rate, mpu, up=up, floor=floor), mpu
+
+
+def contacts_of(
+    contacts: Contacts | str | os.PathLike | None,
+    motion: Motion,
+    arrays: LegArrays,
+    ground: Ground,
+    meters_per_unit: float,
+    thresholds: Thresholds = DEFAULT,
+) -> Contacts:
+    """The footplants of a motion: ``contacts`` given (a table, or its CSV file, checked to be
+    of this take), else detected."""
+    if contacts is None:
+        return detect_contacts(arrays, ground, motion.frame_rate, meters_per_unit, motion.first_frame, thresholds)
+    if isinstance(contacts, (str, os.PathLike)):
+        table = Contacts.read_csv(contacts, first_frame=motion.first_frame, frames=motion.frames)
+    elif isinstance(contacts, Contacts):
+        table = contacts
+    else:
+        raise TypeError(f"contacts must be a Contacts table, a CSV file or None, got {type(contacts).__name__}")
+    table.check_take(motion.first_frame, motion.frames)
+    table.masks(arrays.legs)  # every foot named is one of the legs'
+    return table
+
+
+def clean_footskate(
+    motion: Motion,
+    contacts: Contacts | str | os.PathLike | None = None,
+    *,
+    legs: Legs | Joints = None,
+    up: str | None = None,
+    floor: float | None = None,
+    meters_per_unit: float | None = None,
+    blend: float = 0.2,
+    root_window: float = 0.1,
+    knee_soft: float = 3.0,
+    thresholds: Thresholds = DEFAULT,
+    workers: int | None = None,
+) -> Cleanup:
+    """Footskate cleanup of a motion, with what it stood on (see :class:`Cleanup` and the
+    module docstring); the step ``cleanup`` (``motion.cleanup(...)``, ``motiontheater
+    cleanup``) returns the motion alone.
+
+    - ``contacts``: the footplants (a :class:`~motiontheater.feet.contacts.Contacts`
+      table or its CSV file); default: detected with ``thresholds``.
+    - ``legs``: hip,knee,ankle[,toe] joints of the left then the right leg (default: found by name).
+    - ``up``: the up axis ("y", "z", "-y"...); default y for ASF, detected for BVH.
+    - ``floor``: the floor's level along up, file units (then level); default: fitted, tilted, to
+      the feet at rest.
+    - ``meters_per_unit``: default the skeleton's length unit (an ASF's ``:units length``, a
+      BVH's detected from its size, or as read with ``unit=`` / ``--unit``).
+    - ``blend``: seconds over which adjustments fade in and out around constraints;
+      ``root_window``: seconds of smoothing of the root's moves; ``knee_soft``: degrees short
+      of straight that a constrained knee keeps unless the input's is straighter.
+    - ``workers``: threads for the two legs (None: both on takes of 1,000 frames or more; 1: the
+      calling thread only).
+
+    Raises ValueError (UnknownNameError and FormatError among its kinds) naming
+    what is wrong: no recognisable legs, contacts of another take, a floor
+    above the character, a root without translation channels.
+    """
+    for name, value in (("blend", blend), ("root_window", root_window), ("knee_soft", knee_soft)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+            raise ValueError(f"{name} must be a number >= 0, got {value!r}")
+    if knee_soft >= 90:
+        raise ValueError(f"knee_soft must be below 90 degrees, got {knee_soft}")
+    if up is not None and (not isinstance(up, str) or up.strip().lower().lstrip("+") not in UP_AXES):
+        raise ValueError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
+    root_columns = _root_translation(motion)
+    arrays, ground, mpu = prepare(motion, legs=legs, up=up, floor=floor, meters_per_unit=meters_per_unit)
+    table = contacts_of(contacts, motion, arrays, ground, mpu, thresholds)
+    masks = table.masks(arrays.legs)
+    options = kernels.CleanupOptions(
+        up=(float(ground.up[0]), float(ground.up[1]), float(ground.up[2])),
+        slope=(float(ground.slope[0]), float(ground.slope[1]), float(ground.slope[2])),
+        level=float(ground.level),
+        blend=round(blend * motion.frame_rate),
+        root_window=round(root_window * motion.frame_rate / 2),
+        knee_soft=math.radians(knee_soft),
+    )
+    angles, root, enforced = kernels.cleanup(
+        arrays.chains,
+        arrays.hips,
+        arrays.parents,
+        arrays.angles,
+        arrays.points,
+        masks,
+        plant_targets(masks, arrays.points),
+        ground.clearance,
+        options,
+        workers=workers,
+    )
+    values = kernels.write_channels(
+        motion.values, arrays.angles, angles, arrays.columns, arrays.angle_scale, root, root_columns
+    )
+    values.flags.writeable = False
+    return Cleanup(motion.replace(values=values), table, ground, arrays.legs, root, enforced, mpu)
+
+
+@step(
+    "cleanup", "footskate cleanup: planted heels and balls held still on the floor (Kovar et al. 2002)", frames="none"
+)
+def cleanup(
+    motion: Motion,
+    *,
+    contacts: Annotated[Path | None, "footplants CSV (foot,point,first,last; default: detected)"] = None,
+    floor: Annotated[float | None, "the floor's level along the up axis, file units (default: fitted)"] = None,
+    up: Annotated[
+        Literal["x", "y", "z", "-x", "-y", "-z"] | None, "the up axis (default: y for ASF, found for BVH)"
+    ] = None,
+    legs: Annotated[Joints, "hip,knee,ankle[,toe] of the left then the right leg (default: found by name)"] = None,
+    blend: Annotated[float, "seconds over which adjustments fade in and out around plants"] = 0.2,
+    knee_soft: Annotated[float, "degrees short of straight that a constrained knee keeps"] = 3.0,
+) -> Motion:
+    """Hold planted feet still on the floor: every planted heel and ball at one target per plant,
+    the legs solved analytically and the root moved where a leg cannot reach.
+
+    Only the root's translation and the legs' joints change. The footplants are
+    detected from height and speed unless --contacts gives a table (motiontheater
+    contacts writes one to edit). The floor is fitted to the resting feet (tilted
+    as the capture's is) unless --floor gives its level. See
+    motiontheater.feet.footskate for the method.
+    """
+    return clean_footskate(
+        motion,
+        contacts,
+        legs=legs,
+        up=up,
+        floor=floor,
+        blend=blend,
+        knee_soft=knee_soft,
+    ).motion
+
+
+def _root_translation(motion: Motion) -> list[int]:
+    order = motion.skeleton.dofs("root")
+    missing = [d for d in ("tx", "ty", "tz") if d not in order]
+    if missing:
+        raise ValueError(
+            f"the root has no {', '.join(missing)} channel: footskate cleanup moves the root and needs all three"
+        )
+    return motion.columns("root", ("tx", "ty", "tz"))

@@ -1,0 +1,278 @@
+"""BVH (Biovision Hierarchy): read and write any hierarchy, the numbers scanned in C.
+
+A BVH skeleton becomes a :class:`Skeleton` with ``convention="bvh"``: each
+JOINT a bone whose ``direction`` is its OFFSET and whose ``dofs`` are its
+CHANNELS in the file's order (Xposition -> tx, Zrotation -> rz), each End
+Site a channel-less bone named ``<joint>_End``.  Forward kinematics runs the
+same C kernel as ASF/AMC; position channels replace the joint's OFFSET, as
+Blender and MotionBuilder read them.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from mtcore.errors import CountError, FormatError, MissingError, TruncatedError
+from mtcore.text import format_number, format_table, parse_number, scan_table
+
+from .._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
+from ..model.motion import Motion
+from ..model.skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem, settle_length_unit
+
+CHANNELS = {
+    "xposition": "tx",
+    "yposition": "ty",
+    "zposition": "tz",
+    "xrotation": "rx",
+    "yrotation": "ry",
+    "zrotation": "rz",
+}
+NAMES = {dof: name.capitalize() for name, dof in CHANNELS.items()}
+_FRAMES = re.compile(rb"^[ \t]*Frames[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECASE | re.MULTILINE)
+_FRAME_TIME = re.compile(rb"^[ \t]*Frame[ \t]+Time[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECASE | re.MULTILINE)
+
+
+def read_bvh(source: Source, *, unit: str | None = None) -> Motion:
+    """Read a BVH file (path or file object) into a :class:`Motion` of a BVH skeleton.
+
+    A BVH file states no length unit: ``unit`` gives it (m, cm, mm, in, or a
+    number L for inch / L); without it the unit is detected from the size of
+    the rest pose, or assumed where the size tells none
+    (:func:`~motiontheater.model.skeleton.settle_length_unit`;
+    ``skeleton.length_source`` says which).
+
+    Any hierarchy; channel lists of any order and count on any joint; End
+    Site in any capitalisation, or none; joint names with spaces, ':' and
+    '.'; CRLF; exponent notation; the frame time kept exactly (the rate is
+    its inverse, and writing puts the same text back).  Bad input raises a
+    :class:`~mtcore.errors.FormatError` subclass naming the file and line.
+    """
+    data, name = read_source(source)
+    try:
+        motion = _read(data)
+    except FormatError as e:
+        raise e.at(name) from None
+    return motion.replace(skeleton=settle_length_unit(motion.skeleton, unit)).read_from(source)
+
+
+def _read(data) -> Motion:
+    motion_at = re.search(rb"^[ \t]*MOTION[ \t]*\r?$", data, re.MULTILINE)
+    if motion_at is None:
+        raise MissingError("no MOTION section", data.count(b"\n") + 1)
+    head = decode(data[: motion_at.start()])
+    lines = [(n, line.strip()) for n, line in enumerate(LINE_BREAK.split(head), start=1) if line.strip()]
+    skeleton = _hierarchy(lines)
+    motion_line = data.count(b"\n", 0, motion_at.start()) + 1
+    frames_match = _FRAMES.search(data, motion_at.end())
+    time_match = _FRAME_TIME.search(data, motion_at.end())
+    if frames_match is None or time_match is None:
+        raise MissingError("the MOTION section needs 'Frames: N' and 'Frame Time: T'", motion_line)
+    try:
+        if not frames_match.group(1).isdigit():  # int() would take '_', signs and other scripts' digits
+            raise ValueError
+        frames = int(frames_match.group(1))
+        frame_time = parse_number(time_match.group(1))
+    except ValueError:
+        raise FormatError("expected a whole number of frames and a frame time in seconds", motion_line + 1) from None
+    if frames < 0 or not frame_time > 0:
+        raise FormatError(
+            f"expected frames >= 0 and a positive frame time, got {frames} and {frame_time}", motion_line + 1
+        )
+    start = max(frames_match.end(), time_match.end())
+    start = data.find(b"\n", start) + 1 if data.find(b"\n", start) != -1 else len(data)
+    lines_before = data.count(b"\n", 0, start)
+    columns = len(skeleton.channels)
+    room = (len(data) - start + 1) // max(1, 2 * columns)  # a frame takes a digit and a blank per channel
+    if frames > room and frames * columns * 8 > 1 << 24:  # a header's claim is no reason to allocate much
+        raise TruncatedError(
+            f"the header says {frames} frames but the {len(data) - start} bytes after it hold at most {room}",
+            motion_line + 1,
+        )
+    try:
+        values = scan_table(data, frames, columns, start=start)
+    except FormatError as e:
+        raise e.at(None, lines_before) from None
+    values.flags.writeable = False
+    return Motion(
+        skeleton,
+        values,
+        frame_rate=1.0 / frame_time,
+        first_frame=1,
+        header=(f"Frame Time: {decode(time_match.group(1))}",),
+        line_order=None,
+        style=TextStyle.of(data),
+    )
+
+
+@dataclass
+class _Open:
+    """A joint (or End Site) whose block is being read."""
+
+    name: str
+    line: int
+    offset: tuple[float, float, float] | None = None
+    channels: tuple[str, ...] = ()
+    end: bool = False
+
+
+def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
+    if not lines or lines[0][1].upper() != "HIERARCHY":
+        raise FormatError("expected HIERARCHY", lines[0][0] if lines else 1)
+    bones: list[Bone] = []
+    pairs: list[tuple[str, tuple[str, ...]]] = []
+    root = None
+    stack: list[_Open] = []  # the open joints, innermost last
+    pos = 1
+    while pos < len(lines):
+        number, text = lines[pos]
+        pos += 1
+        word, _, rest = text.partition(" ") if " " in text else text.partition("\t")
+        key = word.upper()
+        if key in ("ROOT", "JOINT"):
+            if key == "ROOT" and (stack or root is not None):
+                raise FormatError("a second ROOT, or ROOT inside a joint", number)
+            if key == "JOINT" and not stack:
+                raise FormatError("JOINT outside the ROOT", number)
+            joint = _Open(rest.strip(), number)
+            if not joint.name:
+                raise FormatError(f"{key} needs a name", number)
+            if key == "JOINT" and (problem := name_problem(joint.name, "bvh")):
+                raise FormatError(problem, number)
+            pos = _expect_brace(lines, pos, number)
+            if stack:
+                pairs.append((stack[-1].name if len(stack) > 1 else "root", (joint.name,)))
+            stack.append(joint)
+        elif key == "END":
+            if not stack:
+                raise FormatError("End Site outside a joint", number)
+            parent = stack[-1].name
+            joint = _Open(f"{parent}_End", number, end=True)
+            pos = _expect_brace(lines, pos, number)
+            pairs.append((parent if len(stack) > 1 else "root", (joint.name,)))
+            stack.append(joint)
+        elif key == "OFFSET":
+            if not stack:
+                raise FormatError("OFFSET outside a joint", number)
+            x, y, z = _numbers(rest.split(), 3, number, "OFFSET")
+            stack[-1].offset = (x, y, z)
+        elif key == "CHANNELS":
+            if not stack or stack[-1].end:
+                raise FormatError("CHANNELS outside a joint", number)
+            words = rest.split()
+            try:
+                count = int(words[0])
+            except (IndexError, ValueError):
+                raise FormatError("CHANNELS needs a count and the channel names", number) from None
+            names = words[1:]
+            if len(names) != count:
+                raise CountError(f"CHANNELS says {count} but names {len(names)}", number)
+            unknown = [n for n in names if n.lower() not in CHANNELS]
+            if unknown or len({n.lower() for n in names}) != len(names):
+                raise FormatError(
+                    f"unknown or repeated channel '{(unknown or names)[0]}'; expected "
+                    "Xposition Yposition Zposition Xrotation Yrotation Zrotation",
+                    number,
+                )
+            stack[-1].channels = tuple(CHANNELS[n.lower()] for n in names)
+        elif key == "}":
+            if not stack:
+                raise FormatError("'}' closes nothing", number)
+            joint = stack.pop()
+            if joint.offset is None:
+                raise MissingError(f"joint '{joint.name}' has no OFFSET", joint.line)
+            if not stack:
+                root = Root(order=joint.channels, axis="XYZ", position=joint.offset, name=joint.name)
+            else:
+                bones.append(
+                    Bone(
+                        name=joint.name,
+                        direction=joint.offset,
+                        length=float(np.linalg.norm(joint.offset)),
+                        dofs=joint.channels,
+                        end_site=joint.end,
+                    )
+                )
+        else:
+            raise FormatError(f"expected ROOT, JOINT, End Site, OFFSET, CHANNELS or '}}', found '{text[:40]}'", number)
+    if stack:
+        raise TruncatedError(f"joint '{stack[-1].name}' is not closed with '}}' before MOTION", lines[-1][0])
+    if root is None:
+        raise MissingError("no ROOT in the HIERARCHY", lines[0][0])
+    # bones were appended as their blocks closed; the file's order is the order they opened
+    opened = {child: i for i, child in enumerate(child for _, children in pairs for child in children)}
+    bones.sort(key=lambda b: opened[b.name])
+    return Skeleton(
+        bones=tuple(bones),
+        hierarchy=canonical_hierarchy(tuple(bones), pairs),
+        root=root,
+        units=(("angle", "deg"),),
+        convention="bvh",
+    )
+
+
+def _expect_brace(lines, pos: int, number: int) -> int:
+    if pos >= len(lines) or lines[pos][1] != "{":
+        raise FormatError("expected '{' on the line after", number)
+    return pos + 1
+
+
+def _numbers(words: list[str], count: int, number: int, what: str) -> tuple[float, ...]:
+    if len(words) != count:
+        raise CountError(f"{what} takes {count} numbers, found {len(words)}", number)
+    try:
+        return tuple(parse_number(w) for w in words)
+    except ValueError:
+        raise FormatError(f"expected numbers after {what}, found '{' '.join(words)}'", number) from None
+
+
+def write_bvh(motion: Motion, target: Source) -> None:
+    """Write a motion of a BVH skeleton as BVH, to a path (atomically) or a binary file object;
+    every number the shortest text that reads back exactly, the frame time as it was read, lines
+    and exponents laid out as the file read was (``motion.style``).  A motion written back
+    unchanged is its file's very bytes."""
+    skeleton = motion.skeleton
+    if skeleton.convention != "bvh":
+        raise ValueError("write_bvh needs a motion of a BVH skeleton (read_bvh, or convert an ASF/AMC first)")
+    if motion.unchanged() and motion.origin is not None and motion.origin.file.copy_to(target):
+        return
+
+    lines = ["HIERARCHY"]
+    written: list[str] = []  # joints in the order the file declares them: its columns' order
+
+    def joint(name: str, depth: int) -> None:
+        written.append(name)
+        pad = "\t" * depth
+        bone = None if name == "root" else skeleton.bone(name)
+        if bone is not None and bone.end_site:
+            lines.extend([f"{pad}End Site", f"{pad}{{"])
+        else:
+            lines.extend(
+                [
+                    f"{pad}{'ROOT' if bone is None else 'JOINT'} {skeleton.root.name if bone is None else name}",
+                    f"{pad}{{",
+                ]
+            )
+        offset = skeleton.root.position if bone is None else bone.direction
+        lines.append(f"{pad}\tOFFSET {' '.join(format_number(v) for v in offset)}")
+        dofs = skeleton.dofs(name)
+        if bone is None or not bone.end_site:
+            lines.append(f"{pad}\tCHANNELS {len(dofs)}" + "".join(f" {NAMES[d]}" for d in dofs))
+        for child in skeleton.children(name):
+            joint(child, depth + 1)
+        lines.append(f"{pad}}}")
+
+    joint("root", 0)
+    frame_time = next((h.split(":", 1)[1].strip() for h in motion.header if h.lower().startswith("frame time")), None)
+    if frame_time is None or 1.0 / parse_number(frame_time) != motion.frame_rate:
+        frame_time = format_number(1.0 / motion.frame_rate)
+    lines += ["MOTION", f"Frames: {motion.frames}", f"Frame Time: {frame_time}"]
+    columns = [c for name in written for c in motion.columns(name)] if motion.values.shape[1] else []
+    style = motion.style
+    with output(target) as f:
+        f.write(style.lines(lines))
+        format_table(motion.values[:, columns], f, **style.numbers())
+        if not style.final_newline and f.seekable():  # the file read ended without a line break
+            f.truncate(f.tell() - len(style.newline))

@@ -1,0 +1,213 @@
+"""The format table: what each file suffix stands for, and the one place that says it.
+
+A row (:class:`Format`) names a suffix's codec: how a take of it is read and written, how a
+skeleton is read from it, which skeleton convention its motions have, and the companion file
+that holds its skeleton where the take does not (an ``.amc`` needs its ``.asf``).  Everything
+that reads or writes a file by its name (the command line, batch, retarget, info, the viewer,
+the exporters) asks this module; adding a format is its codec module and one row of
+:data:`FORMATS`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..model.motion import Motion
+from ..model.skeleton import Skeleton, settle_length_unit
+from .amc import read_amc, skeleton_path_for, write_amc
+from .asf import read_asf, write_asf
+from .bvh import read_bvh, write_bvh
+
+ReadTake = Callable[..., Motion]  # (path, skeleton or None, frame_rate, unit, workers) -> Motion
+
+
+@dataclass(frozen=True)
+class Format:
+    """One file format: its suffix (lower case, with the dot) and its codec's functions.
+
+    ``read`` takes ``(path, skeleton, frame_rate, unit, workers)`` (``skeleton`` is the
+    companion's, or None for a format that holds its own) and returns the take; ``write`` writes
+    a motion of ``convention``'s skeletons.  ``read_skeleton`` reads a skeleton file of this
+    format (an ``.asf``, or the hierarchy of a ``.bvh``), ``write_skeleton`` writes one.
+    ``companion`` is the suffix of the skeleton file a take needs beside it, or None;
+    ``states_unit`` whether its files state their length unit (a BVH file does not).
+    """
+
+    suffix: str
+    name: str
+    convention: str
+    read: ReadTake | None = None
+    write: Callable[[Motion, str | os.PathLike], None] | None = None
+    read_skeleton: Callable[[str | os.PathLike], Skeleton] | None = None
+    write_skeleton: Callable[[Skeleton, str | os.PathLike], None] | None = None
+    companion: str | None = None
+    states_unit: bool = True
+
+    @property
+    def holds_takes(self) -> bool:
+        """Whether files of this format hold motions (an ``.asf`` holds a skeleton only)."""
+        return self.read is not None
+
+
+def _read_amc(path, skeleton, frame_rate, unit, workers) -> Motion:
+    return read_amc(path, skeleton, frame_rate, workers=workers)
+
+
+def _read_bvh(path, skeleton, frame_rate, unit, workers) -> Motion:
+    return read_bvh(path, unit=unit)
+
+
+def _bvh_skeleton(path) -> Skeleton:
+    return read_bvh(path).skeleton
+
+
+FORMATS: dict[str, Format] = {
+    ".asf": Format(".asf", "ASF", "asf", read_skeleton=read_asf, write_skeleton=write_asf),
+    ".amc": Format(".amc", "ASF/AMC", "asf", _read_amc, write_amc, companion=".asf"),
+    ".bvh": Format(".bvh", "BVH", "bvh", _read_bvh, write_bvh, read_skeleton=_bvh_skeleton, states_unit=False),
+}
+
+
+def take_suffixes() -> tuple[str, ...]:
+    """The suffixes of the formats that hold takes (``.amc``, ``.bvh``, ...)."""
+    return tuple(s for s, f in FORMATS.items() if f.holds_takes)
+
+
+def skeleton_suffixes() -> tuple[str, ...]:
+    """The suffixes of the files a skeleton is read from (``.asf``, ``.bvh``, ...)."""
+    return tuple(s for s, f in FORMATS.items() if f.read_skeleton is not None)
+
+
+def _listing(suffixes: tuple[str, ...]) -> str:
+    return ", ".join(suffixes[:-1]) + (" or " if len(suffixes) > 1 else "") + suffixes[-1]
+
+
+def format_of(path: str | os.PathLike) -> Format:
+    """The format of a take file by its suffix (any case); ValueError naming the file otherwise."""
+    suffix = Path(path).suffix.lower()
+    found = FORMATS.get(suffix)
+    if found is None or not found.holds_takes:
+        raise ValueError(f"{os.fspath(path)}: a take's file name must end in {_listing(take_suffixes())}")
+    return found
+
+
+def format_for(convention: str) -> Format:
+    """The format a motion of a skeleton convention (``"asf"``, ``"bvh"``) is written in."""
+    for row in FORMATS.values():
+        if row.holds_takes and row.write is not None and row.convention == convention:
+            return row
+    raise ValueError(f"no format writes motions of {convention!r} skeletons")
+
+
+def suffix_for(convention: str) -> str:
+    """The take suffix a motion of a skeleton convention (``"asf"``, ``"bvh"``) is written as."""
+    return format_for(convention).suffix
+
+
+def take_suffix(path: str | os.PathLike) -> str:
+    """The lower-case suffix of a take file; ValueError naming the file when no format holds takes so."""
+    return format_of(path).suffix
+
+
+def skeleton_for(
+    path: str | os.PathLike, asf: str | os.PathLike | None = None, folders: dict[Path, list[Path]] | None = None
+) -> Path | None:
+    """The skeleton file a take needs beside it: ``asf`` when given, else the one found beside it
+    by the CMU/HDM05 naming (``folders`` as for :func:`~motiontheater.formats.amc.skeleton_path_for`);
+    None for a take that holds its own skeleton (BVH)."""
+    if format_of(path).companion is None:
+        return None
+    if asf is not None:
+        return Path(asf)
+    return skeleton_path_for(path, folders)
+
+
+def read_skeleton(path: str | os.PathLike, unit: str | None = None) -> Skeleton:
+    """The skeleton of a file (an ``.asf``, or a ``.bvh``'s hierarchy), its length unit settled
+    (``unit`` when given).  Files of the same bytes are parsed once (a database has a few
+    skeletons and thousands of takes; a subject's ASF is copied into every session's folder);
+    a changed file is read again.  FileNotFoundError naming a missing file."""
+    suffix = Path(path).suffix.lower()
+    row = FORMATS.get(suffix)
+    if row is None or row.read_skeleton is None:
+        raise ValueError(f"{os.fspath(path)}: a skeleton's file name must end in {_listing(skeleton_suffixes())}")
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"{os.fspath(path)}: no such file")
+    with open(path, "rb") as f:
+        key = (hashlib.sha256(f.read()).digest(), suffix, unit)
+    if key not in _PARSED:
+        if len(_PARSED) >= 256:
+            _PARSED.pop(next(iter(_PARSED)))  # the oldest
+        _PARSED[key] = settle_length_unit(row.read_skeleton(path), unit)
+    return _PARSED[key]
+
+
+_PARSED: dict[tuple[bytes, str, str | None], Skeleton] = {}  # skeletons by the digest of their file's bytes
+
+
+def read_take(
+    path: str | os.PathLike,
+    asf: str | os.PathLike | None = None,
+    frame_rate: float | None = None,
+    unit: str | None = None,
+    *,
+    workers: int | None = None,
+) -> Motion:
+    """The motion of a take file, read by its suffix's format: an AMC with its skeleton (``asf``,
+    or the ASF found beside it), a BVH with its own.  ``unit`` is its length unit (m, cm, mm, in,
+    or a number L for inch / L) when given: a BVH's is detected from its size otherwise, an ASF's
+    is its ``:units length``.  The take must hold at least one frame."""
+    row = format_of(path)
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"{os.fspath(path)}: no such file")
+    companion = skeleton_for(path, asf)
+    skeleton = None if companion is None else read_skeleton(companion, unit)
+    assert row.read is not None
+    return require_frames(row.read(path, skeleton, frame_rate, unit, workers), path)
+
+
+def require_frames(motion: Motion, path: str | os.PathLike) -> Motion:
+    """The motion; ValueError naming the file when it has no frame to work on."""
+    if not motion.frames:
+        raise ValueError(f"{os.fspath(path)}: the take holds no frames")
+    return motion
+
+
+def companion_path(motion: Motion, path: str | os.PathLike) -> Path | None:
+    """Where the skeleton file of a take written to ``path`` goes (beside it, named as the take's
+    stem: ``out/y.amc`` -> ``out/y.asf``), or None when the take's format holds its skeleton."""
+    companion = format_of(path).companion
+    return None if companion is None else Path(path).with_suffix(companion)
+
+
+def states_unit(path: str | os.PathLike) -> bool:
+    """Whether a file of this name states its length unit: False for a format that does not (BVH),
+    True for the others and for files no format of the table reads (positions, markers)."""
+    row = FORMATS.get(Path(path).suffix.lower())
+    return row is None or row.states_unit
+
+
+def write_skeleton(skeleton: Skeleton, path: str | os.PathLike) -> None:
+    """Write a skeleton file in the format its suffix names (an ``.asf``)."""
+    row = FORMATS.get(Path(path).suffix.lower())
+    if row is None or row.write_skeleton is None:
+        raise ValueError(f"{os.fspath(path)}: no format writes skeletons as {Path(path).suffix or 'this'}")
+    row.write_skeleton(skeleton, path)
+
+
+def write_take(motion: Motion, path: str | os.PathLike) -> None:
+    """Write a motion in the format its suffix names; a motion of another convention is refused
+    (``motiontheater convert`` turns one into the other)."""
+    row = format_of(path)
+    if row.write is None or motion.skeleton.convention != row.convention:
+        other = suffix_for(motion.skeleton.convention)
+        kind = f"{'an' if motion.skeleton.convention[0] in 'aeiou' else 'a'} {motion.skeleton.convention.upper()}"
+        raise ValueError(
+            f"{os.fspath(path)}: this is a motion of {kind} skeleton, which is written as {other}, not {row.suffix}; "
+            f"name the output {other}, or convert it first (motiontheater convert)"
+        )
+    row.write(motion, path)
