@@ -12,18 +12,14 @@ frame's source and weight as it goes, run on 1/400 of the frames.
 """
 
 import importlib
-import sys
-from pathlib import Path
 from unittest import mock
 
 import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater.editing.combine import _root_offsets, combine, plan
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from conftest import DATA
+from motiontheater.editing.combine import _root_offsets, combine, plan
 from twins import combine as twin
 from twins import rotations as euler_twin
 

@@ -11,19 +11,15 @@ is 01_01 tiled to 432,000 frames (one hour at 120 Hz, 62 channels), on one
 core (the kernels run in the calling thread).
 """
 
-import sys
-from pathlib import Path
 from unittest import mock
 
 import numpy as np
 import pytest
 
 import motiontheater as mt
+from conftest import DATA
 from motiontheater.feet.footskate import clean_footskate
 from mtcore import footskate as kernels
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from conftest import DATA
 from twins import footskate as footskate_twin
 
 TAKE = "detect + clean up cmu/01_01 (2751 frames)"

@@ -6,16 +6,11 @@ all positions, upc-pymotion's load of the same take's BVH plus its FK, and
 the tests' numpy twin (one numpy call per bone over all frames).
 """
 
-import sys
-from pathlib import Path
-
 import pytest
 
 import motiontheater as mt
-from mtcore.kinematics import forward_kinematics
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from conftest import DATA
+from mtcore.kinematics import forward_kinematics
 from twins.kinematics import motion_kinematics as numpy_fk
 
 FAST = dict(rounds=30, iterations=1, warmup_rounds=2)

@@ -10,17 +10,12 @@ pair of skeletons and kept, as for a batch of takes; its own cost is the
 joint over all frames (tests/retarget_twin.py).
 """
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 import motiontheater as mt
-from motiontheater.characters.retarget import _cached_plan, _rest_channels, _root_positions, _unroll
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from conftest import DATA
+from motiontheater.characters.retarget import _cached_plan, _rest_channels, _root_positions, _unroll
 from twins import retarget as retarget_twin
 
 FAST = dict(rounds=30, iterations=1, warmup_rounds=2)

@@ -6,14 +6,12 @@ the issues set as targets.  Ratios use each benchmark's fastest round, the
 figure least disturbed by other load on a shared machine.
 """
 
-import os
 import re
 from collections import defaultdict
-from pathlib import Path
 
 import pytest
 
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
+from corpus import DATA
 
 RESULTS: dict[str, dict[str, tuple[float, float, str]]] = defaultdict(dict)
 CEILING: dict[str, str] = {}  # case -> the case holding its memory-copy reference

@@ -1,11 +1,9 @@
-import os
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-# The real captures live beside the checkout (never in it); MOTIONTHEATER_DATA overrides.
-DATA = Path(os.environ.get("MOTIONTHEATER_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
+from corpus import DATA
 
 
 @pytest.fixture
@@ -18,12 +16,3 @@ def data_dir() -> Path:
     if not DATA.is_dir():
         pytest.skip(f"real capture corpus not found at {DATA} (set MOTIONTHEATER_DATA)")
     return DATA
-
-
-def real_files(pattern: str) -> list[Path]:
-    """Files of the corpus for parametrize; empty (the tests then skip) when it is absent."""
-    return sorted(DATA.glob(pattern)) if DATA.is_dir() else []
-
-
-def ids(paths):
-    return [p.name for p in paths]

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from conftest import ids, real_files
+from corpus import ids, real_files
 from motiontheater._io import PLAIN
 from twins.text import parse_amc
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from conftest import ids, real_files
+from corpus import ids, real_files
 
 BVHS = real_files("*/*.bvh")
 

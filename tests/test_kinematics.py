@@ -7,7 +7,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import motiontheater as mt
-from conftest import ids, real_files
+from corpus import ids, real_files
 from mtcore import rotations as rot
 from mtcore.kinematics import JointTree, forward_kinematics
 from twins.kinematics import motion_kinematics as twin

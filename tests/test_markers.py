@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from conftest import ids, real_files
+from corpus import ids, real_files
 from motiontheater.cli import main
 from motiontheater.views.markers import c3d_points, write_c3d
 

@@ -6,7 +6,7 @@ import pytest
 import scipy.ndimage as ndi
 
 import motiontheater as mt
-from conftest import real_files
+from corpus import real_files
 from mtcore import signal as sg
 from twins.signal import equalize_twin, levels_twin
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from conftest import ids, real_files
+from corpus import ids, real_files
 from motiontheater.model import units
 from motiontheater.model.skeleton import settle_length_unit
 

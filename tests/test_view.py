@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from conftest import real_files
+from corpus import real_files
 from motiontheater.views.viewer import DEFAULT_MAX_FRAMES, EDIT_STEPS, page, write_page
 
 

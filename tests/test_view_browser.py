@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from conftest import ids, real_files
+from corpus import ids, real_files
 from motiontheater.views.viewer import write_page
 
 if sys.version_info >= (3, 11):

@@ -11,10 +11,8 @@ import argparse
 import logging
 import os
 import shutil
-import signal
 import sys
 import textwrap
-import threading
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -23,6 +21,7 @@ import numpy as np
 
 import mtcore
 
+from .._signals import terminate_as_interrupt
 from .._version import __version__
 from ..editing.filtering import FILTERS
 from ..editing.pipeline import Pipeline
@@ -785,10 +784,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     logger.addHandler(notes)
     level = logger.level
     logger.setLevel(logging.INFO)
-    main_thread = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, _terminated) if main_thread else None
     try:
-        status = int(args.run(args))
+        with terminate_as_interrupt():
+            status = int(args.run(args))
         sys.stdout.flush()  # here, where a closed pipe is caught, not at exit
         return status
     except KeyboardInterrupt:
@@ -807,12 +805,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         logger.removeHandler(notes)
         logger.setLevel(level)
-        if main_thread:
-            signal.signal(signal.SIGTERM, previous)
-
-
-def _terminated(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt(f"signal {signum}")
 
 
 if __name__ == "__main__":

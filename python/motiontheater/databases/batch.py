@@ -16,9 +16,11 @@ elsewhere.
 from __future__ import annotations
 
 import contextlib
+import functools
 import glob
 import hashlib
 import json
+import multiprocessing
 import os
 import shutil
 import signal
@@ -34,6 +36,7 @@ from typing import Any
 from mtcore import cpu_count, share_cores
 
 from .._io import WRITE_ERRORS, OutputError, output, remove_stale_partials
+from .._signals import terminate_as_interrupt
 from ..editing.pipeline import Pipeline
 from ..editing.streaming import CHUNK_FRAMES, stream, streamable
 from ..formats.table import (
@@ -129,7 +132,8 @@ class Manifest:
         self._log: Any = None
         for path in (self.path, Path(folder) / _OLD_MANIFEST):
             with contextlib.suppress(OSError, UnicodeDecodeError):
-                self.entries = _manifest_entries(path.read_text())
+                status = path.stat()
+                self.entries = dict(_read_manifest(str(path), status.st_mtime_ns, status.st_size))
                 break
 
     def _key(self, job: Job) -> str:
@@ -183,6 +187,14 @@ def _relative(path: str, folder: Path) -> str:
 
 def _manifest_line(key: str, entry: dict[str, Any]) -> bytes:
     return json.dumps({"output": key, **entry}).encode() + b"\n"
+
+
+@functools.lru_cache(maxsize=2)
+def _read_manifest(path: str, mtime_ns: int, size: int) -> dict[str, dict[str, Any]]:
+    """A manifest file's entries, parsed once while the file stays as it was: the plan reads it
+    to skip what is done, and the run that follows needs the same entries to compact it."""
+    with open(path, encoding="utf-8") as f:
+        return _manifest_entries(f.read())
 
 
 def _manifest_entries(text: str) -> dict[str, dict[str, Any]]:
@@ -470,17 +482,17 @@ def _run_local(jobs: list[Job], workers: int) -> Generator[tuple[Job, Result]]:
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    previous = signal.signal(signal.SIGTERM, _interrupt)
-    pool = ProcessPoolExecutor(max_workers=count, initializer=_worker_start, initargs=(os.getpid(), count))
-    try:
-        futures = {pool.submit(_run_jobs, group): group for group in _groups(jobs, count)}
-        for future in as_completed(futures):
-            yield from zip(futures[future], future.result())
-    finally:
-        for process in list(getattr(pool, "_processes", {}).values()):
-            process.terminate()  # a half-written take dies with its worker; its partial file is removed
-        pool.shutdown(wait=True, cancel_futures=True)
-        signal.signal(signal.SIGTERM, previous)
+    with terminate_as_interrupt():
+        others = set(multiprocessing.active_children())
+        pool = ProcessPoolExecutor(max_workers=count, initializer=_worker_start, initargs=(os.getpid(), count))
+        try:
+            futures = {pool.submit(_run_jobs, group): group for group in _groups(jobs, count)}
+            for future in as_completed(futures):
+                yield from zip(futures[future], future.result())
+        finally:
+            for process in set(multiprocessing.active_children()) - others:  # the pool's workers
+                process.terminate()  # a half-written take dies with its worker; its partial file is removed
+            pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _groups(jobs: list[Job], workers: int) -> list[list[Job]]:
@@ -510,10 +522,6 @@ def _worker_start(parent: int, processes: int) -> None:
         os._exit(1)
 
     threading.Thread(target=watch, daemon=True).start()
-
-
-def _interrupt(signum: int, frame: Any) -> None:
-    raise KeyboardInterrupt(f"signal {signum}")
 
 
 def _run_dask(jobs: list[Job], workers: int, scheduler: str | None) -> Generator[tuple[Job, Result]]:
