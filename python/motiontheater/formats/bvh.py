@@ -20,6 +20,7 @@ from mtcore.text import format_number, format_table, parse_number, scan_table
 
 from .._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
 from ..model.motion import Motion
+from ..model.rates import rate_of_frame_time
 from ..model.skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem, settle_length_unit
 
 CHANNELS = {
@@ -31,11 +32,12 @@ CHANNELS = {
     "zrotation": "rz",
 }
 NAMES = {dof: name.capitalize() for name, dof in CHANNELS.items()}
+_BLANKS = re.compile(r"[ \t]+")
 _FRAMES = re.compile(rb"^[ \t]*Frames[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECASE | re.MULTILINE)
 _FRAME_TIME = re.compile(rb"^[ \t]*Frame[ \t]+Time[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECASE | re.MULTILINE)
 
 
-def read_bvh(source: Source, *, unit: str | None = None) -> Motion:
+def read_bvh(source: Source, *, unit: str | None = None, frame_rate: float | None = None) -> Motion:
     """Read a BVH file (path or file object) into a :class:`Motion` of a BVH skeleton.
 
     A BVH file states no length unit: ``unit`` gives it (m, cm, mm, in, or a
@@ -46,16 +48,25 @@ def read_bvh(source: Source, *, unit: str | None = None) -> Motion:
 
     Any hierarchy; channel lists of any order and count on any joint; End
     Site in any capitalisation, or none; joint names with spaces, ':' and
-    '.'; CRLF; exponent notation; the frame time kept exactly (the rate is
-    its inverse, and writing puts the same text back).  Bad input raises a
-    :class:`~mtcore.errors.FormatError` subclass naming the file and line.
+    '.'; CRLF; exponent notation; any run of blanks and tabs between words.
+    The frame rate is the one the Frame Time was printed from
+    (:func:`~motiontheater.model.rates.rate_of_frame_time`: ``0.0333333`` is
+    30 Hz), or ``frame_rate`` (Hz) when given; the Frame Time's text is
+    written back as found while the rate stays the one it stands for.  Bad
+    input raises a :class:`~mtcore.errors.FormatError` subclass naming the
+    file and line.
     """
     data, name = read_source(source)
     try:
         motion = _read(data)
     except FormatError as e:
         raise e.at(name) from None
-    return motion.replace(skeleton=settle_length_unit(motion.skeleton, unit)).read_from(source)
+    motion = motion.replace(skeleton=settle_length_unit(motion.skeleton, unit)).read_from(source)
+    if frame_rate is None:
+        return motion
+    if not 0 < frame_rate < float("inf"):
+        raise ValueError(f"the frame rate must be a positive number of frames per second, got {frame_rate!r}")
+    return motion.replace(frame_rate=float(frame_rate))  # no longer the file's: written with its own Frame Time
 
 
 def _read(data) -> Motion:
@@ -70,17 +81,16 @@ def _read(data) -> Motion:
     time_match = _FRAME_TIME.search(data, motion_at.end())
     if frames_match is None or time_match is None:
         raise MissingError("the MOTION section needs 'Frames: N' and 'Frame Time: T'", motion_line)
+    frames_text, frame_time = decode(frames_match.group(1)), decode(time_match.group(1))
+    if not frames_text.isdigit():  # int() would take '_', signs and other scripts' digits
+        raise FormatError(f"expected a whole number of frames, got {frames_text!r}", _line_of(data, frames_match))
+    frames = int(frames_text)
     try:
-        if not frames_match.group(1).isdigit():  # int() would take '_', signs and other scripts' digits
-            raise ValueError
-        frames = int(frames_match.group(1))
-        frame_time = parse_number(time_match.group(1))
+        frame_rate = rate_of_frame_time(frame_time)
     except ValueError:
-        raise FormatError("expected a whole number of frames and a frame time in seconds", motion_line + 1) from None
-    if frames < 0 or not frame_time > 0:
         raise FormatError(
-            f"expected frames >= 0 and a positive frame time, got {frames} and {frame_time}", motion_line + 1
-        )
+            f"expected a positive, finite frame time in seconds, got {frame_time!r}", _line_of(data, time_match)
+        ) from None
     start = max(frames_match.end(), time_match.end())
     start = data.find(b"\n", start) + 1 if data.find(b"\n", start) != -1 else len(data)
     lines_before = data.count(b"\n", 0, start)
@@ -99,12 +109,16 @@ def _read(data) -> Motion:
     return Motion(
         skeleton,
         values,
-        frame_rate=1.0 / frame_time,
+        frame_rate=frame_rate,
         first_frame=1,
-        header=(f"Frame Time: {decode(time_match.group(1))}",),
+        header=(f"Frame Time: {frame_time}",),
         line_order=None,
         style=TextStyle.of(data),
     )
+
+
+def _line_of(data: bytes, match: re.Match) -> int:
+    return data.count(b"\n", 0, match.start()) + 1
 
 
 @dataclass
@@ -129,7 +143,7 @@ def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
     while pos < len(lines):
         number, text = lines[pos]
         pos += 1
-        word, _, rest = text.partition(" ") if " " in text else text.partition("\t")
+        word, rest = _BLANKS.split(text, 1) if _BLANKS.search(text) else (text, "")
         key = word.upper()
         if key in ("ROOT", "JOINT"):
             if key == "ROOT" and (stack or root is not None):
@@ -266,7 +280,7 @@ def write_bvh(motion: Motion, target: Source) -> None:
 
     joint("root", 0)
     frame_time = next((h.split(":", 1)[1].strip() for h in motion.header if h.lower().startswith("frame time")), None)
-    if frame_time is None or 1.0 / parse_number(frame_time) != motion.frame_rate:
+    if frame_time is None or rate_of_frame_time(frame_time) != motion.frame_rate:
         frame_time = format_number(1.0 / motion.frame_rate)
     lines += ["MOTION", f"Frames: {motion.frames}", f"Frame Time: {frame_time}"]
     columns = [c for name in written for c in motion.columns(name)] if motion.values.shape[1] else []

@@ -58,7 +58,7 @@ def _read_amc(path, skeleton, frame_rate, unit, workers) -> Motion:
 
 
 def _read_bvh(path, skeleton, frame_rate, unit, workers) -> Motion:
-    return read_bvh(path, unit=unit)
+    return read_bvh(path, unit=unit, frame_rate=frame_rate)
 
 
 def _bvh_skeleton(path) -> Skeleton:
@@ -158,9 +158,10 @@ def read_take(
     workers: int | None = None,
 ) -> Motion:
     """The motion of a take file, read by its suffix's format: an AMC with its skeleton (``asf``,
-    or the ASF found beside it), a BVH with its own.  ``unit`` is its length unit (m, cm, mm, in,
-    or a number L for inch / L) when given: a BVH's is detected from its size otherwise, an ASF's
-    is its ``:units length``.  The take must hold at least one frame."""
+    or the ASF found beside it), a BVH with its own.  ``frame_rate`` (Hz) is an AMC's rate where
+    its header states none, and a BVH's in place of its Frame Time.  ``unit`` is its length unit
+    (m, cm, mm, in, or a number L for inch / L) when given: a BVH's is detected from its size
+    otherwise, an ASF's is its ``:units length``.  The take must hold at least one frame."""
     row = format_of(path)
     if not os.path.exists(path):
         raise FileNotFoundError(f"{os.fspath(path)}: no such file")
