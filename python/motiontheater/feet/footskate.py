@@ -61,6 +61,7 @@ from mtcore import footskate as kernels
 
 from ..model.motion import Motion
 from ..model.registry import Joints, step
+from ..model.rig import body_view
 from .contacts import DEFAULT, Contacts, Thresholds, detect_contacts, plant_targets
 from .legs import Ground, LegArrays, Legs, fit_ground, leg_arrays, resolve_legs
 
@@ -104,7 +105,10 @@ def prepare(
 ) -> tuple[LegArrays, Ground, float]:
     """A motion's legs as arrays, its ground, and its metres per file unit (the skeleton's, or
     ``meters_per_unit``).  ``legs``: resolved :class:`~motiontheater.feet.legs.Legs` (so that a
-    cleaned motion is measured with the heels of its input), joint names, or None to find them."""
+    cleaned motion is measured with the heels of its input), joint names, or None to find them.
+    The motion is seen from its body (:func:`~motiontheater.model.rig.body_view`): a static joint
+    above the hips and position channels that only hold offsets are not the legs' concern."""
+    motion = body_view(motion).motion
     mpu = motion.skeleton.meters_per_unit if meters_per_unit is None else float(meters_per_unit)
     if not (mpu > 0 and math.isfinite(mpu)):
         raise ValueError(f"meters_per_unit must be a positive number, got {meters_per_unit!r}")
@@ -181,7 +185,9 @@ def clean_footskate(
         raise ValueError(f"knee_soft must be below 90 degrees, got {knee_soft}")
     if up is not None and (not isinstance(up, str) or up.strip().lower().lstrip("+") not in UP_AXES):
         raise ValueError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
-    root_columns = _root_translation(motion)
+    view = body_view(motion)
+    motion = view.motion
+    root_columns = _root_translation(motion, view.body)
     arrays, ground, mpu = prepare(motion, legs=legs, up=up, floor=floor, meters_per_unit=meters_per_unit)
     table = contacts_of(contacts, motion, arrays, ground, mpu, thresholds)
     masks = table.masks(arrays.legs)
@@ -209,7 +215,7 @@ def clean_footskate(
         motion.values, arrays.angles, angles, arrays.columns, arrays.angle_scale, root, root_columns
     )
     values.flags.writeable = False
-    return Cleanup(motion.replace(values=values), table, ground, arrays.legs, root, enforced, mpu)
+    return Cleanup(view.restore(motion.replace(values=values)), table, ground, arrays.legs, root, enforced, mpu)
 
 
 @step(
@@ -247,11 +253,12 @@ def cleanup(
     ).motion
 
 
-def _root_translation(motion: Motion) -> list[int]:
+def _root_translation(motion: Motion, body: str = "root") -> list[int]:
     order = motion.skeleton.dofs("root")
     missing = [d for d in ("tx", "ty", "tz") if d not in order]
     if missing:
+        joint = "the root" if body == "root" else f"the body joint '{body}'"
         raise ValueError(
-            f"the root has no {', '.join(missing)} channel: footskate cleanup moves the root and needs all three"
+            f"{joint} has no {', '.join(missing)} channel: footskate cleanup moves the body and needs all three"
         )
     return motion.columns("root", ("tx", "ty", "tz"))

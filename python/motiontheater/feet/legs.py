@@ -277,11 +277,11 @@ def _check_chain(skeleton: Skeleton, leg: Leg) -> None:
     for name, what in ((leg.hip, "hip"), (leg.knee, "knee")):
         if not _turns(skeleton, name):
             raise ValueError(f"{leg.side} leg: the {what} '{name}' has no rotation channels")
-    for name in chain:
+    for name in chain[1:]:  # a hip that shifts moves where the leg starts, not how long its bones are
         extra = [d for d in skeleton.dofs(name) if d not in ROTATIONS]
         if extra:
             raise ValueError(
-                f"{leg.side} leg: '{name}' has translation or stretch channels ({', '.join(extra)}): "
+                f"{leg.side} leg: '{name}' has translation or stretch channels ({', '.join(extra)}) that move: "
                 "footskate cleanup turns leg joints only"
             )
 

@@ -1,0 +1,227 @@
+"""The rig model: what of a take's channels is motion, and which joint carries the body.
+
+Game-studio BVH rigs put six channels on every joint and a static joint above the hips: a
+joint's position channels there only repeat its OFFSET, and the root stands still while the
+hips travel.  Steps that reason about the body (legs, footplants, the cleanup, retargeting,
+the viewer's camera) work on a :class:`BodyView` of such a take: the body joint as the root
+(the static joints above it folded into its channels), and the position channels that hold
+only an offset folded into the offsets.  ``BodyView.restore`` puts a result back into the
+take's own layout, every channel the step did not change exactly as found.
+
+- The **body** is the first joint (in the file's order) whose position channels move; where
+  none does, the hips by name; else the root.
+- A position channel **holds an offset** where it is constant over the take to a millionth of
+  the figure's size (1.7 µm for a person: below any file's printed precision).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from mtcore.rotations import euler_to_matrices, matrices_to_euler
+
+from .motion import Motion
+from .skeleton import ROTATIONS, TRANSLATIONS, Bone, Root, Skeleton, canonical_hierarchy
+
+_HIPS = re.compile(r"^(?:.*[:_|])?(?:hips?|pelvis)$", re.IGNORECASE)
+STILL = 1e-6  # of the figure's size: a channel whose spread is below it holds an offset
+
+
+@dataclass(frozen=True)
+class BodyView:
+    """A take seen from its body: see the module docstring.
+
+    ``motion`` is the view; ``original`` the take; ``body`` the body joint's name in the take
+    (``"root"`` when the root carries the body); ``columns[i]`` the take's column that the
+    view's column ``i`` holds; ``above`` the static transform of the joints above the body
+    (4 x 4, world from the body's parent), None where it is the identity.
+    """
+
+    motion: Motion
+    original: Motion
+    body: str
+    columns: np.ndarray
+    above: np.ndarray | None
+
+    @property
+    def identity(self) -> bool:
+        """Whether the view is the take itself (nothing static above the body, nothing folded)."""
+        return self.motion is self.original
+
+    def restore(self, result: Motion) -> Motion:
+        """A result computed on the view, in the take's layout: the view's channels put back
+        where they came from (the body's through the static joints above it), every other channel
+        as the take has it."""
+        if self.identity:
+            return result
+        if result.frames != self.original.frames:
+            raise ValueError("a body view restores results of the same frames only")
+        values = self.original.values.copy()
+        view = np.array(result.values, dtype=np.float64)
+        if self.above is not None:
+            view = view.copy()
+            root_columns = len(self.motion.skeleton.root.order)
+            view[:, :root_columns] = _through(
+                view[:, :root_columns], self.motion.skeleton.root.order, np.linalg.inv(self.above)
+            )
+        values[:, self.columns] = view
+        values.flags.writeable = False
+        return self.original.replace(values=values, frame_rate=result.frame_rate, first_frame=result.first_frame)
+
+
+def body_joint(motion: Motion) -> str:
+    """The joint that carries the body: the first whose position channels move, else the hips by
+    name, else the root (``"root"``)."""
+    skeleton = motion.skeleton
+    still = _still_columns(motion)
+    for joint in skeleton.joint_names:
+        columns = [c for c, d in zip(motion.columns(joint), skeleton.dofs(joint)) if d in TRANSLATIONS]
+        if any(c not in still for c in columns):
+            return joint
+    named = [b.name for b in skeleton.bones if _HIPS.match(b.name) and not b.end_site]
+    return named[0] if named else "root"
+
+
+def body_view(motion: Motion) -> BodyView:
+    """The take seen from its body (see the module docstring); the take itself where its root
+    carries the body and no position channel holds only an offset.  ASF skeletons are their own
+    view (their translation dofs add to a bone's vector, and only the root moves in CMU/HDM05)."""
+    identity = BodyView(motion, motion, "root", np.arange(motion.values.shape[1]), None)
+    skeleton = motion.skeleton
+    if skeleton.convention != "bvh" or not motion.frames:
+        return identity
+    still = _still_columns(motion)
+    body = body_joint(motion)
+    chain = _chain_above(skeleton, body)
+    if any(c not in still for joint in chain for c in motion.columns(joint)):
+        body, chain = "root", []  # a moving joint above the body: the take is seen from its root
+    folded = {
+        j
+        for j in skeleton.bone_names
+        if j != body
+        and (dofs := skeleton.dofs(j))
+        and any(d in TRANSLATIONS for d in dofs)
+        and all(c in still for c, d in zip(motion.columns(j), dofs) if d in TRANSLATIONS)
+    }
+    if body == "root" and not folded:
+        return identity
+    above = _static_transform(motion, chain) if chain else None
+    if above is not None and np.allclose(above, np.eye(4), rtol=0, atol=1e-12):
+        above = None
+    turns = [d for d in skeleton.dofs(body) if d in ROTATIONS]
+    if above is not None and (len(turns) != 3 or not all(d in skeleton.dofs(body) for d in TRANSLATIONS)):
+        body, chain, above = "root", [], None  # the body cannot carry the static joints' turn: seen from the root
+        if not folded:
+            return identity
+    keep = _below(skeleton, body)
+    first = motion.values[0]
+    bones: list[Bone] = []
+    pairs: list[tuple[str, tuple[str, ...]]] = []
+    columns = list(motion.columns(body))
+    for bone in skeleton.bones:
+        if bone.name not in keep or bone.name == body:
+            continue
+        dofs, direction = bone.dofs, bone.direction
+        if bone.name in folded:
+            at = dict(zip(dofs, motion.columns(bone.name)))
+            x, y, z = (float(first[at[d]]) if d in at else v for d, v in zip(TRANSLATIONS, direction))
+            direction = (x, y, z)
+            dofs = tuple(d for d in dofs if d not in TRANSLATIONS)
+        bones.append(replace(bone, direction=direction, length=float(np.linalg.norm(direction)), dofs=dofs))
+        columns += [c for c, d in zip(motion.columns(bone.name), bone.dofs) if d in dofs]
+        parent = skeleton.parent(bone.name)
+        pairs.append(("root" if parent == body else parent, (bone.name,)))
+    body_dofs = skeleton.dofs(body)
+    position = skeleton.root.position if body == "root" else skeleton.bone(body).direction
+    root = Root(order=body_dofs, position=position, name=skeleton.root.name if body == "root" else body)
+    values = motion.values[:, columns]
+    if above is not None:
+        values = values.copy()
+        values[:, : len(body_dofs)] = _through(values[:, : len(body_dofs)], body_dofs, above)
+    values = np.ascontiguousarray(values)
+    values.flags.writeable = False
+    view_skeleton = Skeleton(
+        bones=tuple(bones),
+        hierarchy=canonical_hierarchy(tuple(bones), pairs),
+        root=root,
+        name=skeleton.name,
+        units=skeleton.units,
+        convention="bvh",
+        length_choice=skeleton.length_choice,
+    )
+    view = Motion(view_skeleton, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame)
+    return BodyView(view, motion, body, np.array(columns, dtype=np.intp), above)
+
+
+def _still_columns(motion: Motion) -> set[int]:
+    """The columns that do not move over the take (to STILL of the figure's size, NaN-free)."""
+    values = motion.values
+    if not len(values):
+        return set(range(values.shape[1]))
+    rest = motion.skeleton.rest_positions()
+    size = float(np.nanmax(np.ptp(rest, axis=0))) if len(rest) > 1 else 0.0
+    spread = np.ptp(values, axis=0)
+    return {int(c) for c in np.flatnonzero(spread <= STILL * max(size, 1.0))}
+
+
+def _chain_above(skeleton: Skeleton, joint: str) -> list[str]:
+    """The joints from the root down to ``joint``'s parent (empty for the root)."""
+    chain: list[str] = []
+    while joint != "root":
+        joint = skeleton.parent(joint)
+        chain.append(joint)
+    return chain[::-1]
+
+
+def _below(skeleton: Skeleton, joint: str) -> set[str]:
+    found, todo = set(), [joint]
+    while todo:
+        name = todo.pop()
+        found.add(name)
+        todo.extend(skeleton.children(name))
+    return found
+
+
+def _local(dofs: tuple[str, ...], values: np.ndarray, offset) -> np.ndarray:
+    """(frames, 4, 4): a BVH joint's transform in its parent's frame, from its channels (position
+    channels replacing the offset; rotations R1 R2 R3 in the listed order)."""
+    frames = len(values)
+    transform = np.tile(np.eye(4), (frames, 1, 1))
+    transform[:, :3, 3] = offset
+    for i, d in enumerate(dofs):
+        if d in TRANSLATIONS:
+            transform[:, TRANSLATIONS.index(d), 3] = values[:, i]
+    turning = [i for i, d in enumerate(dofs) if d in ROTATIONS]
+    if turning:
+        order = "".join(dofs[i][1] for i in turning)
+        transform[:, :3, :3] = euler_to_matrices(values[:, turning], order, extrinsic=False, degrees=True)
+    return transform
+
+
+def _static_transform(motion: Motion, chain: list[str]) -> np.ndarray:
+    """The world transform of the last joint of ``chain`` (whose channels stand still), frame 1."""
+    skeleton = motion.skeleton
+    world = np.eye(4)
+    for joint in chain:
+        offset = skeleton.root.position if joint == "root" else skeleton.bone(joint).direction
+        world = world @ _local(skeleton.dofs(joint), motion.values[:1, motion.columns(joint)], offset)[0]
+    return world
+
+
+def _through(channels: np.ndarray, dofs: tuple[str, ...], transform: np.ndarray) -> np.ndarray:
+    """A joint's channels (frames, dofs: xyz positions and rotations) as they are in the frame
+    ``transform`` maps its parent's into."""
+    local = _local(dofs, channels, (0.0, 0.0, 0.0))
+    moved = transform @ local
+    out = channels.copy()
+    for i, d in enumerate(dofs):
+        if d in TRANSLATIONS:
+            out[:, i] = moved[:, TRANSLATIONS.index(d), 3]
+    turning = [i for i, d in enumerate(dofs) if d in ROTATIONS]
+    if turning:
+        order = "".join(dofs[i][1] for i in turning)
+        out[:, turning] = matrices_to_euler(moved[:, :3, :3], order, extrinsic=False, degrees=True)
+    return out

@@ -1,0 +1,99 @@
+"""The rig model: the body joint and the channels that only hold offsets, seen through a BodyView
+that steps work on and restore from, on real takes and the variants other producers would write."""
+
+import numpy as np
+import pytest
+
+import motiontheater as mt
+from corpus import ids, real_files
+from motiontheater.model.rig import body_joint, body_view
+from variants import with_offset_channels, with_static_root
+
+BVHS = real_files("*/*.bvh")
+
+
+def positions_by_name(motion):
+    p = motion.positions()
+    return {n: p[:, i] for i, n in enumerate(motion.skeleton.point_names)}
+
+
+@pytest.mark.parametrize("path", BVHS, ids=ids(BVHS))
+def test_every_real_bvh_has_a_body_and_a_view_that_draws_it(path):
+    motion = mt.read_bvh(path)
+    view = body_view(motion)
+    assert view.motion.frames == motion.frames
+    seen, drawn = positions_by_name(view.motion), positions_by_name(motion)
+    size = max(1.0, float(np.nanmax(np.ptp(motion.skeleton.rest_positions(), axis=0))))
+    for name, points in seen.items():  # offsets folded as they stand in frame 1: within what a file prints
+        np.testing.assert_allclose(points, drawn[name], rtol=0, atol=1e-5 * size)
+    assert view.restore(view.motion).values.tobytes() == motion.values.tobytes()
+
+
+@pytest.mark.parametrize("name", ["walk01.bvh", "16_15.bvh", "jesse_dance.bvh"])
+def test_a_static_root_and_offset_channels_change_nothing(data_dir, name):
+    take = mt.read_bvh(next(data_dir.glob(f"*/{name}")))
+    game = with_static_root(with_offset_channels(take))
+    assert len(game.skeleton.channels) > len(take.skeleton.channels) + 3
+    hips = game.skeleton.bone_names[0]
+    assert body_joint(take) == "root" and body_joint(game) == hips
+    view = body_view(game)
+    assert view.body == hips and view.above is None
+    assert view.motion.skeleton.channels == take.skeleton.channels  # the same layout as the take
+    assert view.motion.values.tobytes() == take.values.tobytes()  # and the same numbers
+    # a result on the view goes back into the game rig's layout, the offsets and static root as found
+    smoothed = view.motion.median(size=5)
+    back = view.restore(smoothed)
+    assert back.skeleton is game.skeleton
+    expected = with_static_root(with_offset_channels(take.median(size=5)))
+    assert back.values.tobytes() == expected.values.tobytes()
+
+
+def test_a_turned_static_root_is_folded_into_the_body(data_dir):
+    take = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    z_up = with_static_root(take, turn=(90.0, 0.0, 0.0), shift=(10.0, -3.0, 2.5))  # an exporter's z-up frame
+    view = body_view(z_up)
+    assert view.above is not None
+    drawn, seen = positions_by_name(z_up), positions_by_name(view.motion)
+    for name, points in seen.items():
+        np.testing.assert_allclose(points, drawn[name], atol=1e-9)
+    np.testing.assert_allclose(view.restore(view.motion).values, z_up.values, atol=1e-9)
+
+
+def test_the_body_is_the_first_joint_that_travels_else_the_hips_by_name(data_dir):
+    take = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    still = take.replace(values=np.broadcast_to(take.values[:1], take.values.shape).copy())
+    assert body_joint(still) == "root"  # the root is called Hips in the file, and that is the root
+    standing = with_static_root(with_offset_channels(still))
+    assert body_joint(standing) == "Hips"  # nothing travels: the hips by name
+    asf = mt.read_amc(data_dir / "cmu" / "01_01.amc", mt.read_asf(data_dir / "cmu" / "01.asf"))
+    assert body_view(asf).identity
+
+
+@pytest.mark.parametrize("name", ["walk01.bvh", "16_15.bvh"])
+def test_feet_steps_on_a_game_rig_are_the_takes_own(data_dir, name):
+    """Six channels on every joint and a static root above the hips: the footplants, the cleanup
+    and its metrics are those of the take as its producer laid it out, the game rig's offsets and
+    static root written back as found."""
+    take = mt.read_bvh(next(data_dir.glob(f"*/{name}")), unit="cm")
+    game = with_static_root(with_offset_channels(take))
+    result, on_game = mt.clean_footskate(take), mt.clean_footskate(game)
+    assert on_game.contacts.plants == result.contacts.plants
+    assert on_game.motion.values.tobytes() == with_static_root(with_offset_channels(result.motion)).values.tobytes()
+    before, after = mt.skate_metrics(game), mt.skate_metrics(on_game.motion, on_game.contacts)
+    assert before.text() == mt.skate_metrics(take).text()
+    assert after.text() == mt.skate_metrics(result.motion, result.contacts).text()
+    assert game.cleanup().values.tobytes() == on_game.motion.values.tobytes()
+
+
+NO_FEET = {"rest.bvh": "holds 1 frame", "sinusoidal.bvh": "a synthetic 3-bone rig, no legs"}
+
+
+@pytest.mark.parametrize(
+    "path", [p for p in BVHS if p.name not in NO_FEET], ids=ids([p for p in BVHS if p.name not in NO_FEET])
+)
+def test_every_real_bvh_is_cleaned_within_the_bounds(path):
+    """The issue's bounds on the take's own plants: sliding mean <= 1 mm, max <= 5 mm, penetration <= 5 mm."""
+    result = mt.clean_footskate(mt.read_bvh(path))
+    report = mt.skate_metrics(result.motion, result.contacts, legs=result.legs, ground=result.ground)
+    for foot in report.feet:
+        assert foot.sliding_mean_mm <= 1.0 and foot.sliding_max_mm <= 5.0 and foot.penetration_mm <= 5.0, report.text()
