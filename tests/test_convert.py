@@ -203,9 +203,10 @@ def test_convert_command(data_dir, tmp_path, capsys):
         == 0
     )
     captured = capsys.readouterr()
-    # a CMU character is 27 units tall: as a BVH its size tells no unit, so the command says how to read it
-    assert f"read {tmp_path / 'w.bvh'} with --unit 0.45" in captured.err
-    assert main(["convert", str(tmp_path / "w.bvh"), str(tmp_path / "w.amc"), "--unit", "0.45"]) == 0
+    # a CMU character is 27 units tall, named as CMU names it: read back as a BVH, its unit is told again
+    assert "--unit" not in captured.err
+    assert mt.read_bvh(tmp_path / "w.bvh").skeleton.length_choice == ("0.45", "detected")
+    assert main(["convert", str(tmp_path / "w.bvh"), str(tmp_path / "w.amc")]) == 0
     out = capsys.readouterr().out
     assert f"343 frames in {tmp_path / 'w.amc'} and its skeleton {tmp_path / 'w.asf'}" in out
     original = mt.read_amc(data_dir / "cmu" / "02_01.amc", mt.read_asf(data_dir / "cmu" / "02.asf"))

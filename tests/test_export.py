@@ -111,7 +111,7 @@ def test_positions_command_takes_a_unit(data_dir, tmp_path, capsys):
     assert main(["positions", str(data_dir / "bvh" / "walk01.bvh"), "-o", str(out), "--unit", "mm"]) == 0
     assert out.read_text().split("\n")[2].split("\t")[4] == "mm"
     assert capsys.readouterr().err == ""
-    assert main(["positions", str(data_dir / "bvh" / "rest.bvh"), "-o", str(tmp_path / "r.csv"), "--meters"]) == 0
+    assert main(["positions", str(data_dir / "bvh" / "sinusoidal.bvh"), "-o", str(tmp_path / "r.csv"), "--meters"]) == 0
     assert "the length unit of the input was assumed (cm)" in capsys.readouterr().err
     assert main(["positions", str(data_dir / "bvh" / "walk01.bvh"), "-o", str(out), "--unit", "ells"]) == 2
     assert "unknown length unit 'ells'" in capsys.readouterr().err

@@ -464,16 +464,17 @@ def test_the_verbs(tmp_path, capsys):
 
 
 def test_the_verbs_read_the_length_unit_given(capsys):
-    """CMU's BVH conversions are in its ASF unit (inch / 0.45), which their size does not tell."""
+    """CMU's BVH conversions are in its ASF unit (inch / 0.45), told by their names and size; a unit
+    given replaces it, and the metres measured follow."""
     take = DATA / "cmu" / "01_01.bvh"
     if not take.exists():
         pytest.skip("real capture corpus not found")
     reports = {}
-    for unit in (None, "0.45"):
+    for unit in (None, "0.45", "in"):
         assert main(["skate", str(take), "--json", *(["--unit", unit] if unit else [])]) == 0
         reports[unit] = json.loads(capsys.readouterr().out)
-    assert reports["0.45"] == json.loads(skate_metrics(mt.read_bvh(take, unit="0.45")).to_json())
-    assert reports["0.45"] != reports[None]
+    assert reports["in"] == json.loads(skate_metrics(mt.read_bvh(take, unit="in")).to_json())
+    assert reports["0.45"] == reports[None] != reports["in"]
 
 
 @pytest.mark.parametrize(

@@ -71,7 +71,14 @@ def test_info_of_a_bvh(data_dir, capsys):
     }
 
 
-@pytest.mark.parametrize("name", ["01_01.bvh", "rest.bvh", "sinusoidal.bvh"])
+def test_info_says_why_cmus_conversion_is_in_its_asf_unit(data_dir, capsys):
+    assert main(["info", str(data_dir / "cmu" / "01_01.bvh")]) == 0
+    text = " ".join(capsys.readouterr().out.split())  # unwrapped
+    assert "in/0.45 = 0.05644 m, detected: its rest pose stands 25.65 units tall along y, 1.448 m" in text
+    assert "in CMU's inch/0.45: its joints are named as in CMU's BVH conversion (LHipJoint, RHipJoint)" in text
+
+
+@pytest.mark.parametrize("name", ["sinusoidal.bvh"])
 def test_info_says_a_unit_was_assumed_and_how_to_set_it(data_dir, name, capsys):
     path = next(data_dir.glob(f"*/{name}"))
     assert main(["info", str(path)]) == 0

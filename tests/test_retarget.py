@@ -335,8 +335,8 @@ def test_a_rest_pose_that_does_not_stand_is_an_error(data_dir, cmu):
 
 
 def test_a_length_unit_that_is_only_assumed_is_refused(data_dir, cmu):
-    conversion = mt.read_take(data_dir / "cmu" / "01_01.bvh")  # 26 units tall: no unit makes that human
-    assert conversion.skeleton.length_source == "assumed"
+    conversion = mt.read_take(data_dir / "cmu" / "01_01.bvh")
+    conversion = conversion.replace(skeleton=conversion.skeleton.with_length_unit("cm", "assumed"))
     with pytest.raises(ValueError, match="the source skeleton has no known length unit.*--unit UNIT.*taken for cm"):
         mt.plan_retarget(conversion.skeleton, cmu.skeleton)
     with pytest.raises(ValueError, match="the target skeleton has no known length unit.*--to-unit UNIT"):

@@ -98,7 +98,7 @@ def test_dry_run_prints_the_plan_and_writes_nothing(data_dir, tmp_path, capsys):
         ("furlong.asf", None, "unknown length unit 'furlong'"),
         ("missing.bvh", None, "missing.bvh: no such target skeleton file"),
         ("cmu/01_01.amc", None, "the target must be a skeleton file (.asf or .bvh)"),
-        ("cmu/01_01.bvh", None, "the target skeleton '01_01' has no known length unit"),
+        ("small.bvh", None, "the target skeleton 'small' has no known length unit"),
     ],
 )
 def test_bad_input_is_one_line_and_writes_nothing(data_dir, tmp_path, capsys, target, map_text, message):
@@ -106,6 +106,10 @@ def test_bad_input_is_one_line_and_writes_nothing(data_dir, tmp_path, capsys, ta
         text = (data_dir / "cmu" / "02.asf").read_text().replace("length 0.45", "length furlong")
         (tmp_path / target).write_text(text)
         target_path = tmp_path / target
+    elif target == "small.bvh":  # CMU's conversion, named otherwise: 26 units tall, no unit told
+        text = (data_dir / "cmu" / "01_01.bvh").read_bytes().replace(b"HipJoint", b"Hip_")
+        target_path = tmp_path / target
+        target_path.write_bytes(text)
     else:
         target_path = data_dir / target if target != "missing.bvh" else tmp_path / target
     args = ["retarget", str(data_dir / "cmu" / "01_01.amc"), "--to", str(target_path), "-o", str(tmp_path / "o.bvh")]

@@ -97,3 +97,23 @@ def test_every_real_bvh_is_cleaned_within_the_bounds(path):
     report = mt.skate_metrics(result.motion, result.contacts, legs=result.legs, ground=result.ground)
     for foot in report.feet:
         assert foot.sliding_mean_mm <= 1.0 and foot.sliding_max_mm <= 5.0 and foot.penetration_mm <= 5.0, report.text()
+
+
+@pytest.mark.parametrize("preserve", ["ground", "literal"])
+def test_the_combiner_preserves_the_body_of_a_game_rig(data_dir, preserve):
+    """A splice of a game rig's take keeps its hips continuous, as it does the take's own root:
+    the static root above them stays where it stands."""
+    take = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    game = with_static_root(with_offset_channels(take))
+    options = dict(cut=(1, 60), scale=(80, 140), preserve=preserve)
+    expected = with_static_root(with_offset_channels(mt.combine(take, take, **options)))
+    got = mt.combine(game, game, **options)
+    assert got.skeleton is game.skeleton and got.frames == expected.frames
+    assert got.values.tobytes() == expected.values.tobytes()
+
+
+def test_a_track_of_another_rate_is_refused_with_the_way_through(data_dir):
+    take = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    fast = take.replace(frame_rate=4 * take.frame_rate)
+    with pytest.raises(ValueError, match=r"new: a motion at 96 Hz and the old one at 24 Hz: .* resample it first"):
+        mt.combine(take, fast, cut=(1, 10))

@@ -22,28 +22,26 @@ EXPECTED = {
     "test_freebvh.bvh": ("cm", "detected", "y"),  # 178
     "test_mocapbank.bvh": ("cm", "detected", "y"),  # 167
     "16_15.bvh": ("cm", "detected", "y"),  # 177; and its root moves as 16_15.amc's times 5.644 (below)
-    "jesse_dance.bvh": ("cm", "detected", "y"),  # a Rokoko rig drawn along x: 20 tall, 130 wide
+    "jesse_dance.bvh": ("cm", "detected", "y"),  # a Rokoko rig drawn along x: sized from its poses, 154
     "AV_8Walk_Meredith_HVHA_Rep1.bvh": ("in", "detected", "y"),  # 60.5: 1.54 m, walking at 1.75 m/s
     "zombie.bvh": ("in", "detected", "z"),  # z-up, 45 tall; AnimatedDrawings scales it by 0.025 to metres
-    "01_01.bvh": ("cm", "assumed", "y"),  # 25.6: CMU's conversion, in the ASF's inch/0.45 (below)
-    "rest.bvh": ("cm", "assumed", "y"),  # 24, the same rig
+    "01_01.bvh": ("0.45", "detected", "y"),  # 25.6: CMU's conversion (LHipJoint, ...) keeps the ASF's inch/0.45
+    "rest.bvh": ("0.45", "detected", "y"),  # 24, the same rig
     "sinusoidal.bvh": ("cm", "assumed", "y"),  # a synthetic 3-bone rig, 8 units
     # bvh-producers/ (SOURCES.md there says what each is)
     "AxisNeuronFakeServer_test.bvh": ("cm", "detected", "y"),  # Perception Neuron, 173
     "BvhToDeepMimic_0005_Walking001.bvh": ("in", "detected", "y"),  # SFU/NUS Vicon, 62: 1.58 m
     "MoDi_000000_joints_1_frames_64.bvh": ("m", "detected", "y"),  # SMPL names, 1.6
-    "bvhTools_test2_lafan1.bvh": ("cm", "detected", "y"),  # LAFAN1: rest pose along x, y-up in the frames
+    "bvhTools_test2_lafan1.bvh": ("cm", "detected", "y"),  # LAFAN1: rest pose along x, sized from its poses
     "bvhTools_test3.bvh": ("m", "detected", "y"),  # a Blender export, 1.4
     "lafan1-resolved_Geno_bind.bvh": ("cm", "detected", "y"),  # 213 with the arms raised
     "makehuman_cmu_10_01.bvh": ("in", "detected", "y"),  # CMU subject 10 on a Character Studio rig, 64
     "pybvh_bvh_example.bvh": ("in", "detected", "z"),  # z-up, 64
     "pybvh_bvh_test1_2024-12.bvh": ("in", "detected", "y"),  # the same family y-up, 62
     "pybvh_bvh_test2.bvh": ("cm", "detected", "y"),  # Xsens MVN names, 182
-    "pybvh_cmu_12_01_walk.bvh": ("cm", "assumed", "y"),  # 24: CMU's cgspeed conversion, as 01_01.bvh
+    "pybvh_cmu_12_01_walk.bvh": ("0.45", "detected", "y"),  # 24: CMU's cgspeed conversion, as 01_01.bvh
     "video2bvh_cxk.bvh": ("mm", "detected", "z"),  # a video pose estimate, 1545
 }
-# where the reading is known wrong today (the rig model of issue 23 judges up from the frames)
-WRONG_TODAY = {"bvhTools_test2_lafan1.bvh": "up is taken from a rest pose lying along x (issue 23)"}
 
 
 def standing_height(positions, axis):
@@ -116,14 +114,7 @@ def test_size_up_rules():
     assert units.size_up(np.empty((0, 3))).unit is None
 
 
-@pytest.mark.parametrize(
-    "path",
-    [
-        pytest.param(p, marks=pytest.mark.xfail(reason=WRONG_TODAY[p.name])) if p.name in WRONG_TODAY else p
-        for p in BVHS
-    ],
-    ids=ids(BVHS),
-)
+@pytest.mark.parametrize("path", BVHS, ids=ids(BVHS))
 def test_every_visible_bvh_has_the_unit_its_size_tells(path):
     skeleton = mt.read_bvh(path).skeleton
     unit, source, up = EXPECTED[path.name]
@@ -243,3 +234,14 @@ Frames: 1
 Frame Time: 0.01
 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0
 """
+
+
+@pytest.mark.parametrize(
+    "path", [p for p in BVHS if p.name != "sinusoidal.bvh"], ids=ids([p for p in BVHS if p.name != "sinusoidal.bvh"])
+)
+def test_every_real_figure_is_human_sized_in_metres(path):
+    """The widest extent of frame 1, in metres by the detected unit: 0.9 to 2.4 m (the rig issue's
+    bound; sinusoidal.bvh is a synthetic 3-bone rig of 8 units)."""
+    pose = mt.read_bvh(path).positions(meters=True)[0]
+    pose = pose[np.isfinite(pose).all(axis=1)]
+    assert 0.9 <= np.ptp(pose, axis=0).max() <= 2.4

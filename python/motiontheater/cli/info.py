@@ -207,20 +207,23 @@ def _why(skeleton, sizing: units.Sizing) -> str:
                 f"the skeleton states :units length {skeleton.unit('length')}, which makes it "
                 f"{_g(max(sizing.extents) * stated)} m in size; "
             )
+        pose = "its poses stand" if skeleton.posed is not None else "its rest pose"
+        if skeleton.posed is not None:
+            what = what.replace("stands ", "", 1)
+        if skeleton.length_unit == units.ACCLAIM_CMU:
+            return (
+                f"{said}{pose} {what}, {_g(meters)} m in CMU's inch/0.45: its joints are named as in CMU's BVH "
+                f"conversion (LHipJoint, RHipJoint), which keeps the CMU ASF's unit, and none of "
+                f"{', '.join(units.DETECTABLE)} gives a human size ({low:g} to {high:g} m)"
+            )
         return (
-            f"{said}its rest pose {what}, {_g(meters)} m in {_WORDS.get(unit, unit)}, the one unit of "
+            f"{said}{pose} {what}, {_g(meters)} m in {_WORDS.get(unit, unit)}, the one unit of "
             f"{', '.join(units.DETECTABLE)} that gives a human size ({low:g} to {high:g} m)"
-        )
-    cmu = ""
-    if {"LHipJoint", "RHipJoint"} <= set(skeleton.bone_names):
-        cmu = (
-            " (its joints are named as in CMU's BVH conversion, whose unit is the CMU ASF's inch/0.45: "
-            "if it is one, --unit 0.45)"
         )
     return (
         f"no unit of {', '.join(units.DETECTABLE)} makes the rest pose ({_g(sizing.height)} units tall along "
         f"{sizing.up}, {_g(max(sizing.extents))} at most) a human size ({low:g} to {high:g} m), so {unit}, "
-        f"the unit of most BVH files, is assumed{cmu}"
+        f"the unit of most BVH files, is assumed"
     )
 
 

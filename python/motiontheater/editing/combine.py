@@ -24,6 +24,7 @@ from mtcore.combine import combine_frames
 
 from ..model.errors import UnknownNameError
 from ..model.motion import Motion
+from ..model.rig import body_view
 from ..model.skeleton import TRANSLATIONS
 
 PRESERVE = (None, "literal", "ground")
@@ -138,6 +139,12 @@ def plan(
     """The frame map of :func:`combine` (see there for the arguments)."""
     if new.skeleton.channels != old.skeleton.channels:
         raise ValueError("new: a motion of another skeleton (its channels differ from the old motion's)")
+    if new.frame_rate != old.frame_rate:
+        raise ValueError(
+            f"new: a motion at {_hz(new.frame_rate)} and the old one at {_hz(old.frame_rate)}: frames would not "
+            f"keep their times; resample it first (motion.resample(rate={_hz(old.frame_rate, unit='')}), "
+            f"motiontheater resample --rate {_hz(old.frame_rate, unit='')})"
+        )
     n1, n2 = new.first_frame, new.first_frame + new.frames - 1
     o1, o2 = old.first_frame, old.first_frame + old.frames - 1
     cut, scale = _pair(cut, "cut"), _pair(scale, "scale")
@@ -275,6 +282,10 @@ def _ramps(rows: np.ndarray, next_row: np.ndarray, ramp: np.ndarray) -> None:
     ramp[:] = np.where(has_next, position / lengths[for_run], 0.0)
 
 
+def _hz(rate: float, unit: str = " Hz") -> str:
+    return f"{rate:.6g}{unit}"
+
+
 def combine(old: Motion, new: Motion, **options: Any) -> Motion:
     """Lay ``new`` over ``old``: a new Motion (the inputs are not modified).
 
@@ -319,7 +330,23 @@ def combine_planned(
     **frame_map: Any,
 ) -> tuple[Plan, Motion]:
     """:func:`combine`, returning the frame map it followed as well; the options that make the
-    frame map (cut, scale, blend, preserve, discard_old, interpolate) are :func:`plan`'s."""
+    frame map (cut, scale, blend, preserve, discard_old, interpolate) are :func:`plan`'s.
+
+    Takes of a game rig are combined as their bodies
+    (:func:`~motiontheater.model.rig.body_view`): the root preserved is the joint that
+    carries the body, not a static joint above it."""
+    seen = body_view(old)
+    if not seen.identity and new.skeleton.channels == old.skeleton.channels:
+        p, result = combine_planned(
+            seen.motion,
+            body_view(new).motion,
+            joints=joints,
+            rotation_blend=rotation_blend,
+            up=up,
+            workers=workers,
+            **frame_map,
+        )
+        return p, seen.restore(result)
     if rotation_blend not in ROTATION_BLENDS:
         raise ValueError(f"rotation_blend must be one of {ROTATION_BLENDS}, got {rotation_blend!r}")
     if up not in UP_AXES:

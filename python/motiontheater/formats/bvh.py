@@ -11,7 +11,7 @@ Blender and MotionBuilder read them.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -22,6 +22,7 @@ from .._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
 from ..model.motion import Motion
 from ..model.rates import rate_of_frame_time
 from ..model.skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem, settle_length_unit
+from ..model.units import size_up_poses
 
 CHANNELS = {
     "xposition": "tx",
@@ -61,12 +62,28 @@ def read_bvh(source: Source, *, unit: str | None = None, frame_rate: float | Non
         motion = _read(data)
     except FormatError as e:
         raise e.at(name) from None
-    motion = motion.replace(skeleton=settle_length_unit(motion.skeleton, unit)).read_from(source)
+    motion = motion.replace(skeleton=settle_length_unit(_posed(motion), unit)).read_from(source)
     if frame_rate is None:
         return motion
     if not 0 < frame_rate < float("inf"):
         raise ValueError(f"the frame rate must be a positive number of frames per second, got {frame_rate!r}")
     return motion.replace(frame_rate=float(frame_rate))  # no longer the file's: written with its own Frame Time
+
+
+POSES = 16  # frames of a take sized where its rest pose is no standing pose
+
+
+def _posed(motion: Motion) -> Skeleton:
+    """The skeleton, sized from the take's poses where its rest pose tells no unit or tells it
+    only by an extent other than its height (a rig drawn along x, a rest pose lying down)."""
+    skeleton = motion.skeleton
+    rest = skeleton.sizing()
+    if (rest.unit is not None and rest.axis == rest.up) or not motion.frames:
+        return skeleton
+    chosen = np.unique(np.linspace(0, motion.frames - 1, min(POSES, motion.frames)).round().astype(int))
+    poses = motion.replace(values=motion.values[chosen]).positions()
+    posed = size_up_poses(poses, cmu=skeleton.cmu_named)
+    return replace(skeleton, posed=posed) if posed.unit is not None else skeleton
 
 
 def _read(data) -> Motion:

@@ -54,12 +54,13 @@ class BodyView:
     def restore(self, result: Motion) -> Motion:
         """A result computed on the view, in the take's layout: the view's channels put back
         where they came from (the body's through the static joints above it), every other channel
-        as the take has it."""
+        as the take has it (for a result of other frames, as the take's first frame has it)."""
         if self.identity:
             return result
-        if result.frames != self.original.frames:
-            raise ValueError("a body view restores results of the same frames only")
-        values = self.original.values.copy()
+        if result.frames == self.original.frames:
+            values = self.original.values.copy()
+        else:  # cut, spliced or resampled: what the view leaves out stands still, as in frame 1
+            values = np.repeat(self.original.values[:1], result.frames, axis=0)
         view = np.array(result.values, dtype=np.float64)
         if self.above is not None:
             view = view.copy()

@@ -14,6 +14,7 @@ last first.  :attr:`Skeleton.tree` holds the tables the C kernel takes.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Hashable, Iterable
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -74,6 +75,9 @@ class Root:
     name: str = "root"
 
 
+_CMU_HIP = re.compile(r"^(?:.*:)?(l|r)hipjoint$", re.IGNORECASE)
+
+
 def name_problem(name: str, convention: str) -> str | None:
     """Why a bone (ASF) or joint (BVH) name cannot be written in the convention's format, or None."""
     if convention == "bvh":
@@ -121,6 +125,7 @@ class Skeleton:
     sections: tuple[tuple[str, tuple[str, ...]], ...] = ()
     convention: str = "asf"  # "asf", or "bvh": a joint's offset turns with its parent, see kinematics
     length_choice: tuple[str, str] | None = None
+    posed: length_units.Sizing | None = field(default=None, compare=False, repr=False)
     style: TextStyle = field(default=PLAIN, compare=False, repr=False)  # how its ASF file was laid out
     origin: Origin | None = field(default=None, compare=False, repr=False)  # the ASF file it was read from
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
@@ -262,13 +267,23 @@ class Skeleton:
         return positions[np.maximum(tree.parent, 0)] if start else positions
 
     def sizing(self) -> length_units.Sizing:
-        """What the rest pose says about the length unit: its extents, up axis and the unit that
-        makes the character human-sized (see :func:`motiontheater.model.units.size_up`)."""
-        return self._sizing
+        """What the skeleton's size says about its length unit: its extents, up axis and the unit
+        that makes the character human-sized (see :func:`motiontheater.model.units.size_up`).  The
+        rest pose's, or ``posed`` where a reader found the rest pose no standing pose and sized the
+        take's poses instead (:func:`~motiontheater.model.units.size_up_poses`)."""
+        return self.posed or self._sizing
 
     @cached_property
     def _sizing(self) -> length_units.Sizing:
-        return length_units.size_up(self.rest_positions())  # every take of a skeleton asks: worked out once
+        # every take of a skeleton asks: worked out once
+        return length_units.size_up(self.rest_positions(), cmu=self.cmu_named)
+
+    @cached_property
+    def cmu_named(self) -> bool:
+        """Whether the joints are named as CMU's BVH conversion names them (LHipJoint, RHipJoint),
+        whose length unit is CMU's inch/0.45."""
+        sides = {m.group(1).lower() for b in self.bones if (m := _CMU_HIP.match(b.name))}
+        return sides == {"l", "r"}
 
     def derived(self, key: Hashable, make: Callable[[], T]) -> T:
         """What ``make()`` works out from this skeleton, made once per ``key``: a batch asks for

@@ -126,7 +126,11 @@ def human_unit(size: float) -> str | None:
     return next((u for u in DETECTABLE if low <= size * METERS_PER_NAMED_UNIT[u] < high), None)
 
 
-def size_up(points: np.ndarray) -> Sizing:
+ACCLAIM_CMU = "0.45"
+"""The unit of CMU's captures (inch / 0.45, 5.644 cm), which their BVH conversion keeps."""
+
+
+def size_up(points: np.ndarray, *, cmu: bool = False) -> Sizing:
     """The length unit a rest pose of ``points`` (n, 3) tells, and its up axis.
 
     The rule: the up axis is y or z, whichever the pose spans more (BVH is
@@ -137,10 +141,13 @@ def size_up(points: np.ndarray) -> Sizing:
     about its height, and some rigs draw their rest pose along another axis
     (Rokoko's, along x).  When neither tells, ``unit`` is None.
 
+    ``cmu``: the rig is named as CMU's BVH conversion names it (``LHipJoint``,
+    ``RHipJoint``): where no unit of mm, cm, in, m makes it human, CMU's
+    :data:`ACCLAIM_CMU` is tried too (its 26-unit character is 0.26 m in cm,
+    0.66 m in inches, 26 m in metres, and 1.47 m in inch/0.45).
+
     What it cannot tell: a character whose size is not human (a child under
-    1 m, a hand, an animal, a synthetic rig), and CMU's BVH conversion, whose
-    unit is the ASF's inch/0.45 and whose 26-unit character is 0.26 m in cm,
-    0.66 m in inches and 26 m in metres: none human.  NaN points are ignored.
+    1 m, a hand, an animal, a synthetic rig).  NaN points are ignored.
     """
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     finite = points[np.isfinite(points).all(axis=1)]
@@ -153,4 +160,25 @@ def size_up(points: np.ndarray) -> Sizing:
         unit = human_unit(extents["xyz".index(axis)])
         if unit is not None:
             return Sizing(extents, up, unit, axis)
+    if cmu:
+        low, high = HUMAN_HEIGHT
+        for axis in dict.fromkeys((up, largest)):
+            if low <= extents["xyz".index(axis)] * meters_per(ACCLAIM_CMU) < high:
+                return Sizing(extents, up, ACCLAIM_CMU, axis)
     return Sizing(extents, up, None, None)
+
+
+def size_up_poses(poses: np.ndarray, *, cmu: bool = False) -> Sizing:
+    """What a take's poses (frames, n, 3) say, as :func:`size_up` says of one: the unit and up
+    axis that most of the poses tell (the earlier pose on a tie), with their median extents.
+    For a take whose rest pose is not a standing pose (drawn along x, or lying down)."""
+    told = [size_up(pose, cmu=cmu) for pose in poses]
+    if not told:
+        return size_up(np.empty((0, 3)), cmu=cmu)
+    votes: dict[tuple[str | None, str], int] = {}
+    for sizing in told:
+        votes[sizing.unit, sizing.up] = votes.get((sizing.unit, sizing.up), 0) + 1
+    unit, up = max(votes, key=lambda k: (k[0] is not None, votes[k]))
+    chosen = [s for s in told if (s.unit, s.up) == (unit, up)]
+    x, y, z = (float(v) for v in np.median([s.extents for s in chosen], axis=0))
+    return Sizing((x, y, z), up, unit, next(s.axis for s in chosen))
