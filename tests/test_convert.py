@@ -1,5 +1,6 @@
 """ASF/AMC <-> BVH conversions: forward kinematics gives the same points, units go with the motion."""
 
+import io
 from dataclasses import replace
 
 import numpy as np
@@ -235,3 +236,14 @@ def test_convert_command_says_when_a_unit_was_assumed(data_dir, tmp_path, capsys
 def test_bad_order():
     with pytest.raises(ValueError, match="order must be one of XYZ"):
         mt.to_bvh(mt.Motion(mt.Skeleton(bones=(), hierarchy=()), np.zeros((1, 6))), "XXY")
+
+
+def test_a_bone_without_dofs_is_a_joint_of_rotations_held_at_zero(data_dir):
+    """pybvh, bvhsdk and bvh-toolbox's exporter refuse or crash on CHANNELS 0 (CMU's lhipjoint)."""
+    bvh = mt.to_bvh(read_take(data_dir / "cmu" / "02_01.amc"))
+    assert bvh.skeleton.dofs("lhipjoint") == ("rz", "rx", "ry")
+    assert not bvh.values[:, bvh.columns("lhipjoint")].any()
+    out = io.BytesIO()
+    mt.write_bvh(bvh, out)
+    assert b"CHANNELS 0" not in out.getvalue()
+    assert all(not b.dofs for b in bvh.skeleton.bones if b.end_site)

@@ -47,8 +47,11 @@ def to_bvh(motion: Motion, order: str = "ZXY") -> Motion:
     Every joint of the ASF skeleton is at the same point in every frame (to
     rounding); the BVH joint named after a bone is at the bone's start, the
     bone's end is its first child joint or the End Site (or, for a bone with
-    translation or stretch dofs, the joint) ``<bone>_End``.  The units
-    (``:units length``, e.g. 0.45) go with it; angles become degrees."""
+    translation or stretch dofs, the joint) ``<bone>_End``.  A bone without
+    dofs (CMU's ``lhipjoint``) becomes a joint of three rotation channels held
+    at zero, as CMU's own BVH conversion writes it: BVH readers refuse
+    ``CHANNELS 0``.  The units (``:units length``, e.g. 0.45) go with it;
+    angles become degrees."""
     skeleton = motion.skeleton
     if skeleton.convention == "bvh":
         return motion
@@ -73,13 +76,16 @@ def to_bvh(motion: Motion, order: str = "ZXY") -> Motion:
         turns = bone.name in angles
         carried = parent in reach
         offset = segment[parent] if parent != "root" else np.zeros(3)
-        dofs = (TRANSLATIONS if carried else ()) + (rotation_dofs if turns else ())
+        held = not carried and not turns  # no channel: three rotations held at zero, as CMU's conversion writes
+        dofs = (TRANSLATIONS if carried else ()) + (rotation_dofs if turns or held else ())
         bones.append(_bvh_bone(bone.name, offset, dofs))
         pairs.append((parent, (bone.name,)))
         if carried:
             columns.append(reach[parent])
         if turns:
             columns.append(angles[bone.name])
+        elif held:
+            columns.append(np.zeros((motion.frames, 3)))
         if skeleton.children(bone.name):
             continue
         end = f"{bone.name}_End"
