@@ -419,3 +419,23 @@ def test_after_the_cleanup_the_feet_hold_the_cleanups_bounds(data_dir, pair):
     # cleanup and after, see motiontheater.feet.skate; the sliding above is the planted feet's own measure)
     assert after.worst("penetration_mm") <= 5.0
     assert cleaned.skeleton is target
+
+
+def test_a_limb_left_unmapped_is_an_error_naming_its_joints(data_dir, cmu, tmp_path):
+    """A rig the tables half know (its arms named otherwise) is refused, not retargeted with arms at rest."""
+    text = (
+        (data_dir / "bvh" / "walk01.bvh")
+        .read_text()
+        .replace("LeftArm", "ArmUpper_L")
+        .replace("LeftForeArm", "ArmLower_L")
+    )
+    (tmp_path / "odd.bvh").write_text(text)
+    odd = mt.read_bvh(tmp_path / "odd.bvh").skeleton
+    with pytest.raises(
+        ValueError,
+        match=r"the target.s left arm \(no joint of it named as a known rig names it\) follow no joint of the source",
+    ):
+        mt.plan_retarget(cmu.skeleton, odd)
+    (tmp_path / "map.toml").write_text('[joints]\nlhumerus = "ArmUpper_L"\nlradius = "ArmLower_L"\n')
+    plan = mt.plan_retarget(cmu.skeleton, odd, tmp_path / "map.toml")
+    assert ("lhumerus", "ArmUpper_L") in plan.joint_map.pairs

@@ -257,6 +257,32 @@ def _resolve(name: str, skeleton: Skeleton, side: str, where: str) -> str:
     raise UnknownNameError(f"{where}: '{name}' is not a joint of the {side} skeleton '{label}'{hint}")
 
 
+LIMBS = {
+    f"{side} {limb}": tuple(f"{side}_{part}" for part in parts)
+    for side in ("left", "right")
+    for limb, parts in (("leg", ("thigh", "shin")), ("arm", ("upper_arm", "forearm")))
+}
+"""The limbs whose joints a retarget must drive: a figure with a leg or an arm left at rest is
+no result (the tables' parts of each; a map file may leave one out on purpose)."""
+
+
+def _require_limbs(target_rig: Recognised, chosen: dict[str, tuple[str, str]], source_rig: Recognised) -> None:
+    """ValueError naming the target's limb joints that follow no source joint."""
+    missing = []
+    for limb, parts in LIMBS.items():
+        joints = [target_rig.parts[p][0] if p in target_rig.parts else None for p in parts]
+        if all(j is None for j in joints):
+            missing.append(f"{limb} (no joint of it named as a known rig names it)")
+        elif left := [j for j in joints if j is not None and j not in chosen]:
+            missing.append(f"{limb} ({', '.join(left)})")
+    if missing:
+        raise ValueError(
+            f"the target's {'; '.join(missing)} follow no joint of the source ({source_rig.title}): the "
+            "character would move without them; give a map file (--map MAP.toml) with a [joints] table "
+            'of source = "target" names for them'
+        )
+
+
 def joint_map(source: Skeleton, target: Skeleton, map_file: str | os.PathLike | None = None) -> JointMap:
     """The pairs of joints of ``source`` and ``target`` that turn the same part (see the module
     docstring), with the pairs of ``map_file`` replacing the tables' for the joints it names.
@@ -309,6 +335,8 @@ def joint_map(source: Skeleton, target: Skeleton, map_file: str | os.PathLike | 
             f"neither turn nor travel; map it in a map file ({_source_hips(source_rig, source)} = "
             f'"{target.root.name}")'
         )
+    if map_file is None:
+        _require_limbs(target_rig, chosen, source_rig)
     used = {s for s, _ in chosen.values()}
     return JointMap(
         pairs=tuple((s, t) for t, (s, _) in ordered),
