@@ -11,6 +11,7 @@ import pytest
 
 import motiontheater as mt
 from motiontheater.cli import main
+from variants import with_static_root
 
 pytest.importorskip("matplotlib", reason="matplotlib is not installed (pip install 'motiontheater[plot]')")
 Image = pytest.importorskip("PIL.Image", reason="pillow is not installed (pip install 'motiontheater[plot]')")
@@ -63,6 +64,16 @@ def test_figure_holds_the_channels_of_each_take():
     np.testing.assert_array_equal(lines[0].get_ydata(), before.channel("lfemur", "rx"))
     np.testing.assert_array_equal(lines[1].get_ydata(), after.channel("lfemur", "rx"))
     assert "degrees" in axes[0].get_ylabel()
+
+
+def test_a_bvh_root_is_plotted_by_its_own_name(data_dir):
+    walk01 = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    fig = figure([walk01, walk01.median(size=5)], joints=["Hips"])
+    axes = fig.get_axes()
+    assert [a.get_ylabel().split("\n")[0] for a in axes][:3] == ["Hips Xposition", "Hips Yposition", "Hips Zposition"]
+    for ax, dof in zip(axes, walk01.skeleton.dofs("root")):
+        assert len(ax.get_lines()) == 2  # it drew empty panels: the root is called root inside
+        np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), walk01.channel("root", dof))
 
 
 def test_compared_takes_are_aligned_in_time_and_framed():
@@ -133,6 +144,28 @@ def test_render_gif_has_a_frame_per_instant_and_shows_the_walk(tmp_path):
         blue = (picture[..., 2] > 120) & (picture[..., 0] < 90)  # the skeleton's colour
         assert blue.sum() > 30
     assert not np.array_equal(frames[0], frames[12])  # the legs moved
+
+
+def drawn_extent(picture) -> tuple[int, int]:
+    """(height, width) in pixels of what is drawn in the skeleton's colour, below the caption."""
+    below = picture[20:]
+    rows, columns = np.nonzero((below[..., 2] > 120) & (below[..., 0] < 90))
+    return int(np.ptp(rows)), int(np.ptp(columns))
+
+
+@pytest.mark.parametrize(
+    "name,variant",
+    [("walk01.bvh", None), ("zombie.bvh", None), ("walk01.bvh", "static root"), ("walk01.bvh", "z-up")],
+    ids=["y-up", "z-up (AnimatedDrawings)", "a static root turned above the hips", "turned to stand along z"],
+)
+def test_a_standing_take_is_drawn_standing_whatever_its_up_axis(data_dir, tmp_path, name, variant):
+    take = mt.read_bvh(next(data_dir.glob(f"*/{name}")))
+    if variant is not None:  # a z-up studio's frame above the hips, the points where they were or turned with it
+        take = with_static_root(take, turn=(90.0, 0.0, 0.0), keep_world=variant == "static root")
+    target = tmp_path / "stand.gif"
+    render([take], target, fps=5, frames=(1, 2), size=(200, 200), **({"up": "z"} if variant == "z-up" else {}))
+    tall, wide = drawn_extent(gif_frames(target, duration=200)[0])
+    assert tall > wide, (tall, wide)
 
 
 def test_render_of_a_range_with_a_compared_take(tmp_path):

@@ -7,15 +7,20 @@ import motiontheater as mt
 from motiontheater.model.skeleton import TRANSLATIONS, Bone, Root, canonical_hierarchy
 
 
-def with_static_root(motion: mt.Motion, name: str = "Reference", turn=None, shift=(0.0, 0.0, 0.0)) -> mt.Motion:
+def with_static_root(
+    motion: mt.Motion, name: str = "Reference", turn=None, shift=(0.0, 0.0, 0.0), *, keep_world: bool = True
+) -> mt.Motion:
     """A BVH take under a joint above its root that never moves (six channels, constant): at
     ``shift``, turned by ``turn`` (X, Y, Z rotation channels in degrees; None: not turned, and then
-    the old root's channels are exactly the same numbers)."""
+    the old root's channels are exactly the same numbers).  ``keep_world``: the old root's channels
+    are made relative to the static joint, so that every point stays where it was; else they stay
+    as they were and the whole take turns and moves with the static joint (``turn=(90, 0, 0)``:
+    a y-up take stands along z, as a z-up exporter writes it)."""
     skeleton = motion.skeleton
     old = skeleton.root
     turn = (0.0, 0.0, 0.0) if turn is None else turn
     values = motion.values
-    if any(turn) or any(shift):  # the old root's channels, in the static joint's frame
+    if keep_world and (any(turn) or any(shift)):  # the old root's channels, in the static joint's frame
         from motiontheater.model.rig import _local, _through
 
         static = _local(("tx", "ty", "tz", "rx", "ry", "rz"), np.array([[*shift, *turn]]), (0, 0, 0))[0]

@@ -16,6 +16,7 @@ import numpy as np
 
 from .._io import Source, output
 from .._optional import require
+from ..formats.bvh import NAMES as BVH_CHANNELS
 from ..model.motion import Motion
 from ..model.skeleton import ROTATIONS
 from .positions import length_unit_name
@@ -79,7 +80,7 @@ def figure(
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
     for ax, (joint, dof) in zip(axes, panels):
         for k, (motion, label) in enumerate(zip(takes, labels)):
-            if joint not in motion.skeleton.joint_names or dof not in motion.skeleton.dofs(joint):
+            if not motion.skeleton.has_joint(joint) or dof not in motion.skeleton.dofs(joint):
                 continue
             # frame numbers of the first take at the same time from each take's start
             x = base.first_frame + np.arange(motion.frames) * (base.frame_rate / motion.frame_rate)
@@ -91,7 +92,8 @@ def figure(
                 linewidth=1.0 if k == 0 else 1.3,
                 label=label,
             )
-        ax.set_ylabel(f"{joint} {dof}\n({_unit(base, dof)})", fontsize=9)
+        spelled = BVH_CHANNELS[dof] if base.skeleton.convention == "bvh" else dof  # as the file names it
+        ax.set_ylabel(f"{joint} {spelled}\n({_unit(base, dof)})", fontsize=9)
         ax.grid(True, color="0.9", linewidth=0.6)
         ax.tick_params(labelsize=8)
         ax.set_xlim(lo, hi)

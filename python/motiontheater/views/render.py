@@ -2,8 +2,9 @@
 ``plot`` extra) or MP4 (also ffmpeg on the PATH).
 
 The camera is the viewer page's: a perspective view from above and to the
-side, its distance set by the skeleton's size, following the root over the
-floor (``follow=True``) or fixed on the whole take.  Y is up.  The first
+side, its distance set by the skeleton's size, following the body over the
+floor (``follow=True``) or fixed on the whole take.  The take's up axis is
+drawn up (a z-up export stands, as a y-up one does).  The first
 take is drawn solid, compared takes ghosted over it at the same time from
 each take's start.
 """
@@ -22,6 +23,7 @@ import numpy as np
 from .._io import Source, output
 from .._optional import require
 from ..model.motion import Motion
+from ..model.rig import body_view
 
 FORMATS = ("gif", "mp4")
 MAX_GIF_FRAMES = 1500  # a minute at 25 fps; pillow holds every frame of a GIF until it writes it
@@ -92,6 +94,7 @@ def render(
     frames: tuple[int, int] | None = None,
     names: Sequence[str] | None = None,
     follow: bool = True,
+    up: str | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> int:
     """Write an animation of the takes' skeletons and return the number of frames written.
@@ -101,7 +104,12 @@ def render(
     first take in real time (the nearest frame to each instant) over
     ``frames`` (first, last frame numbers; default all).  ``size`` is
     (width, height) in pixels (even numbers for MP4).  ``names`` label the
-    takes in the corner.  ``progress(done, total)`` is called after each
+    takes in the corner.  ``up`` is the axis that points up ("y", "z",
+    "-y", ...; default: y for ASF, the one a BVH's figure stands along, see
+    :meth:`~motiontheater.model.skeleton.Skeleton.sizing`): it is drawn up.
+    Takes are drawn as their bodies (:func:`~motiontheater.model.rig.body_view`):
+    the camera follows the joint that travels, and no bone is drawn from a
+    static joint above it.  ``progress(done, total)`` is called after each
     frame.  A path is written atomically.
     """
     if format is None:
@@ -135,7 +143,9 @@ def render(
             f"a GIF of {len(shown)} frames is too long (at most {MAX_GIF_FRAMES}, held in memory until written): "
             "choose fewer frames, a lower fps, or write .mp4"
         )
-    pictures = _pictures(takes, labels, shown, (width, height), follow)
+    axis = up or (takes[0].skeleton.sizing().up if takes[0].skeleton.convention == "bvh" else "y")
+    turn = up_to_y(axis)
+    pictures = _pictures([body_view(m).motion for m in takes], labels, shown, (width, height), follow, turn)
     total = len(shown)
 
     def counted():
@@ -151,7 +161,25 @@ def render(
     return total
 
 
-def _pictures(takes, labels, shown, size, follow):
+_UP = {  # a turn (det 1) that takes the axis named up to +y
+    "y": ((1, 0, 0), (0, 1, 0), (0, 0, 1)),
+    "z": ((1, 0, 0), (0, 0, 1), (0, -1, 0)),
+    "x": ((0, -1, 0), (1, 0, 0), (0, 0, 1)),
+    "-y": ((1, 0, 0), (0, -1, 0), (0, 0, -1)),
+    "-z": ((1, 0, 0), (0, 0, -1), (0, 1, 0)),
+    "-x": ((0, 1, 0), (-1, 0, 0), (0, 0, 1)),
+}
+
+
+def up_to_y(up: str) -> np.ndarray:
+    """The rotation (3 x 3) that turns a take whose ``up`` axis is "y", "z", "-y", ... to stand along +y."""
+    key = up.strip().lower().lstrip("+")
+    if key not in _UP:
+        raise ValueError(f"up must be one of {', '.join(_UP)}, got {up!r}")
+    return np.array(_UP[key], dtype=float)
+
+
+def _pictures(takes, labels, shown, size, follow, turn):
     """RGB arrays (height, width, 3), one per shown frame of the first take."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.collections import LineCollection
@@ -162,11 +190,11 @@ def _pictures(takes, labels, shown, size, follow):
     # only the frames shown: each take's nearest frame to each instant of the first take's
     seconds = np.asarray(shown) / base.frame_rate
     rows = [np.minimum(m.frames - 1, np.rint(seconds * m.frame_rate).astype(int)) for m in takes]
-    positions = [m.replace(values=m.values[r]).positions() for m, r in zip(takes, rows)]
+    positions = [m.replace(values=m.values[r]).positions() @ turn.T for m, r in zip(takes, rows)]
     points = positions[0]
     finite = points[np.isfinite(points).all(axis=2)]
     floor = float(finite[:, 1].min()) if len(finite) else 0.0
-    rest = base.skeleton.rest_positions()
+    rest = base.skeleton.rest_positions() @ turn.T
     extent = np.nanmax(rest, axis=0) - np.nanmin(rest, axis=0)
     camera = _Camera(size, 2.2 * max(float(np.nanmax(extent)), 1e-9))
     centre = (np.nanmin(finite, axis=0) + np.nanmax(finite, axis=0)) / 2 if len(finite) else np.zeros(3)
