@@ -9,6 +9,7 @@ import pytest
 import motiontheater as mt
 from corpus import ids, real_files
 from motiontheater.cli import main
+from motiontheater.editing.convert import _notes
 
 BVHS = real_files("*/*.bvh")
 AMCS = real_files("*/*.amc")
@@ -19,21 +20,35 @@ TRANSLATIONS = ("tx", "ty", "tz")
 
 def asf_end_points_in_bvh(asf_skeleton, bvh_skeleton):
     """BVH point index of each ASF joint's end: the root, a child joint's start, or ``<bone>_End`` (an
-    End Site, or the joint of position channels that ends a bone with translation dofs)."""
+    End Site, or the joint of position channels that ends a bone with translation dofs); a bone that
+    to_asf made to reach a joint ends at that joint."""
     names, index = bvh_skeleton.point_names, []
+    _, connectors, _ = _notes(asf_skeleton)
     for joint in asf_skeleton.joint_names:
         if joint == "root":
             index.append(0)
+        elif joint in connectors:
+            index.append(names.index(joint.split("_to_", 1)[1]))
         else:
-            children = asf_skeleton.children(joint)
-            index.append(names.index(children[0] if children else f"{joint}_End"))
+            children = [c for c in asf_skeleton.children(joint) if c not in connectors]
+            end = children[0] if children else f"{joint}_End"
+            index.append(names.index(end if end in names else joint))  # a BVH leaf joint is its own end
     return index
 
 
 def bvh_points_in_asf(bvh_skeleton, asf_skeleton):
-    """ASF point index of each BVH point: the bone named after the joint (spaces as '_') ends there."""
+    """ASF point index of each BVH point, as to_asf lays them: a joint is where the bone named after
+    its parent ends (the root's children: the root), or where the bone made to reach it ends."""
     names = asf_skeleton.joint_names
-    return [0] + [names.index(n.replace(" ", "_")) for n in bvh_skeleton.point_names[1:]]
+    index = [0]
+    for point in bvh_skeleton.point_names[1:]:
+        parent = bvh_skeleton.parent(point)
+        start = bvh_skeleton.root.name if parent == "root" else parent
+        reach = f"{start}_to_{point}".replace(" ", "_")
+        index.append(
+            names.index(reach) if reach in names else 0 if parent == "root" else names.index(parent.replace(" ", "_"))
+        )
+    return index
 
 
 def assert_same_points(actual, expected):
@@ -247,3 +262,41 @@ def test_a_bone_without_dofs_is_a_joint_of_rotations_held_at_zero(data_dir):
     mt.write_bvh(bvh, out)
     assert b"CHANNELS 0" not in out.getvalue()
     assert all(not b.dofs for b in bvh.skeleton.bones if b.end_site)
+
+
+def by_name(motion):
+    points = motion.positions()
+    return {name: points[:, i] for i, name in enumerate(motion.skeleton.point_names)}
+
+
+def tree_of(skeleton):
+    return {name: skeleton.parent(name) for name in skeleton.bone_names}
+
+
+@pytest.mark.parametrize("bvh", BVHS, ids=ids(BVHS))
+def test_bvh_to_asf_to_bvh_gives_the_same_joints_names_and_points(bvh, tmp_path):
+    """No joint renamed one down the chain, no `_End_End`, the root keeps its name (Hips)."""
+    motion = mt.read_bvh(bvh)
+    motion = motion.crop(1, min(motion.frames, 120))
+    asf = amc_through_files(mt.to_asf(motion), tmp_path)
+    again = bvh_through_file(mt.to_bvh(asf), tmp_path, unit=asf.skeleton.length_unit)
+    assert again.skeleton.root.name == motion.skeleton.root.name
+    assert sorted(again.skeleton.point_names) == sorted(motion.skeleton.point_names)
+    assert tree_of(again.skeleton) == tree_of(motion.skeleton)
+    assert {b.name for b in again.skeleton.bones if b.end_site} == {b.name for b in motion.skeleton.bones if b.end_site}
+    expected, got = by_name(motion), by_name(again)
+    for name, points in expected.items():
+        assert_same_points(got[name], points)
+
+
+@pytest.mark.parametrize("amc", AMCS, ids=ids(AMCS))
+def test_amc_to_bvh_to_amc_gives_the_same_bones_and_points(amc, tmp_path):
+    motion = read_take(amc)
+    motion = motion.crop(motion.first_frame, min(motion.last_frame, motion.first_frame + 119))
+    bvh = bvh_through_file(mt.to_bvh(motion), tmp_path, unit=motion.skeleton.length_unit)
+    back = amc_through_files(mt.to_asf(bvh), tmp_path)
+    assert sorted(back.skeleton.bone_names) == sorted(motion.skeleton.bone_names)
+    assert tree_of(back.skeleton) == tree_of(motion.skeleton)
+    expected, got = by_name(motion), by_name(back)
+    for name, points in expected.items():
+        assert_same_points(got[name], points)
