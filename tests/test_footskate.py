@@ -115,10 +115,10 @@ def test_legs_are_found_by_name_and_hierarchy(path, data_dir):
 
 
 def test_an_asf_converted_from_bvh_is_read_by_its_segments(data_dir):
-    # to_asf names a bone after the joint it ends at: its "LeftFoot" runs from the knee to the ankle
+    # to_asf names a bone after the joint it starts at: its "LeftUpLeg" runs from the hip to the knee
     converted = mt.to_asf(mt.read_bvh(data_dir / "cmu" / "01_01.bvh")).skeleton
     left, _ = find_legs(converted)
-    assert (left.hip, left.knee, left.ankle, left.toe) == ("LeftLeg", "LeftFoot", "LeftToeBase", "LeftToeBase_End")
+    assert (left.hip, left.knee, left.ankle, left.toe) == ("LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase")
 
 
 def test_a_skeleton_without_feet_is_refused_with_the_reason(data_dir):
