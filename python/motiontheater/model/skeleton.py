@@ -276,7 +276,8 @@ class Skeleton:
     @cached_property
     def _sizing(self) -> length_units.Sizing:
         # every take of a skeleton asks: worked out once
-        return length_units.size_up(self.rest_positions(), cmu=self.cmu_named)
+        # CMU's ASFs state their unit: the naming rule is for its BVH conversion
+        return length_units.size_up(self.rest_positions(), cmu=self.convention == "bvh" and self.cmu_named)
 
     @cached_property
     def cmu_named(self) -> bool:
