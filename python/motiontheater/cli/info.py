@@ -4,7 +4,8 @@
 :func:`as_text` puts it in words: the frames, rate, duration and first
 frame; the length unit, how it was chosen and how to choose another; the
 character's height in metres and file units and its up axis; and the joint
-tree with each channel's range over the take.
+tree with each channel's range over the take.  :func:`unit_notes` is what the
+verbs that write takes say about units; ``INFO`` is the verb.
 """
 
 from __future__ import annotations
