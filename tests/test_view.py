@@ -115,7 +115,7 @@ def test_compared_takes_and_footplants():
     a, b = small_take(seed=1), small_take(frames=30, seed=2)
     flags = np.zeros(40, bool)
     flags[5:12] = flags[20:] = True
-    data = page_data(page([a, b], names=["before", "after"], plants=[{"toe": flags}, None]))
+    data = page_data(page([a, b], names=["before", "after"], contacts=[{"toe": flags}, None]))
     assert [t["name"] for t in data["takes"]] == ["before", "after"]
     point = a.skeleton.point_names.index("toe")
     assert data["takes"][0]["plants"] == [{"label": "toe", "point": point, "spans": [[5, 11], [20, 39]]}]
@@ -130,7 +130,7 @@ def test_a_contacts_table_marks_heels_and_balls(data_dir):
 
     motion = mt.read_amc(data_dir / "cmu" / "01_01.amc", mt.read_asf(data_dir / "cmu" / "01.asf"))
     table = Contacts([Plant("lfoot", "heel", 11, 50), Plant("rfoot", "ball", 2000, 2751)], 1, motion.frames)
-    rows = page_data(page([motion], plants=[table]))["takes"][0]["plants"]
+    rows = page_data(page([motion], contacts=[table]))["takes"][0]["plants"]
     points = motion.skeleton.point_names
     assert [(r["label"], points[r["point"]], r["spans"]) for r in rows] == [
         ("lfoot heel", "ltibia", [[10, 49]]),  # an ASF bone's point is where it ends: ltibia ends at the ankle
@@ -138,12 +138,12 @@ def test_a_contacts_table_marks_heels_and_balls(data_dir):
         ("rfoot heel", "rtibia", []),
         ("rfoot ball", "rfoot", [[1999, 2750]]),
     ]
-    decimated = page_data(page([motion], plants=[table], max_frames=1000))["takes"][0]["plants"]
+    decimated = page_data(page([motion], contacts=[table], max_frames=1000))["takes"][0]["plants"]
     assert decimated[0]["spans"] == [[4, 16]]  # frames 13, 16 .. 49 of the 1 in 3 shown (indices 12 .. 48)
     with pytest.raises(ValueError, match="another take"):
-        page([motion.replace(values=motion.values[:100])], plants=[table])
+        page([motion.replace(values=motion.values[:100])], contacts=[table])
     with pytest.raises(mt.errors.UnknownNameError, match="nose"):
-        page([motion], plants=[Contacts([Plant("nose", "ball", 1, 2)], 1, motion.frames)])
+        page([motion], contacts=[Contacts([Plant("nose", "ball", 1, 2)], 1, motion.frames)])
 
 
 def test_editor_steps_are_registered_steps():
@@ -163,8 +163,8 @@ def test_editor_steps_are_registered_steps():
         (dict(takes=[]), "at least one take"),
         (dict(max_frames=1), "max_frames"),
         (dict(names=["a", "b"]), "one name"),
-        (dict(plants=[{"nose": np.zeros(40, bool)}]), "not a point"),
-        (dict(plants=[{"toe": np.zeros(39, bool)}]), "one flag per frame"),
+        (dict(contacts=[{"nose": np.zeros(40, bool)}]), "not a point"),
+        (dict(contacts=[{"toe": np.zeros(39, bool)}]), "one flag per frame"),
     ],
 )
 def test_bad_arguments_are_refused(kwargs, message):
@@ -208,7 +208,7 @@ def test_cli_view_marks_footplants(tmp_path, data_dir, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     take = data_dir / "cmu" / "07_05-walk.amc"
     assert main(["contacts", str(take), "-o", "plants.csv"]) == 0
-    detected = page_data_of(main, ["view", str(take), "--no-open", "--plants"], tmp_path / "07_05-walk.html")
+    detected = page_data_of(main, ["view", str(take), "--no-open", "--contacts"], tmp_path / "07_05-walk.html")
     given = page_data_of(
         main, ["view", str(take), "--no-open", "--contacts", "plants.csv"], tmp_path / "07_05-walk.html"
     )
@@ -230,6 +230,27 @@ def test_cli_view_marks_footplants(tmp_path, data_dir, monkeypatch, capsys):
     other = data_dir / "cmu" / "01_01.amc"
     assert main(["view", str(other), "--no-open", "-o", "x.html", "--contacts", "plants.csv"]) == 2
     assert "another take" in capsys.readouterr().err and not (tmp_path / "x.html").exists()
+
+
+def test_view_takes_the_old_name_of_contacts(tmp_path, data_dir, monkeypatch, capsys):
+    """plants= and --plants still work for one release, each saying what to give instead."""
+    from motiontheater.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    take = data_dir / "cmu" / "07_05-walk.amc"
+    new = page_data_of(main, ["view", str(take), "--no-open", "--contacts", "-o", "new.html"], tmp_path / "new.html")
+    capsys.readouterr()
+    old = page_data_of(main, ["view", str(take), "--no-open", "--plants", "-o", "old.html"], tmp_path / "old.html")
+    err = capsys.readouterr().err
+    assert err == "motiontheater view: --plants is deprecated: give --contacts (with no FILE)\n"
+    assert old["takes"][0]["plants"] == new["takes"][0]["plants"] != []
+    motion = mt.read_take(take)
+    flags = {"ltoes": np.zeros(motion.frames, bool)}
+    with pytest.warns(DeprecationWarning, match="contacts=") as caught:
+        write_page([motion], tmp_path / "api.html", plants=[flags])
+    assert caught[0].filename == __file__  # the warning names the caller's line
+    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match="once, as contacts="):
+        page([motion], plants=[flags], contacts=[flags])
 
 
 def page_data_of(main, argv, path):

@@ -354,7 +354,7 @@ def test_footplants_are_marked_on_the_feet_and_the_timeline(browser, data_dir, t
     motion = cmu(data_dir)
     flags = np.zeros(motion.frames, bool)
     flags[:200] = True
-    open_page(browser, tmp_path, [motion], plants=[{"ltoes": flags}])
+    open_page(browser, tmp_path, [motion], contacts=[{"ltoes": flags}])
     browser.execute_script("mtView.seek(100)")
     wait_frame(browser, 101)
     settle(browser)

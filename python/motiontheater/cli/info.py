@@ -4,11 +4,13 @@
 :func:`as_text` puts it in words: the frames, rate, duration and first
 frame; the length unit, how it was chosen and how to choose another; the
 character's height in metres and file units and its up axis; and the joint
-tree with each channel's range over the take.
+tree with each channel's range over the take.  :func:`unit_notes` is what the
+verbs that write takes say about units; ``INFO`` is the verb.
 """
 
 from __future__ import annotations
 
+import argparse
 import math
 import os
 import textwrap
@@ -17,9 +19,11 @@ from typing import Any
 import numpy as np
 
 from ..formats.bvh import NAMES as BVH_CHANNEL_NAMES
-from ..formats.table import format_for, format_of, states_unit
+from ..formats.table import format_for, format_of, skeleton_for, states_unit
 from ..model import units
 from ..model.motion import Motion
+from .takes import add_take_options, take_of
+from .verb import Verb
 
 SET_UNIT = f"set another with --unit UNIT (Python: unit=UNIT), UNIT: {units.UNIT_HELP}"
 _WORDS = {"m": "metres", "cm": "centimetres", "mm": "millimetres", "in": "inches"}
@@ -272,3 +276,35 @@ def _span(low: float | None, high: float | None) -> tuple[str, str]:
     size = max(abs(low), abs(high))
     decimals = min(6, max(0, 4 - math.floor(math.log10(size)))) if size > 0 else 0
     return f"{round(low, decimals) + 0.0:.{decimals}f}", f"{round(high, decimals) + 0.0:.{decimals}f}"
+
+
+def _arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    parser.add_argument("--json", action="store_true", help="print JSON (NaN as null)")
+    add_take_options(parser)
+
+
+def _info(args: argparse.Namespace) -> int:
+    import json
+
+    motion = take_of(args, args.input)
+    skeleton_file = skeleton_for(args.input, args.asf)
+    facts = describe(motion, args.input, skeleton_file, frame_rate_given=args.frame_rate is not None)
+    print(json.dumps(facts, indent=2) if args.json else as_text(facts))
+    return 0
+
+
+INFO = Verb(
+    "info",
+    "describe a take: frames, rate, units, height, up axis, joint tree and channel ranges",
+    _arguments,
+    _info,
+    description=(
+        "Describe a take (AMC or BVH): its frames, frame rate, duration and first frame; its length "
+        "unit, how that was chosen (stated by the ASF, detected from the character's size, given with "
+        "--unit, or assumed) and how to set another; the character's height in metres and in file "
+        "units and its up axis; and the joint tree with each channel's range over the take. --json "
+        "prints the same as JSON for programs."
+    ),
+    epilog="Example: motiontheater info walk01.bvh ; motiontheater info 01_01.amc --json",
+)

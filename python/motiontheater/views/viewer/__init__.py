@@ -6,7 +6,7 @@ perspective view drawn with Canvas 2D, a floor grid, orbit/zoom/pan and a
 camera that follows the root), the joint tree with the selected joint's
 channel values and an axis-angle glyph of its rotation, the selected joint's
 channel curves with a playhead, several takes compared (overlaid curves and
-ghosted skeletons, aligned in time), footplants when given, and an editor that
+ghosted skeletons, aligned in time), footplants when given (``contacts=``), and an editor that
 stacks the registered interpolators (:mod:`motiontheater.editing.interpolators`) and
 filters (:mod:`motiontheater.editing.filtering`) over frame ranges, previews them
 (JavaScript ports of those steps, equal to about 1e-12) and exports the
@@ -34,6 +34,7 @@ from __future__ import annotations
 import base64
 import json
 import math
+import warnings
 import zlib
 from collections.abc import Mapping, Sequence
 from importlib.resources import files
@@ -100,19 +101,21 @@ def _spans(flags: np.ndarray) -> list[list[int]]:
     return [[int(a), int(b) - 1] for a, b in zip(edges[::2], edges[1::2])]
 
 
-def _plant_rows(
-    motion: Motion, label: str, step: int, plants: Mapping[str, np.ndarray] | Contacts | None, legs: Joints
-) -> list[dict]:
+Footplants = Mapping[str, np.ndarray] | Contacts
+"""A take's footplants: a contacts table, or flags per frame of named points."""
+
+
+def _plant_rows(motion: Motion, label: str, step: int, contacts: Footplants | None, legs: Joints) -> list[dict]:
     """The footplant rows of a take as the page draws them: label, point index, spans of shown frames."""
-    if plants is None:
+    if contacts is None:
         return []
-    if isinstance(plants, Contacts):
-        plants.check_take(motion.first_frame, motion.frames)
-        marks = plants.marks(resolve_legs(motion.skeleton, legs))
+    if isinstance(contacts, Contacts):
+        contacts.check_take(motion.first_frame, motion.frames)
+        marks = contacts.marks(resolve_legs(motion.skeleton, legs))
     else:
         points = motion.skeleton.point_names
         marks = []
-        for point, flags in plants.items():
+        for point, flags in contacts.items():
             if point not in points:
                 raise ValueError(f"footplants name '{point}', which is not a point of {label}")
             marks.append((point, points.index(point), np.asarray(flags, bool)))
@@ -126,15 +129,13 @@ def _plant_rows(
     return rows
 
 
-def _take_data(
-    motion: Motion, label: str, step: int, plants: Mapping[str, np.ndarray] | Contacts | None, legs: Joints
-) -> dict:
+def _take_data(motion: Motion, label: str, step: int, contacts: Footplants | None, legs: Joints) -> dict:
     skeleton = motion.skeleton
     tree = skeleton.tree
     names = skeleton.joint_names
     index = {name: i for i, name in enumerate(names)}
     values = motion.values[::step]
-    shown_plants = _plant_rows(motion, label, step, plants, legs)
+    shown_plants = _plant_rows(motion, label, step, contacts, legs)
     return {
         "name": label,
         "frameRate": motion.frame_rate,
@@ -170,17 +171,18 @@ def page(
     takes: Sequence[Motion],
     *,
     names: Sequence[str] | None = None,
-    plants: Sequence[Mapping[str, np.ndarray] | Contacts | None] | None = None,
+    contacts: Sequence[Footplants | None] | None = None,
     legs: Joints = None,
     max_frames: int = DEFAULT_MAX_FRAMES,
     title: str | None = None,
+    plants: Sequence[Footplants | None] | None = None,
 ) -> str:
     """The HTML text of a viewer page for one or more takes.
 
     The first take is the one played and edited; the others are compared
     with it (ghosted skeletons and dashed curves at the same time from each
     take's start).  ``names`` label the takes (default "take 1", ...).
-    ``plants`` gives, per take, optional footplants, marked on the feet (a
+    ``contacts`` gives, per take, optional footplants, marked on the feet (a
     ring on the floor and a dot on the point, while planted) and on the
     timeline under the curves (a row each): a :class:`~motiontheater.feet.contacts.Contacts`
     table of that take (its heels and balls; its feet are those of the legs
@@ -188,14 +190,15 @@ def page(
     right leg), or a mapping point name (one of ``skeleton.point_names``) ->
     bool array with one flag per frame, True where the point is planted.  A
     take of more than ``max_frames`` frames is shown decimated to at most that
-    many, and editing is then off.
+    many, and editing is then off.  ``plants`` is the old name of ``contacts`` (deprecated).
     """
+    contacts = _renamed(contacts, plants)
     if not takes:
         raise ValueError("give at least one take to view")
     if isinstance(max_frames, bool) or not isinstance(max_frames, int) or max_frames < 2:
         raise ValueError(f"max_frames must be an integer of at least 2, got {max_frames!r}")
     labels = list(names) if names is not None else [f"take {i + 1}" for i in range(len(takes))]
-    plant_list = list(plants) if plants is not None else [None] * len(takes)
+    plant_list = list(contacts) if contacts is not None else [None] * len(takes)
     if len(labels) != len(takes) or len(plant_list) != len(takes):
         raise ValueError(f"give one name and one footplant mapping per take ({len(takes)})")
     for motion, label in zip(takes, labels):
@@ -237,8 +240,22 @@ def _escape(text: str) -> str:
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
 
 
+def _renamed(
+    contacts: Sequence[Footplants | None] | None, plants: Sequence[Footplants | None] | None
+) -> Sequence[Footplants | None] | None:
+    """``contacts``, or ``plants`` (its old name) with a DeprecationWarning at the caller of page or write_page."""
+    if plants is None:
+        return contacts
+    warnings.warn("plants= is deprecated: give the footplants as contacts=", DeprecationWarning, stacklevel=3)
+    if contacts is not None:
+        raise ValueError("give the footplants once, as contacts= (plants= is its old name)")
+    return plants
+
+
 def write_page(takes: Sequence[Motion], target: Source, **options) -> None:
     """Write :func:`page` (same options) to a path (atomically) or a binary file object."""
+    if "plants" in options:
+        options["contacts"] = _renamed(options.pop("contacts", None), options.pop("plants"))
     text = page(takes, **options)
     with output(target) as f:
         f.write(text.encode("utf-8"))

@@ -1,0 +1,50 @@
+"""The ``combine`` verb: motion tracks laid over a base motion, as a TOML scene says."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..editing.scene import RECIPE_HELP as SCENE_HELP
+from ..editing.scene import read_recipe
+from ..formats.table import write_take
+from .verb import Verb, prose
+
+
+def _arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("recipe", help="the TOML recipe")
+    parser.add_argument("-o", "--output", help="the take to write (.amc or .bvh, as the motions)")
+    parser.add_argument("--dry-run", action="store_true", help="print the frame maps and borders, write nothing")
+
+
+def _combine(args: argparse.Namespace) -> int:
+    scene = read_recipe(args.recipe)
+    if args.dry_run:
+        for track, plan in scene.plans():
+            print(f"{track.name}:")
+            print("  " + plan.describe().replace("\n", "\n  "))
+        return 0
+    if not args.output:
+        raise ValueError("give -o OUT.amc (or --dry-run)")
+    result = scene.render()
+    write_take(result, args.output)
+    print(
+        f"{len(scene.tracks)} track(s) over {scene.base.frames} frames: wrote {result.frames} frames "
+        f"({result.first_frame}..{result.last_frame}) to {args.output}"
+    )
+    return 0
+
+
+COMBINE = Verb(
+    "combine",
+    "lay motion tracks over a base motion, as a TOML recipe says, and write the result",
+    _arguments,
+    _combine,
+    description=prose(
+        "Combine motions as the MotionTheater thesis's MotionCombiner does: each track of the "
+        "recipe is cut, time-scaled, blended or root-preserved and applied to chosen joints over "
+        "the scene so far. --dry-run prints every track's frame map and borders instead."
+    )
+    + SCENE_HELP,
+    epilog="Example: motiontheater combine scene.toml --dry-run; motiontheater combine scene.toml -o out.amc",
+    laid_out=True,
+)

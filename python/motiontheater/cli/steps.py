@@ -1,0 +1,235 @@
+"""The verbs made from registered steps: one per step, ``steps`` that lists them, ``filter``
+(one smoothing step by a flag) and ``apply`` (a recipe of steps).  Their filter flags and
+recipe help serve ``batch`` too."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from functools import partial
+from typing import Any
+
+from ..editing.filtering import FILTERS
+from ..editing.pipeline import Pipeline
+from ..formats.table import companion_path, take_suffix, write_skeleton, write_take
+from ..model.motion import Motion
+from ..model.registry import Option, Step, lookup, steps
+from .info import unit_notes
+from .takes import add_output_options, add_take_options, output, settle_input, take_of
+from .verb import Verb, prose
+
+RECIPE_HELP = """\
+A recipe is a TOML file of [[step]] tables, applied in order; each names a step
+with run = "..." and gives its options (motiontheater steps lists them);
+frames = [A, B] confines a step to frames A..B:
+
+  [[step]]
+  run = "median"
+  size = 5
+
+  [[step]]
+  run = "slerp"
+  frames = [100, 150]
+  joints = ["lfemur", "rfemur"]
+"""
+
+
+def step_verbs() -> list[Verb]:
+    """The verb of each registered step: ``motiontheater NAME TAKE -o OUT --option ...``."""
+    return [_step_verb(step) for step in steps().values()]
+
+
+def _step_verb(step: Step) -> Verb:
+    required = " ".join(f"{o.flag} {o.metavar or o.name.upper()}" for o in step.all_options if o.required)
+    example = f"Example: motiontheater {step.name} 01_01.amc {required + ' ' if required else ''}-o out"
+    example += step.suffixes[0] if step.is_exporter else ".amc"
+    return Verb(
+        step.name,
+        step.summary,
+        partial(_step_arguments, step),
+        _run_step,
+        description=prose(f"{step.summary[:1].upper()}{step.summary[1:]}.", *step.description.split("\n\n")),
+        epilog=example,
+        aliases=step.aliases,
+        laid_out=True,
+    )
+
+
+def _step_arguments(step: Step, parser: argparse.ArgumentParser) -> None:
+    what = "the file to write (" + (", ".join(step.suffixes) if step.is_exporter else ".amc or .bvh") + ")"
+    parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    add_output_options(parser, what)
+    add_take_options(parser)
+    if step.dry_run is not None:
+        parser.add_argument("--dry-run", action="store_true", help="print what the step would do; write nothing")
+    for option in step.all_options:
+        shown = option.required or option.default is None  # the help says what None means
+        help_text = option.help + ("" if shown else f" (default: {_shown(option.default)})")
+        if option.kind == "bool":
+            parser.add_argument(option.flag, dest=option.name, action=argparse.BooleanOptionalAction, help=help_text)
+        elif option.kind == "choice":
+            parser.add_argument(
+                option.flag, dest=option.name, type=option.parse, choices=option.choices, help=help_text
+            )
+        else:
+            parser.add_argument(
+                option.flag,
+                dest=option.name,
+                type=option.parse,
+                metavar=option.metavar,
+                required=option.required,
+                help=help_text,
+            )
+    parser.set_defaults(step=step.name)
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    return str(value)
+
+
+def _run_step(args: argparse.Namespace) -> int:
+    step = lookup(args.step)
+    options = {o.name: getattr(args, o.name) for o in step.all_options if getattr(args, o.name) is not None}
+    source = settle_input(args)
+    if getattr(args, "dry_run", False):
+        print(step.describe(take_of(args, source), **options))
+        return 0
+    target = output(args, source)
+    if not step.is_exporter:
+        take_suffix(target)
+    motion = take_of(args, source)
+    if step.is_exporter:
+        step(motion, target, **options)
+        print(f"{step.name}: wrote {motion.frames} frames of {source} to {target}")
+        for note in unit_notes(motion, motion, target):
+            print(note, file=sys.stderr)
+        return 0
+    result = step(motion, **options)
+    written = _write_result(motion, result, target)
+    print(f"{step.name}: {motion.frames} frames of {source} -> {result.frames} frames in {written}")
+    return 0
+
+
+def _write_result(motion: Motion, result: Motion, target: str) -> str:
+    """Write a step's result as its suffix says; an AMC of a new skeleton gets its ASF beside it.
+    Returns what was written, in words."""
+    write_take(result, target)
+    for note in unit_notes(motion, result, target):
+        print(note, file=sys.stderr)
+    skeleton = companion_path(result, target)
+    if skeleton is not None and result.skeleton is not motion.skeleton:
+        write_skeleton(result.skeleton, skeleton)
+        return f"{target} and its skeleton {skeleton}"
+    return target
+
+
+def _list_steps(args: argparse.Namespace) -> int:
+    for name, step in steps().items():
+        kind = f"exporter ({', '.join(step.suffixes)})" if step.is_exporter else "step"
+        print(f"{name}: {step.summary} [{kind}]")
+        for option in step.all_options:
+            default = "required" if option.required else f"default {option.default!r}"
+            choices = f" ({', '.join(map(str, option.choices))})" if option.choices else ""
+            print(f"    {option.name}: {option.help}{choices}; {default}")
+    return 0
+
+
+LISTING = Verb("steps", "list every step and exporter with its options", lambda parser: None, _list_steps)
+
+
+def add_filter_options(parser: argparse.ArgumentParser) -> None:
+    """The filter flags shared by filter and batch."""
+    for kind in FILTERS:
+        parser.add_argument(f"--{kind}", type=int, metavar="N", help=f"{lookup(kind).summary} over N frames")
+    names = Option("joints", "names", None, "")
+    parser.add_argument(
+        "--joints", type=names.parse, metavar="A,B,...", help="comma-separated joints to smooth (default: all)"
+    )
+    parser.add_argument("--no-translation", action="store_true", help="leave the root's translation alone")
+    parser.add_argument(
+        "--mode",
+        default="nearest",
+        choices=("nearest", "reflect", "mirror", "constant", "wrap"),
+        help="how the edges are extended (default: nearest, the edge value held)",
+    )
+
+
+def filter_pipeline(args: argparse.Namespace) -> Pipeline:
+    """The one filter the flags of :func:`add_filter_options` name, as a pipeline."""
+    chosen = [(kind, getattr(args, kind)) for kind in FILTERS if getattr(args, kind) is not None]
+    if len(chosen) != 1:
+        raise ValueError("give exactly one of --median N, --mean N, --binomial N")
+    kind, size = chosen[0]
+    return Pipeline.of(kind, size=size, joints=args.joints, translation=not args.no_translation, mode=args.mode)
+
+
+def _filter_arguments(parser: argparse.ArgumentParser) -> None:
+    add_filter_options(parser)
+    parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    add_output_options(parser, "the file to write (the input's format)")
+    add_take_options(parser)
+
+
+def _filter(args: argparse.Namespace) -> int:
+    pipeline = filter_pipeline(args)
+    source = settle_input(args)
+    target = output(args, source)
+    take_suffix(target)
+    motion = take_of(args, source)
+    written = _write_result(motion, pipeline.apply(motion), target)
+    entry = pipeline.entries[0]
+    which = ", ".join(args.joints) if args.joints else "all joints"
+    print(f"{entry.name} {dict(entry.options)['size']} over {motion.frames} frames of {which}: wrote {written}")
+    return 0
+
+
+FILTER = Verb(
+    "filter",
+    "smooth a motion with a median, mean or binomial filter and write it",
+    _filter_arguments,
+    _filter,
+    description=(
+        "Smooth every channel (or the channels of the --joints given) over frames. Rotation "
+        "channels are unwrapped first, so crossings of ±180 degrees stay small steps. Edges "
+        "hold their value unless --mode says otherwise. Nothing is written when anything fails."
+    ),
+    epilog="Example: motiontheater filter --median 5 --joints lhumerus,rhumerus 01_01.amc -o smooth.amc",
+)
+
+
+def _apply_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+    add_output_options(parser, "the file to write")
+    parser.add_argument("--recipe", required=True, metavar="FILE", help="the TOML recipe of steps")
+    add_take_options(parser)
+
+
+def _apply(args: argparse.Namespace) -> int:
+    pipeline = Pipeline.read(args.recipe)
+    source = settle_input(args)
+    target = output(args, source)
+    if pipeline.exporter is None:
+        take_suffix(target)
+    motion = take_of(args, source)
+    result = pipeline.apply(motion)
+    if pipeline.exporter is not None:
+        pipeline.write(result, target)
+        written = target
+    else:
+        written = _write_result(motion, result, target)
+    names = ", ".join(entry.name for entry in pipeline.entries) or "no steps"
+    print(f"{args.recipe} ({names}) on {motion.frames} frames of {source}: wrote {written}")
+    return 0
+
+
+APPLY = Verb(
+    "apply",
+    "apply a recipe of steps (a TOML file) to a take",
+    _apply_arguments,
+    _apply,
+    description=prose("Apply the steps of a recipe, in order, to a take and write the result.") + RECIPE_HELP,
+    epilog="Example: motiontheater apply 01_01.amc --recipe steps.toml -o cleaned.amc",
+    laid_out=True,
+)
