@@ -23,6 +23,7 @@ import motiontheater as mt
 import mtcore
 from conftest import DATA, NOTES, repeated_take
 from mtcore._mtcore import ffi, lib
+from mtcore.text import number_code, number_codes
 
 FRAMES = 125_000
 FAST = dict(rounds=5, iterations=1, warmup_rounds=1)
@@ -31,7 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 WRITE = "write mean-5 filtered 100 MB AMC (Motion -> file)"
 RAW = "write the raw 100 MB AMC (Motion -> file)"
 SCAN = "scan {} 100 MB AMC frame text, 1 thread"
-CODE = "mt_format_frames of {} 100 MB AMC (in memory): widest vector code vs AVX2 and portable code"
+CODE = "mt_format_frames of {} 100 MB AMC (in memory): the best code vs each code by name"
 
 
 @pytest.fixture(scope="module")
@@ -189,9 +190,9 @@ def test_scan(benchmark, record, raw, texts, old, name, who):
 
 def format_in_memory(values: np.ndarray, keys, offsets, counts, code: int) -> int:
     """mt_format_frames over values in the chunks of mtcore.text.format_frames, into one reused
-    buffer (no file), with the style's `code` as given (see mtcore.h)."""
+    buffer (no file), the shortest texts by `code` (enum mt_number_code, see mtcore.h)."""
     *table, _ = key_table(ffi, keys, offsets, counts)
-    style = ffi.new("struct mt_format_style *", [0, 2, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_LF, code])
+    style = ffi.new("struct mt_format_style *", [0, 2, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_LF])
     chunk, (frames, channels) = 256, values.shape
     buf = ffi.new("char[]", lib.mt_format_bound(chunk, table[1], table[3], table[4], style))
     written, total = ffi.new("size_t *"), 0
@@ -199,27 +200,29 @@ def format_in_memory(values: np.ndarray, keys, offsets, counts, code: int) -> in
     for f0 in range(0, frames, chunk):
         n = min(chunk, frames - f0)
         status = lib.mt_format_frames(
-            c_values + f0 * channels, n, channels, f0 + 1, *table, style, buf, len(buf), written
+            c_values + f0 * channels, n, channels, f0 + 1, *table, style, code, buf, len(buf), written
         )
         assert status == lib.MT_OK
         total += written[0]
     return total
 
 
-# the style's `code` (enum mt_code) of each code, and its name in the table
-CODES = {"vector": (lib.MT_CODE_WIDEST, "mtcore"), "avx2": (lib.MT_CODE_AVX2, "AVX2 code"),
-         "portable": (lib.MT_CODE_PORTABLE, "portable code")}  # fmt: skip
+# each code (enum mt_number_code) and its name in the table
+CODES = {"best": (lib.MT_NUMBER_CODE_BEST, "mtcore"), "avx512": (lib.MT_NUMBER_CODE_AVX512, "AVX-512 code"),
+         "avx2": (lib.MT_NUMBER_CODE_AVX2, "AVX2 code"), "portable": (lib.MT_NUMBER_CODE_PORTABLE, "portable code")}  # fmt: skip
 
 
 @pytest.mark.parametrize("code", list(CODES))
 @pytest.mark.parametrize("name", ["raw", "smoothed"])
 def test_format_code(benchmark, record, raw, smoothed, name, code):
-    """The formatter alone, its widest vector code (x86-64: AVX-512, else AVX2), its AVX2 code and its
-    portable code, on the same values; where the processor lacks a vector code, the portable code runs
-    in its place."""
+    """The formatter alone, the code it takes here (number_code()) against each code by
+    name, on the same values; a code this processor does not run is skipped."""
     values = raw.values if name == "raw" else smoothed.values
-    style_code, who = CODES[code]
-    size = benchmark.pedantic(format_in_memory, (values, *layout(raw), style_code), **FAST)
+    c_code, who = CODES[code]
+    if not lib.mt_number_code_runs(c_code):
+        pytest.skip(f"this processor does not run the {who} (it runs {', '.join(number_codes())})")
+    size = benchmark.pedantic(format_in_memory, (values, *layout(raw), c_code), **FAST)
     case = CODE.format("the raw" if name == "raw" else "a mean-5 filtered")
     record(case, who, size, unit="MB")
-    NOTES.append(f"{case}: {who} {benchmark.stats.stats.min / values.size * 1e9:.1f} ns a value (fastest round)")
+    named = f"{who} ({number_code()})" if code == "best" else who
+    NOTES.append(f"{case}: {named} {benchmark.stats.stats.min / values.size * 1e9:.1f} ns a value (fastest round)")

@@ -204,15 +204,8 @@ struct mt_text_style {
 /* The style of text[0 .. len-1]; MT_EIO where it is a mapping whose file has shrunk. */
 int mt_text_style(const char *text, size_t len, struct mt_text_style *style);
 
-/* Which code writes numbers (struct mt_format_style's `code`). */
-enum mt_code {
-    MT_CODE_WIDEST = 0,
-    MT_CODE_PORTABLE = 1,
-    MT_CODE_AVX2 = 2
-};
-
 /*
- * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF, 0}.
+ * How numbers and lines are written; a NULL style is {0, 2, MT_NEWLINE_LF, MT_NEWLINE_LF}.
  *
  *   digits           0: the shortest text that reads back as exactly the value, of
  *                    those the nearest to it (the digits of Python's repr); exponent
@@ -226,22 +219,36 @@ enum mt_code {
  *   newline          the line ending of mt_format_frames and mt_format_table.
  *   frame_newline    the ending of the lines that hold only a frame number
  *                    (mt_format_frames): HDM05 ends those in LF, every other in CRLF.
- *   code             which code writes the shortest texts (digits 0), enum mt_code:
- *                    MT_CODE_WIDEST (0) the widest vector code the processor runs (x86-64:
- *                    AVX-512, else AVX2 with BMI1, BMI2, FMA and LZCNT, else none);
- *                    MT_CODE_PORTABLE (1) the portable code only; MT_CODE_AVX2 (2) vector
- *                    code no wider than AVX2 (the portable code where the processor has
- *                    no AVX2).  The text is the same; this is for the tests and benchmarks
- *                    that compare the codes on one processor.  Other values are refused as
- *                    the other fields' are (MT_EINVAL).
  */
 struct mt_format_style {
     int digits;
     int exponent_digits;
     int newline;
     int frame_newline;
-    int code;
 };
+
+/*
+ * The code that writes the shortest texts (style digits 0) of mt_format_frames and
+ * mt_format_table, their `code` argument: portable C, or code written by hand for the vector
+ * registers of x86-64 processors, AVX2 (the x86-64-v3 level: AVX2, BMI1, BMI2, FMA, LZCNT,
+ * MOVBE, F16C) or AVX-512 (x86-64-v4: v3 and AVX-512 F, BW, CD, DQ, VL).  Every code writes the
+ * same bytes; MT_NUMBER_CODE_BEST is the one mt_number_code() names, and the others are there
+ * for the tests and benchmarks that compare the codes on one processor.  A code the processor
+ * does not run is refused (MT_EINVAL).  Texts rounded to digits are the portable code's alone.
+ */
+enum mt_number_code {
+    MT_NUMBER_CODE_BEST = 0,
+    MT_NUMBER_CODE_PORTABLE = 1,
+    MT_NUMBER_CODE_AVX2 = 2,
+    MT_NUMBER_CODE_AVX512 = 3
+};
+
+/* The code that MT_NUMBER_CODE_BEST stands for on this processor: the widest it runs. */
+int mt_number_code(void);
+
+/* 1 if this processor runs `code` (MT_NUMBER_CODE_BEST and _PORTABLE: always), else 0 (also for a
+   value that is none of enum mt_number_code). */
+int mt_number_code_runs(int code);
 
 /* Bytes a number can take: -1.2345678901234567e-308. */
 enum { MT_NUMBER_MAX = 24 };
@@ -252,22 +259,23 @@ int mt_format_double(double value, const struct mt_format_style *style, char *bu
 /*
  * Writes frames first .. first+frames-1 of values (frames x channels) as
  * frame text, the keys in the order given, into buf of cap bytes; *written
- * receives the length.  MT_ERANGE if cap is below mt_format_bound();
- * MT_EFRAMERANGE if a frame number would be outside 0 .. MT_FRAME_MAX.
+ * receives the length; `code` (enum mt_number_code) writes the shortest texts.  MT_ERANGE if
+ * cap is below mt_format_bound(); MT_EFRAMERANGE if a frame number would be outside
+ * 0 .. MT_FRAME_MAX.
  */
 int mt_format_frames(const double *values, size_t frames, size_t channels, long long first_frame,
                      const char *const *keys, const size_t *key_lens, const size_t *offsets,
-                     const size_t *counts, size_t nkeys, const struct mt_format_style *style, char *buf,
-                     size_t cap, size_t *written);
+                     const size_t *counts, size_t nkeys, const struct mt_format_style *style, int code,
+                     char *buf, size_t cap, size_t *written);
 
 /* Bytes that mt_format_frames may need for `frames` frames of these keys (SIZE_MAX past size_t). */
 size_t mt_format_bound(size_t frames, const size_t *key_lens, const size_t *counts, size_t nkeys,
                        const struct mt_format_style *style);
 
-/* Writes values (rows x columns) as lines of numbers separated by a blank; MT_ERANGE if cap is
-   below mt_format_table_bound(). */
+/* Writes values (rows x columns) as lines of numbers separated by a blank, the shortest texts by
+   `code` (enum mt_number_code); MT_ERANGE if cap is below mt_format_table_bound(). */
 int mt_format_table(const double *values, size_t rows, size_t columns, const struct mt_format_style *style,
-                    char *buf, size_t cap, size_t *written);
+                    int code, char *buf, size_t cap, size_t *written);
 
 /* Bytes that mt_format_table may need (SIZE_MAX past size_t). */
 size_t mt_format_table_bound(size_t rows, size_t columns, const struct mt_format_style *style);

@@ -62,22 +62,20 @@ static inline int floor_shift(int64_t x, int s)
 /* Fixed-point logarithms, checked exact over the exponents used by gen_pow10.py. */
 static inline int floor_log10_pow2(int q)
 {
-    return floor_shift((int64_t)q * 661971961083, 41);
+    return floor_shift(q * LOG10_2, LOG10_2_SHIFT);
 }
 
 static inline int floor_log10_three_quarters_pow2(int q)
 {
-    return floor_shift((int64_t)q * 661971961083 - 274743187321, 41);
+    return floor_shift(q * LOG10_2 + LOG10_3_4, LOG10_2_SHIFT);
 }
 
 static inline int floor_log2_pow10(int p)
 {
-    return floor_shift((int64_t)p * 913124641741, 38);
+    return floor_shift(p * LOG2_10, LOG2_10_SHIFT);
 }
 
-#define MASK52 ((UINT64_C(1) << 52) - 1)
 #define MASK62 ((UINT64_C(1) << 62) - 1)
-#define MASK63 ((UINT64_C(1) << 63) - 1)
 #define EXP_BITS UINT64_C(0x7ff0000000000000)
 
 /* The significand c and exponent q of a finite a > 0: a = c * 2^q, c < 2^53. */
@@ -270,8 +268,8 @@ static uint64_t schubfach(double a, int *exp10)
  * The shortest decimal by Jeon's Dragonbox ("Dragonbox: A New Floating-Point Binary-to-Decimal
  * Conversion Algorithm", 2020), for an interval symmetric about a = c 2^q: one 64 x 128-bit
  * product with phi(-k) (gen_pow10.py) and divisions by constants settle nearly every value;
- * an integer test or a parity product settles the rest.  kappa = 2: the first try is at
- * 10^(kappa+1) = 1000 units of 10^k, the second at 10^kappa.  The narrow interval below a
+ * an integer test or a parity product settles the rest.  KAPPA (number.h): the first try is at
+ * 10^(kappa+1) units of 10^k, the second at 10^kappa.  The narrow interval below a
  * power of two goes to Schubfach, which handles it.
  */
 
@@ -340,20 +338,20 @@ uint64_t number_shortest(double a, int *exp10)
     if (c == (UINT64_C(1) << 52) && q > -1074)
         return schubfach(a, exp10);
     const int even = (c & 1) == 0; /* the interval's ends read back as a (ties to even) */
-    const int minus_k = floor_log10_pow2(q) - 2;
+    const int minus_k = floor_log10_pow2(q) - KAPPA;
     const int beta_minus_1 = q + floor_log2_pow10(-minus_k); /* 6 .. 9 */
     const uint64_t *phi = pow10_phi[-minus_k - CACHE_MIN];
-    const uint32_t delta = (uint32_t)(phi[0] >> (63 - beta_minus_1)); /* 100 <= delta < 1000 */
+    const uint32_t delta = (uint32_t)(phi[0] >> (63 - beta_minus_1)); /* KAPPA_SMALL <= delta < KAPPA_BIG */
     const uint64_t two_fc = c << 1, two_fr = two_fc + 1, two_fl = two_fc - 1;
     const uint64_t z = times_phi(two_fr << beta_minus_1, phi);
     /* The larger divisor: a decimal of 10^(k+3) steps in the interval is the shortest there is;
        it is when the remainder is below delta.  At the interval's ends (r 0 or delta, one value
        in a thousand) an exact test tells.  Both answers are worked out and one is taken without
        a branch: which one applies is as good as random. */
-    uint64_t d = z / 1000;
-    uint32_t r = (uint32_t)(z - 1000 * d);
+    uint64_t d = z / KAPPA_BIG;
+    uint32_t r = (uint32_t)(z - KAPPA_BIG * d);
     int larger = r < delta;
-    *exp10 = minus_k + 2; /* the larger divisor's decimal is returned times 10 */
+    *exp10 = minus_k + KAPPA; /* the larger divisor's decimal is returned times 10 */
     if (r == 0 || r == delta) {
         larger = r == 0 ? even || !integral_endpoint(two_fr, q, minus_k)
                         : (even && integral_endpoint(two_fl, q, minus_k)) || parity_phi(two_fl, phi, beta_minus_1);
@@ -361,15 +359,15 @@ uint64_t number_shortest(double a, int *exp10)
             return d * 10;
         if (r == 0) { /* the right end is excluded and is exactly this decimal */
             d--;
-            r = 1000;
+            r = KAPPA_BIG;
         }
     }
     /* The smaller divisor: of the decimals of 10^(k+2) steps, the one nearest a (r > delta here;
        below, what is computed is not used). */
-    const uint32_t dist = r - delta / 2 + 50;
-    const uint32_t dist_q = dist / 100;
+    const uint32_t dist = r - delta / 2 + KAPPA_SMALL / 2;
+    const uint32_t dist_q = dist / KAPPA_SMALL;
     uint64_t nearest = d * 10 + dist_q;
-    if ((dist == dist_q * 100) & !larger) { /* a tie or a step past the nearest: the parity tells */
+    if ((dist == dist_q * KAPPA_SMALL) & !larger) { /* a tie or a step past the nearest: the parity tells */
         if (parity_phi(two_fc, phi, beta_minus_1) != (int)(dist & 1))
             nearest--;
         else if ((nearest & 1) && integral_midpoint(two_fc, q, minus_k))
@@ -377,167 +375,6 @@ uint64_t number_shortest(double a, int *exp10)
     }
     return larger ? d * 10 : nearest;
 }
-
-#if MT_AVX512
-#include <immintrin.h>
-
-int number_have_avx512(void)
-{
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-           __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512dq") &&
-           __builtin_cpu_supports("avx512vl");
-}
-
-/* The high 64 bits of each lane's 128-bit a * b, and the low 64 to *lo (NULL: not wanted), from
-   the four 32 x 32-bit products (AVX-512 multiplies no wider). */
-MT_AVX512_CODE static inline __m512i mul_high(__m512i a, __m512i b, __m512i *lo)
-{
-    const __m512i low32 = _mm512_set1_epi64(0xffffffff);
-    const __m512i a_hi = _mm512_srli_epi64(a, 32), b_hi = _mm512_srli_epi64(b, 32);
-    const __m512i ll = _mm512_mul_epu32(a, b), lh = _mm512_mul_epu32(a, b_hi);
-    const __m512i hl = _mm512_mul_epu32(a_hi, b), hh = _mm512_mul_epu32(a_hi, b_hi);
-    const __m512i mid = _mm512_add_epi64(_mm512_add_epi64(_mm512_srli_epi64(ll, 32), _mm512_and_si512(lh, low32)),
-                                         _mm512_and_si512(hl, low32));
-    if (lo != NULL)
-        *lo = _mm512_or_si512(_mm512_slli_epi64(mid, 32), _mm512_and_si512(ll, low32));
-    return _mm512_add_epi64(_mm512_add_epi64(hh, _mm512_srli_epi64(lh, 32)),
-                            _mm512_add_epi64(_mm512_srli_epi64(hl, 32), _mm512_srli_epi64(mid, 32)));
-}
-
-/* floor(x k / 2^s) of each lane, for the fixed-point logarithms (x k within 64 bits, signed) */
-MT_AVX512_CODE static inline __m512i times_shift(__m512i x, int64_t k, int s)
-{
-    return _mm512_srai_epi64(_mm512_mullo_epi64(x, _mm512_set1_epi64(k)), (unsigned)s);
-}
-
-/* number_shortest's Dragonbox, lane by lane, for normal values other than powers of two. */
-MT_AVX512_CODE unsigned number_shortest8(const double *a, uint64_t *d, int64_t *exp10)
-{
-    const __m512i bits = _mm512_and_si512(_mm512_loadu_si512(a), _mm512_set1_epi64((int64_t)MASK63));
-    const __m512i biased = _mm512_srli_epi64(bits, 52), fraction = _mm512_and_si512(bits, _mm512_set1_epi64(MASK52));
-    __mmask8 done = _mm512_cmpneq_epi64_mask(biased, _mm512_setzero_si512()) &
-                    _mm512_cmpneq_epi64_mask(biased, _mm512_set1_epi64(0x7ff)) &
-                    _mm512_cmpneq_epi64_mask(fraction, _mm512_setzero_si512());
-    const __m512i c = _mm512_or_si512(fraction, _mm512_set1_epi64(INT64_C(1) << 52));
-    const __m512i q = _mm512_sub_epi64(biased, _mm512_set1_epi64(1075));
-    const __m512i minus_k = _mm512_sub_epi64(times_shift(q, 661971961083, 41), _mm512_set1_epi64(2));
-    const __m512i beta_minus_1 = _mm512_add_epi64(q, times_shift(_mm512_sub_epi64(_mm512_setzero_si512(), minus_k),
-                                                                 913124641741, 38)); /* 6 .. 9 */
-    /* phi(-minus_k): lanes outside the table (not done) read its first row */
-    __m512i row = _mm512_sub_epi64(_mm512_set1_epi64(-CACHE_MIN), minus_k);
-    row = _mm512_maskz_mov_epi64(done, _mm512_slli_epi64(row, 1));
-    const long long *table = (const long long *)&pow10_phi[0][0];
-    const __m512i phi0 = _mm512_i64gather_epi64(row, table, 8);
-    const __m512i phi1 = _mm512_i64gather_epi64(_mm512_add_epi64(row, _mm512_set1_epi64(1)), table, 8);
-    const __m512i delta = _mm512_srlv_epi64(phi0, _mm512_sub_epi64(_mm512_set1_epi64(63), beta_minus_1));
-    const __m512i x = _mm512_sllv_epi64(_mm512_add_epi64(_mm512_slli_epi64(c, 1), _mm512_set1_epi64(1)), beta_minus_1);
-    /* z = floor(x phi / 2^128) */
-    __m512i low0;
-    const __m512i high0 = mul_high(x, phi0, &low0), high1 = mul_high(x, phi1, NULL);
-    const __m512i middle = _mm512_add_epi64(low0, high1);
-    const __m512i z = _mm512_mask_add_epi64(high0, _mm512_cmplt_epu64_mask(middle, high1), high0,
-                                            _mm512_set1_epi64(1));
-    /* z / 1000 as compilers divide: (z / 8) 0x20c49ba5e353f7cf / 2^68 */
-    const __m512i quotient = _mm512_srli_epi64(
-        mul_high(_mm512_srli_epi64(z, 3), _mm512_set1_epi64(INT64_C(0x20c49ba5e353f7cf)), NULL), 4);
-    const __m512i r = _mm512_sub_epi64(z, _mm512_mullo_epi64(quotient, _mm512_set1_epi64(1000)));
-    const __mmask8 larger = _mm512_cmplt_epu64_mask(r, delta);
-    /* at the interval's ends number_shortest tests exactly */
-    done &= _mm512_cmpneq_epi64_mask(r, _mm512_setzero_si512()) & _mm512_cmpneq_epi64_mask(r, delta);
-    const __m512i dist = _mm512_add_epi64(_mm512_sub_epi64(r, _mm512_srli_epi64(delta, 1)), _mm512_set1_epi64(50));
-    const __m512i dist_q = _mm512_srli_epi64(_mm512_mullo_epi64(dist, _mm512_set1_epi64(5243)), 19); /* / 100 */
-    /* a tie or a step past the nearest: the parity tells, in number_shortest */
-    done &= ~(_mm512_cmpeq_epi64_mask(dist, _mm512_mullo_epi64(dist_q, _mm512_set1_epi64(100))) & ~larger);
-    const __m512i tens = _mm512_mullo_epi64(quotient, _mm512_set1_epi64(10));
-    _mm512_storeu_si512(d, _mm512_mask_add_epi64(tens, (__mmask8)~larger, tens, dist_q));
-    _mm512_storeu_si512(exp10, _mm512_add_epi64(minus_k, _mm512_set1_epi64(2)));
-    return done;
-}
-#endif
-
-#if MT_AVX2
-#include <immintrin.h>
-
-int number_have_avx2(void)
-{
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") &&
-           __builtin_cpu_supports("fma") && __builtin_cpu_supports("lzcnt");
-}
-
-#define K4(x) _mm256_set1_epi64x((int64_t)(x)) /* x in every lane */
-
-/* mul_high in AVX2 lanes: the high 64 bits of each lane's a * b, the low 64 to *lo (NULL: not wanted). */
-MT_AVX2_CODE static inline __m256i mul_high4(__m256i a, __m256i b, __m256i *lo)
-{
-    const __m256i low32 = K4(0xffffffff);
-    const __m256i a_hi = _mm256_srli_epi64(a, 32), b_hi = _mm256_srli_epi64(b, 32);
-    const __m256i ll = _mm256_mul_epu32(a, b), lh = _mm256_mul_epu32(a, b_hi);
-    const __m256i hl = _mm256_mul_epu32(a_hi, b), hh = _mm256_mul_epu32(a_hi, b_hi);
-    const __m256i mid = _mm256_add_epi64(_mm256_add_epi64(_mm256_srli_epi64(ll, 32), _mm256_and_si256(lh, low32)),
-                                         _mm256_and_si256(hl, low32));
-    if (lo != NULL)
-        *lo = _mm256_or_si256(_mm256_slli_epi64(mid, 32), _mm256_and_si256(ll, low32));
-    return _mm256_add_epi64(_mm256_add_epi64(hh, _mm256_srli_epi64(lh, 32)),
-                            _mm256_add_epi64(_mm256_srli_epi64(hl, 32), _mm256_srli_epi64(mid, 32)));
-}
-
-/* floor(x k / 2^s) of each lane, where x k fits in 32 bits, signed: floor_log10_pow2 and
-   floor_log2_pow10 with Jeon's smaller constants (checked equal over the exponents of doubles).
-   The product of the low halves is exact in 64 bits; its high half, all sign, stays so shifted. */
-MT_AVX2_CODE static inline __m256i times_shift4(__m256i x, int32_t k, int s)
-{
-    return _mm256_srai_epi32(_mm256_mul_epi32(x, _mm256_set1_epi32(k)), s);
-}
-
-/*
- * number_shortest8's Dragonbox in four lanes.  AVX2 has neither 64-bit products (from 32-bit
- * ones, as there), unsigned 64-bit comparisons (signed ones with the sign bit flipped), nor masks
- * (lanes of all ones), nor 64-bit arithmetic shifts (the logarithms' products fit in 32 bits).
- */
-MT_AVX2_CODE unsigned number_shortest4(const double *a, uint64_t *d, int64_t *exp10)
-{
-    const __m256i zero = _mm256_setzero_si256();
-    const __m256i bits = _mm256_and_si256(_mm256_loadu_si256((const __m256i *)a), K4(MASK63));
-    const __m256i biased = _mm256_srli_epi64(bits, 52), fraction = _mm256_and_si256(bits, K4(MASK52));
-    __m256i skip = _mm256_or_si256(_mm256_cmpeq_epi64(biased, zero), _mm256_cmpeq_epi64(biased, K4(0x7ff)));
-    skip = _mm256_or_si256(skip, _mm256_cmpeq_epi64(fraction, zero));
-    const __m256i c = _mm256_or_si256(fraction, K4(UINT64_C(1) << 52));
-    const __m256i q = _mm256_sub_epi64(biased, K4(1075));
-    const __m256i minus_k = _mm256_sub_epi64(times_shift4(q, 315653, 20), K4(2));
-    const __m256i beta_minus_1 = _mm256_add_epi64(q, times_shift4(_mm256_sub_epi64(zero, minus_k), 1741647, 19));
-    /* phi(-minus_k): lanes outside the table (skipped) read its first row */
-    const __m256i row = _mm256_andnot_si256(skip, _mm256_slli_epi64(_mm256_sub_epi64(K4(-CACHE_MIN), minus_k), 1));
-    const long long *table = (const long long *)&pow10_phi[0][0];
-    const __m256i phi0 = _mm256_i64gather_epi64(table, row, 8);
-    const __m256i phi1 = _mm256_i64gather_epi64(table + 1, row, 8);
-    const __m256i delta = _mm256_srlv_epi64(phi0, _mm256_sub_epi64(K4(63), beta_minus_1));
-    const __m256i x = _mm256_sllv_epi64(_mm256_add_epi64(_mm256_slli_epi64(c, 1), K4(1)), beta_minus_1);
-    /* z = floor(x phi / 2^128); middle < high1 (unsigned) is the carry */
-    __m256i low0;
-    const __m256i high0 = mul_high4(x, phi0, &low0), high1 = mul_high4(x, phi1, NULL);
-    const __m256i middle = _mm256_add_epi64(low0, high1), sign = K4(UINT64_C(1) << 63);
-    const __m256i carry = _mm256_cmpgt_epi64(_mm256_xor_si256(high1, sign), _mm256_xor_si256(middle, sign));
-    const __m256i z = _mm256_sub_epi64(high0, carry);
-    /* z / 1000 as compilers divide; the remainder (< 1000) from the low 32 bits alone */
-    const __m256i quotient = _mm256_srli_epi64(mul_high4(_mm256_srli_epi64(z, 3), K4(0x20c49ba5e353f7cf), NULL), 4);
-    const __m256i r = _mm256_and_si256(_mm256_sub_epi64(z, _mm256_mul_epu32(quotient, K4(1000))), K4(0xffffffff));
-    const __m256i larger = _mm256_cmpgt_epi64(delta, r);
-    /* at the interval's ends number_shortest tests exactly */
-    skip = _mm256_or_si256(skip, _mm256_or_si256(_mm256_cmpeq_epi64(r, zero), _mm256_cmpeq_epi64(r, delta)));
-    const __m256i dist = _mm256_add_epi64(_mm256_sub_epi64(r, _mm256_srli_epi64(delta, 1)), K4(50));
-    const __m256i dist_q = _mm256_srli_epi64(_mm256_mul_epu32(dist, K4(5243)), 19); /* / 100 (unused where larger) */
-    /* a tie or a step past the nearest: the parity tells, in number_shortest */
-    const __m256i step = _mm256_cmpeq_epi64(dist, _mm256_mul_epu32(dist_q, K4(100)));
-    skip = _mm256_or_si256(skip, _mm256_andnot_si256(larger, step));
-    const __m256i tens = _mm256_add_epi64(_mm256_slli_epi64(quotient, 3), _mm256_slli_epi64(quotient, 1));
-    _mm256_storeu_si256((__m256i *)d, _mm256_add_epi64(tens, _mm256_andnot_si256(larger, dist_q)));
-    _mm256_storeu_si256((__m256i *)exp10, _mm256_add_epi64(minus_k, K4(2)));
-    return ~(unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(skip)) & 15u;
-}
-#undef K4
-#endif
 
 uint64_t number_rounded(double a, int digits, int *exp10)
 {

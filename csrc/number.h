@@ -12,7 +12,7 @@
  * Python's float() gives.  No hexadecimal, no '_', no "nan(...)", no blanks inside.
  *
  * Shared by the scanner (scan.c, which inlines the fast path below) and the formatter
- * (format.c).  number.c holds the rest.
+ * (format.c).  number.c holds the rest; number_x86.c number_shortest in vector lanes.
  */
 #ifndef MT_NUMBER_H
 #define MT_NUMBER_H
@@ -77,29 +77,12 @@ uint64_t number_shortest(double a, int *exp10);
  */
 uint64_t number_rounded(double a, int digits, int *exp10);
 
-#if defined(__x86_64__) && defined(__GNUC__)
-/* Code for x86-64 processors with AVX-512 (F, BW, CD, DQ, VL: the x86-64-v4 level), and for those
-   with AVX2 (and BMI1, BMI2, FMA, LZCNT: the x86-64-v3 level), chosen at run time where the
-   processor has it; the portable code stays for every other. */
-#define MT_AVX512 1
-#define MT_AVX512_CODE __attribute__((target("avx512f,avx512bw,avx512cd,avx512dq,avx512vl")))
-#define MT_AVX2 1
-#define MT_AVX2_CODE __attribute__((target("avx2,bmi,bmi2,fma,lzcnt")))
+/* The bits of a double: its fraction; all but its sign. */
+#define MASK52 ((UINT64_C(1) << 52) - 1)
+#define MASK63 ((UINT64_C(1) << 63) - 1)
 
-/* Whether this processor runs MT_AVX512_CODE; MT_AVX2_CODE. */
-int number_have_avx512(void);
-int number_have_avx2(void);
-
-/*
- * number_shortest of |a[0]| .. |a[7]| at once, in the lanes of vectors: the decimals to d and
- * exp10 for the lanes of the mask returned.  The other lanes are left to number_shortest: zero,
- * subnormal, not finite, a power of two (its narrow interval), or one of the few whose interval
- * ends or middle fall on a step of the decimals (about one value in a hundred).
- */
-MT_AVX512_CODE unsigned number_shortest8(const double *a, uint64_t *d, int64_t *exp10);
-
-/* The same for |a[0]| .. |a[3]|, in the lanes of AVX2 vectors. */
-MT_AVX2_CODE unsigned number_shortest4(const double *a, uint64_t *d, int64_t *exp10);
-#endif
+/* Dragonbox's kappa (number_shortest and its vector lanes, number_x86.c): the shortest decimal is
+   sought among the multiples of 10^(kappa+1) units of 10^k, then of 10^kappa. */
+enum { KAPPA = 2, KAPPA_BIG = 1000, KAPPA_SMALL = 100 };
 
 #endif

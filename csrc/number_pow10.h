@@ -4,6 +4,17 @@
 
 #include <stdint.h>
 
+/* Fixed-point logarithms: floor(x log) = (x NAME) >> NAME_SHIFT, checked over the exponents used */
+#define LOG10_2 INT64_C(661971961083) /* log10(2) 2^41 */
+#define LOG10_2_SHIFT 41
+#define LOG10_3_4 INT64_C(-274743187321) /* log10(3/4) 2^41 */
+#define LOG2_10 INT64_C(913124641741) /* log2(10) 2^38 */
+#define LOG2_10_SHIFT 38
+#define LOG10_2_32 315653 /* log10(2) 2^20 */
+#define LOG10_2_32_SHIFT 20
+#define LOG2_10_32 1741647 /* log2(10) 2^19 */
+#define LOG2_10_32_SHIFT 19
+
 #define POW10_MIN (-342)
 #define POW10_MAX 340
 #define POW10_EXACT_MAX 54 /* g(p) - 1 == 10^p / 2^r for 0 <= p <= this */

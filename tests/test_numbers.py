@@ -7,6 +7,7 @@ Python's repr, '%.Ng' and float() are the slow twins: correctly rounded, locale-
 import functools
 import io
 import math
+import platform
 import re
 import struct
 import subprocess
@@ -27,6 +28,8 @@ from mtcore.text import (
     format_frames,
     format_number,
     format_table,
+    number_code,
+    number_codes,
     parse_number,
     scan_frames,
     scan_table,
@@ -200,17 +203,17 @@ def test_seventeen_digits_always_read_back(rng):
 
 
 def c_text(function: str, values: np.ndarray, code: int, exponent_digits: int = 2, **frames) -> bytes:
-    """mt_format_table or mt_format_frames (keys a, b, ... of `counts` columns) called directly, with
-    the style's `code` (enum mt_code) as given: the code the test wants, where the processor has it."""
+    """mt_format_table or mt_format_frames (keys a, b, ... of `counts` columns) called directly, the
+    shortest texts by `code` (enum mt_number_code), which the processor must run."""
     values = np.ascontiguousarray(values, dtype=np.float64)
     rows, columns = values.shape
-    style = ffi.new("struct mt_format_style *", [0, exponent_digits, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_CRLF, code])
+    style = ffi.new("struct mt_format_style *", [0, exponent_digits, lib.MT_NEWLINE_LF, lib.MT_NEWLINE_CRLF])
     written = ffi.new("size_t *")
     c_values = ffi.from_buffer("double[]", values)
     if function == "table":
         cap = lib.mt_format_table_bound(rows, columns, style)
         buf = ffi.new("char[]", cap)
-        assert lib.mt_format_table(c_values, rows, columns, style, buf, cap, written) == lib.MT_OK
+        assert lib.mt_format_table(c_values, rows, columns, style, code, buf, cap, written) == lib.MT_OK
     else:
         counts = frames["counts"]
         keys = [ffi.new("char[]", bytes([97 + k % 26]) * (1 + k // 26)) for k in range(len(counts))]
@@ -221,7 +224,7 @@ def c_text(function: str, values: np.ndarray, code: int, exponent_digits: int = 
         buf = ffi.new("char[]", cap)
         status = lib.mt_format_frames(
             c_values, rows, columns, 3, ffi.new("const char *[]", keys), key_lens, offsets, c_counts, len(keys),
-            style, buf, cap, written,
+            style, code, buf, cap, written,
         )  # fmt: skip
         assert status == lib.MT_OK
     return ffi.buffer(buf, written[0])[:]
@@ -242,9 +245,23 @@ def vector_cases(rng) -> list[np.ndarray]:
     return [patterns, magnitudes, short, smoothed, np.array(edges + decades + powers), subnormals.view(np.float64)]
 
 
-# The vector codes of the style's `code` (enum mt_code): the widest the processor runs (x86-64:
-# AVX-512, else AVX2), and no wider than AVX2; each the portable code where the processor lacks it.
-VECTOR_CODES = {"widest": lib.MT_CODE_WIDEST, "avx2": lib.MT_CODE_AVX2}
+# The vector codes (enum mt_number_code) and what a processor needs to run each.
+VECTOR_CODES = {
+    "avx2": (lib.MT_NUMBER_CODE_AVX2, "AVX2 (x86-64-v3: AVX2, BMI1, BMI2, FMA, LZCNT, MOVBE, F16C)"),
+    "avx512": (lib.MT_NUMBER_CODE_AVX512, "AVX-512 (x86-64-v4: AVX-512 F, BW, CD, DQ, VL)"),
+}
+
+
+def vector_code(name: str) -> int:
+    """The C code of a vector code, or a skip that says why this processor cannot run it: a run
+    that compared the portable code with itself would pass and prove nothing."""
+    code, needs = VECTOR_CODES[name]
+    if not lib.mt_number_code_runs(code):
+        machine = platform.machine()
+        if machine.lower() not in ("x86_64", "amd64"):
+            pytest.skip(f"the {name} code is for x86-64 processors; this one is {machine}")
+        pytest.skip(f"this processor has no {needs} (or this build no vector code, which takes GCC 12 or later)")
+    return code
 
 
 @pytest.mark.parametrize("code", list(VECTOR_CODES))
@@ -252,7 +269,7 @@ def test_vector_code_writes_what_the_portable_code_writes(rng, code):
     """Each vector code against its twin, the portable code, byte for byte: tables of one to 700
     columns (more than a group of slots holds), frames with their lines out of column order, every
     count of values left over from the lanes, every exponent width."""
-    vector, portable = VECTOR_CODES[code], lib.MT_CODE_PORTABLE
+    vector, portable = vector_code(code), lib.MT_NUMBER_CODE_PORTABLE
     for values in vector_cases(rng):
         for columns in (1, 3, 4, 5, 7, 8, 9, 62, 512, 513, 700):
             table = values[: len(values) // columns * columns].reshape(-1, columns)
@@ -283,9 +300,34 @@ def test_style_is_checked():
     buf, n = ffi.new("char[]", 64), ffi.new("size_t *")
     assert lib.mt_format_double(1.0, style, buf, n) == lib.MT_EINVAL
     assert lib.mt_format_table_bound(1, 1, style) == 2**64 - 1  # a bound no buffer meets
-    for bad_code in (-1, 3):  # the style's `code` is one of enum mt_code
-        style = ffi.new("struct mt_format_style *", [0, 2, 0, 0, bad_code])
-        assert lib.mt_format_double(1.0, style, buf, n) == lib.MT_EINVAL
+
+
+def test_the_codes_are_named_and_checked():
+    """number_code() names the code that "best" stands for, the widest that number_codes() lists;
+    a code that is not one, or that the processor does not run, is refused in Python and in C."""
+    codes = number_codes()
+    assert codes[0] == number_code() and codes[-1] == "portable"
+    assert lib.mt_number_code() == {name: code for name, (code, _) in VECTOR_CODES.items()}.get(
+        number_code(), lib.MT_NUMBER_CODE_PORTABLE
+    )
+    values = np.array([[1.5, -2.0, 1e-7, 0.1 + 0.2, 5e-324, 1e300, 123456.789, 0.0]])
+    texts = set()
+    for code in ("best", *codes):
+        out: list[bytes] = []
+        format_table(values, out.append, code=code)
+        format_frames(values, 1, [b"k"], [0], [8], out.append, code=code)
+        texts.add(b"".join(out))
+    assert len(texts) == 1
+    with pytest.raises(ValueError, match="code must be 'best' or one of"):
+        format_table(values, print, code="sse2")
+    for missing in {"avx512", "avx2"} - set(codes):
+        with pytest.raises(ValueError, match=f"code '{missing}' does not run on this processor, which runs"):
+            format_table(values, print, code=missing)
+    buf, n = ffi.new("char[]", 64), ffi.new("size_t *")
+    c_values = ffi.from_buffer("double[]", values)
+    for bad in (-1, 4, *(VECTOR_CODES[name][0] for name in VECTOR_CODES if name not in codes)):
+        assert not lib.mt_number_code_runs(bad)
+        assert lib.mt_format_table(c_values, 1, 1, ffi.NULL, bad, buf, 64, n) == lib.MT_EINVAL
 
 
 @pytest.mark.parametrize("newline", [b"\n", b"\r\n", b"\r"])
@@ -354,17 +396,20 @@ def test_bounds_hold_for_every_style(digits, exponent_digits, newline):
     first = FRAME_MAX - 2  # the longest frame numbers
     bound = lib.mt_format_bound(3, lens, counts, 2, style)
     buf = ffi.new("char[]", bound)
-    assert lib.mt_format_frames(c_values, 3, 5, first, c_keys, lens, offsets, counts, 2, style, buf, bound, n) == 0
+    best = lib.MT_NUMBER_CODE_BEST
+    assert (
+        lib.mt_format_frames(c_values, 3, 5, first, c_keys, lens, offsets, counts, 2, style, best, buf, bound, n) == 0
+    )
     assert n[0] == bound if digits in (0, 17) else n[0] < bound  # the longest numbers meet it
-    args = (c_values, 3, 5, first, c_keys, lens, offsets, counts, 2, style, buf, bound - 1, n)
+    args = (c_values, 3, 5, first, c_keys, lens, offsets, counts, 2, style, best, buf, bound - 1, n)
     assert lib.mt_format_frames(*args) == lib.MT_ERANGE
     bound = lib.mt_format_table_bound(3, 5, style)
     buf = ffi.new("char[]", bound)
-    assert lib.mt_format_table(c_values, 3, 5, style, buf, bound, n) == 0 and n[0] <= bound
-    assert lib.mt_format_table(c_values, 3, 5, style, buf, bound - 1, n) == lib.MT_ERANGE
+    assert lib.mt_format_table(c_values, 3, 5, style, best, buf, bound, n) == 0 and n[0] <= bound
+    assert lib.mt_format_table(c_values, 3, 5, style, best, buf, bound - 1, n) == lib.MT_ERANGE
     empty_lines = lib.mt_format_table_bound(3, 0, style)  # no columns: the newlines still take room
-    assert lib.mt_format_table(c_values, 3, 0, style, buf, empty_lines - 1, n) == lib.MT_ERANGE
-    assert lib.mt_format_table(c_values, 3, 0, style, buf, empty_lines, n) == 0 and n[0] == empty_lines
+    assert lib.mt_format_table(c_values, 3, 0, style, best, buf, empty_lines - 1, n) == lib.MT_ERANGE
+    assert lib.mt_format_table(c_values, 3, 0, style, best, buf, empty_lines, n) == 0 and n[0] == empty_lines
 
 
 def test_bounds_saturate():
@@ -588,8 +633,9 @@ def test_frame_numbers_past_the_range_are_refused():
     buf, n = ffi.new("char[]", 1000), ffi.new("size_t *")
     for first in (-1, 2**63 - 1, FRAME_MAX - 1):  # the C side checks again, without undefined behaviour
         status = lib.mt_format_frames(
-            ffi.from_buffer("double[]", values), 3, 1, first, keys, lens, offsets, counts, 1, ffi.NULL, buf, 1000, n
-        )
+            ffi.from_buffer("double[]", values), 3, 1, first, keys, lens, offsets, counts, 1, ffi.NULL,
+            lib.MT_NUMBER_CODE_BEST, buf, 1000, n,
+        )  # fmt: skip
         assert status == lib.MT_EFRAMERANGE
     for text, line in ((b"1000000000000000000\nk 1\n", 1), (b"999999999999999999\nk 1\n1000000000000000000\nk 2\n", 3)):
         with pytest.raises(SequenceError, match=r"frame number '1000000000000000000' is past the largest") as caught:

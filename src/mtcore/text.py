@@ -44,6 +44,8 @@ __all__ = [
     "format_table",
     "frame_line",
     "line_breaks",
+    "number_code",
+    "number_codes",
     "parse_number",
     "scan_frames",
     "scan_table",
@@ -57,6 +59,37 @@ _FORMAT_CHUNK = 256  # frames per C call when writing: a text buffer that stays 
 _NEWLINES = {b"\n": lib.MT_NEWLINE_LF, b"\r\n": lib.MT_NEWLINE_CRLF, b"\r": lib.MT_NEWLINE_CR}
 _DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")  # the grammar's decimals
 _GRAMMAR = "a number (optional sign, digits with an optional '.' and exponent, as 17.8693 or -1.2e-05; or inf, nan)"
+# the codes that write the shortest texts (enum mt_number_code), widest first
+_NUMBER_CODES = {
+    "avx512": lib.MT_NUMBER_CODE_AVX512,
+    "avx2": lib.MT_NUMBER_CODE_AVX2,
+    "portable": lib.MT_NUMBER_CODE_PORTABLE,
+}
+
+
+def number_code() -> str:
+    """The name of the code that writes the shortest texts of numbers on this processor, the one
+    ``code="best"`` stands for: ``"avx512"`` or ``"avx2"`` (code written for the vector registers of
+    x86-64 processors of those levels), else ``"portable"``.  Every code writes the same bytes."""
+    best = lib.mt_number_code()
+    return next(name for name, code in _NUMBER_CODES.items() if code == best)
+
+
+def number_codes() -> tuple[str, ...]:
+    """The names of the codes that this processor runs for the shortest texts, widest first (the
+    first is :func:`number_code`); any of them, or ``"best"``, is a ``code=`` of the writers."""
+    return tuple(name for name, code in _NUMBER_CODES.items() if lib.mt_number_code_runs(code))
+
+
+def _number_code(code: str) -> int:
+    """The C code of a name of ``code=``, checked against what this processor runs."""
+    if code == "best":
+        return lib.MT_NUMBER_CODE_BEST
+    if code not in _NUMBER_CODES:
+        raise ValueError(f"code must be 'best' or one of {sorted(_NUMBER_CODES)}, got {code!r}")
+    if not lib.mt_number_code_runs(_NUMBER_CODES[code]):
+        raise ValueError(f"code {code!r} does not run on this processor, which runs {', '.join(number_codes())}")
+    return _NUMBER_CODES[code]
 
 
 def _style(digits: int | None, exponent_digits: int, newline: bytes = b"\n", frame_newline: bytes | None = None):
@@ -367,6 +400,7 @@ def format_frames(
     exponent_digits: int = 2,
     newline: bytes = b"\n",
     frame_newline: bytes | None = None,
+    code: str = "best",
 ) -> None:
     """Write (frames, channels) values as frame text to ``out``, in chunks: a binary file (as
     ``open(path, "wb")`` gives), or a function given each chunk as bytes.
@@ -379,8 +413,11 @@ def format_frames(
     inexact.  ``exponent_digits`` is the fewest digits of an exponent (2:
     ``1e-05``; 3: ``1e-005`` as HDM05 writes), ``newline`` the line ending
     (``b"\\n"``, ``b"\\r\\n"`` or ``b"\\r"``); :func:`text_style` finds both in a file.
+    ``code`` names the code that writes the shortest texts (:func:`number_codes`): the same
+    bytes from each; other than ``"best"`` for tests and benchmarks that compare them.
     """
     style = _style(digits, exponent_digits, newline, frame_newline)
+    c_code = _number_code(code)
     values = np.ascontiguousarray(values, dtype=np.float64)
     if values.ndim != 2:
         raise ValueError(f"values must be (frames, channels), got shape {values.shape}")
@@ -410,6 +447,7 @@ def format_frames(
                 table.c_counts,
                 table.n,
                 style,
+                c_code,
                 c_buf,
                 len(buf),
                 written,
@@ -501,10 +539,12 @@ def format_table(
     digits: int | None = None,
     exponent_digits: int = 2,
     newline: bytes = b"\n",
+    code: str = "best",
 ) -> None:
     """Write (rows, columns) values as lines of numbers separated by a blank to ``out``, in chunks;
-    ``out``, numbers and lines as for :func:`format_frames`."""
+    ``out``, numbers, lines and ``code`` as for :func:`format_frames`."""
     style = _style(digits, exponent_digits, newline)
+    c_code = _number_code(code)
     values = np.ascontiguousarray(values, dtype=np.float64)
     if values.ndim != 2:
         raise ValueError(f"values must be (rows, columns), got shape {values.shape}")
@@ -516,7 +556,7 @@ def format_table(
     with c_array(values) as c_values, c_array(buf, "char[]") as c_buf:
         for r0 in range(0, rows, chunk):
             n = min(chunk, rows - r0)
-            status = lib.mt_format_table(c_values + r0 * columns, n, columns, style, c_buf, len(buf), written)
+            status = lib.mt_format_table(c_values + r0 * columns, n, columns, style, c_code, c_buf, len(buf), written)
             check(status, "mt_format_table")
             write(buf[: written[0]])
 

@@ -937,4 +937,6 @@ EXEMPT = {
     "mt_format_bound": "a capacity bound for mt_format_frames, which fails with MT_ERANGE below it",
     "mt_format_table_bound": "a capacity bound for mt_format_table, which fails with MT_ERANGE below it",
     "mt_guard_install": "installs a signal handler once; test_hardening shrinks mapped files under the scanners",
+    "mt_number_code": "names the number writer's code on this processor; test_numbers runs each code against the portable",
+    "mt_number_code_runs": "whether this processor runs a number writer's code; test_numbers checks it with the writers",
 }
