@@ -644,53 +644,41 @@ static MT_CLONES void knee_block(const struct mt_leg *leg, size_t n, const doubl
 
 /* ---------------------------------------------------------------- phases 1 and 2 */
 
-int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *angles, const double *points,
-                      const unsigned char *planted, const double *targets, const double *clearance,
-                      const struct mt_footskate *opt, double *enforced, double *goal, double *turn, double *weight,
-                      double *reaches, double *knee)
+/* The knee's hinge axis: its channel's axis, or the mean bend axis of the take, since the reach
+ * and the solve turn the knee about one axis whatever channels it has. */
+static void knee_hinge(const struct mt_leg *leg, size_t frames, const double *angles, double *axis)
 {
-    if (check_leg(leg) != MT_OK || check_options(opt) != MT_OK || !clearance || !knee)
-        return MT_EINVAL;
-    if (frames > 0 && (!angles || !points || !planted || !targets || !enforced || !goal || !turn || !weight ||
-                       !reaches))
-        return MT_EINVAL;
-    const double *s = leg->segment[0];
-    double axis[3];
-    /* the knee's hinge: its channel's axis, or the mean bend axis of the take */
     if (channels(leg, 1) == 1) {
         const int a = leg->axes[1][0];
         for (int e = 0; e < 3; e++)
             axis[e] = leg->axis[1][3 * e + a];
-    } else {
-        double total[3] = {0, 0, 0};
-        for (size_t t = 0; t < frames; t++) {
-            double l[9], u[3], c[3];
-            local_rotation(leg, 1, angles + 12 * t + 3, l);
-            mat_vec(l, leg->segment[1], u);
-            cross3(s, u, c);
-            for (int e = 0; e < 3; e++)
-                total[e] += c[e];
-        }
-        const double scale = norm3(s) * norm3(leg->segment[1]);
-        if (!(norm3(total) > tiny * (scale > 1 ? scale : 1.0) * (double)frames)) {
-            double down[3];
-            for (int e = 0; e < 3; e++)
-                down[e] = leg->segment[1][e] + leg->segment[2][e];
-            cross3(s, down, total);
-        }
-        unit3(total, axis);
+        return;
     }
-    memcpy(knee, axis, sizeof axis);
-    knee[3] = 1.0;
-    if (frames == 0)
-        return MT_OK;
-    double *partner = malloc(3 * frames * sizeof *partner), *pinlog = malloc(3 * frames * sizeof *pinlog);
-    unsigned char *masks = malloc(2 * frames + 1);
-    if (!partner || !pinlog || !masks) {
-        free(partner), free(pinlog), free(masks);
-        return MT_ENOMEM;
+    const double *s = leg->segment[0];
+    double total[3] = {0, 0, 0};
+    for (size_t t = 0; t < frames; t++) {
+        double l[9], u[3], c[3];
+        local_rotation(leg, 1, angles + 12 * t + 3, l);
+        mat_vec(l, leg->segment[1], u);
+        cross3(s, u, c);
+        for (int e = 0; e < 3; e++)
+            total[e] += c[e];
     }
-    /* the knee's reach and the side it bends to */
+    const double scale = norm3(s) * norm3(leg->segment[1]);
+    if (!(norm3(total) > tiny * (scale > 1 ? scale : 1.0) * (double)frames)) {
+        double down[3];
+        for (int e = 0; e < 3; e++)
+            down[e] = leg->segment[1][e] + leg->segment[2][e];
+        cross3(s, down, total);
+    }
+    unit3(total, axis);
+}
+
+/* The knee's reach in each frame and the side (+1 or -1) most frames bend it to: the root and
+ * the solve keep each hip within the reach, and bend the knee to the side the take does. */
+static double knee_reaches(const struct mt_leg *leg, size_t frames, const double *angles, const double *axis,
+                           const struct mt_footskate *opt, double *reaches)
+{
     double sides = 0;
     for (size_t t0 = 0; t0 < frames; t0 += BLOCK) {
         const size_t n = frames - t0 < BLOCK ? frames - t0 : BLOCK;
@@ -699,61 +687,76 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *ang
         for (size_t f = 0; f < n; f++)
             sides += (bends[f] > 0) - (bends[f] < 0);
     }
-    memcpy(knee, axis, sizeof axis);
-    knee[3] = sides >= 0 ? 1.0 : -1.0;
-    unsigned char *pins = masks, *some = masks + frames;
-    double foot[3];
-    for (int e = 0; e < 3; e++)
-        foot[e] = leg->segment[2][e] - leg->segment[3][e];
-    enforce_targets(planted, targets, clearance, norm3(foot), opt, frames, enforced, partner);
+    return sides >= 0 ? 1.0 : -1.0;
+}
 
-    /* the pinned turns: both points planted, or a roll from one to the other */
-    for (size_t t = 0; t < frames; t++) {
-        const unsigned char *now = planted + 2 * t;
-        const double *ball = points + 15 * t + 6, *heel = points + 15 * t + 9;
-        const int rolled = !isnan(partner[3 * t]);
-        some[t] = now[HEEL] || now[BALL];
-        pins[t] = (now[HEEL] && now[BALL]) || rolled;
-        memset(pinlog + 3 * t, 0, 3 * sizeof *pinlog);
-        if (!pins[t])
+/* What the steps of phase 2 share (see mt_footskate_plan), and its scratch. */
+struct plan {
+    const struct mt_footskate *opt;
+    size_t frames;
+    const double *points, *clearance;
+    const unsigned char *planted;
+    const double *enforced; /* the targets of phase 1 */
+    double *partner;        /* a roll's other target at its first frame, else NaN (frames x 3) */
+    double *pinlog;         /* the pinned turns as rotation vectors, else zero (frames x 3) */
+    unsigned char *pins;    /* frames that pin the foot's turn */
+    unsigned char *some;    /* frames with a point planted */
+};
+
+/* The foot's turns where both points are planted, or it rolls from one to the other: the two
+ * targets fix its direction there, and the turns of the other planted frames blend from them. */
+static void pin_turns(const struct plan *p)
+{
+    for (size_t t = 0; t < p->frames; t++) {
+        const unsigned char *now = p->planted + 2 * t;
+        const double *ball = p->points + 15 * t + 6, *heel = p->points + 15 * t + 9;
+        const int rolled = !isnan(p->partner[3 * t]);
+        p->some[t] = now[HEEL] || now[BALL];
+        p->pins[t] = (now[HEEL] && now[BALL]) || rolled;
+        memset(p->pinlog + 3 * t, 0, 3 * sizeof *p->pinlog);
+        if (!p->pins[t])
             continue;
-        const double *heel_goal = rolled && now[BALL] ? partner + 3 * t : enforced + 6 * t;
-        const double *ball_goal = rolled && now[HEEL] ? partner + 3 * t : enforced + 6 * t + 3;
+        const double *heel_goal = rolled && now[BALL] ? p->partner + 3 * t : p->enforced + 6 * t;
+        const double *ball_goal = rolled && now[HEEL] ? p->partner + 3 * t : p->enforced + 6 * t + 3;
         double from[3], to[3], r[9];
         for (int e = 0; e < 3; e++)
             from[e] = ball[e] - heel[e], to[e] = ball_goal[e] - heel_goal[e];
         between(from, to, r);
-        rotvec_of(r, pinlog + 3 * t);
+        rotvec_of(r, p->pinlog + 3 * t);
     }
-    /* constrained frames: the turn blended from the pins (raised about the pivot where one point is
-     * planted and the other below the floor), the ankle following the planted point; goal holds the
-     * ankle's shift for now */
+}
+
+/* The turns (and, in goal, the ankle's shifts) of the frames with a point planted: the turn
+ * blended from the pins, raised about the pivot where one point is planted and the other would
+ * sink below the floor, and the ankle following the planted point, so that it lands on its target. */
+static void turn_planted(const struct plan *p, double *goal, double *turn)
+{
     struct neighbours around;
-    neighbours_start(&around, pins, frames, opt->blend);
-    for (size_t t = 0; t < frames; t++) {
+    neighbours_start(&around, p->pins, p->frames, p->opt->blend);
+    for (size_t t = 0; t < p->frames; t++) {
         double wp, wn;
         neighbours_at(&around, t, &wp, &wn);
-        if (!some[t])
+        if (!p->some[t])
             continue;
-        const unsigned char *now = planted + 2 * t;
-        const double *ankle = points + 15 * t + 3;
+        const unsigned char *now = p->planted + 2 * t;
+        const double *ankle = p->points + 15 * t + 3;
         double log[3], q[9];
-        if (pins[t])
-            memcpy(log, pinlog + 3 * t, sizeof log);
+        if (p->pins[t])
+            memcpy(log, p->pinlog + 3 * t, sizeof log);
         else
             for (int e = 0; e < 3; e++)
-                log[e] = (around.prev >= 0 ? wp * pinlog[3 * around.prev + e] : 0.0) +
-                         (around.next >= 0 ? wn * pinlog[3 * around.next + e] : 0.0);
+                log[e] = (around.prev >= 0 ? wp * p->pinlog[3 * around.prev + e] : 0.0) +
+                         (around.next >= 0 ? wn * p->pinlog[3 * around.next + e] : 0.0);
         rotvec_exp(log, q);
         const int on_ball = now[BALL] && !now[HEEL];
-        const double *pivot = points + 15 * t + (on_ball ? 6 : 9), *other = points + 15 * t + (on_ball ? 9 : 6);
-        const double *target = enforced + 6 * t + 3 * on_ball;
-        if ((!now[HEEL] || !now[BALL]) && isnan(partner[3 * t])) {
+        const double *pivot = p->points + 15 * t + (on_ball ? 6 : 9), *other = p->points + 15 * t + (on_ball ? 9 : 6);
+        const double *target = p->enforced + 6 * t + 3 * on_ball;
+        if ((!now[HEEL] || !now[BALL]) && isnan(p->partner[3 * t])) {
             double arm[3], lever[3], r[9];
             for (int e = 0; e < 3; e++)
                 arm[e] = other[e] - pivot[e];
             mat_vec(q, arm, lever);
-            raise_lever(lever, target, clearance[on_ball ? HEEL : BALL], opt, r);
+            raise_lever(lever, target, p->clearance[on_ball ? HEEL : BALL], p->opt, r);
             mat_mul(r, q, q);
         }
         double arm[3], moved[3];
@@ -764,12 +767,18 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *ang
             goal[3 * t + e] = target[e] + moved[e] - ankle[e];
         rotvec_of(q, turn + 3 * t);
     }
-    /* free frames: shift and turn blended from the constrained frames (which this pass does not change) */
-    neighbours_start(&around, some, frames, opt->blend);
-    for (size_t t = 0; t < frames; t++) {
+}
+
+/* The shifts and turns of the free frames, and every frame's weight: blended from the planted
+ * frames (which this pass does not change), so that a foot eases into and out of a plant. */
+static void blend_free(const struct plan *p, double *goal, double *turn, double *weight)
+{
+    struct neighbours around;
+    neighbours_start(&around, p->some, p->frames, p->opt->blend);
+    for (size_t t = 0; t < p->frames; t++) {
         double wp, wn;
         neighbours_at(&around, t, &wp, &wn);
-        if (some[t]) {
+        if (p->some[t]) {
             weight[t] = 1.0;
             continue;
         }
@@ -781,9 +790,46 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *ang
         }
         weight[t] = wp > wn ? wp : wn;
     }
-    for (size_t t = 0; t < frames; t++) /* goals from shifts */
+}
+
+/* goal = the ankle plus its shift: the later phases aim the ankle at a point, not by a shift */
+static void shifts_to_goals(const struct plan *p, double *goal)
+{
+    for (size_t t = 0; t < p->frames; t++)
         for (int e = 0; e < 3; e++)
-            goal[3 * t + e] += points[15 * t + 3 + e];
+            goal[3 * t + e] += p->points[15 * t + 3 + e];
+}
+
+int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *angles, const double *points,
+                      const unsigned char *planted, const double *targets, const double *clearance,
+                      const struct mt_footskate *opt, double *enforced, double *goal, double *turn, double *weight,
+                      double *reaches, double *knee)
+{
+    if (check_leg(leg) != MT_OK || check_options(opt) != MT_OK || !clearance || !knee)
+        return MT_EINVAL;
+    if (frames > 0 && (!angles || !points || !planted || !targets || !enforced || !goal || !turn || !weight ||
+                       !reaches))
+        return MT_EINVAL;
+    knee_hinge(leg, frames, angles, knee);
+    knee[3] = 1.0;
+    if (frames == 0)
+        return MT_OK;
+    double *partner = malloc(3 * frames * sizeof *partner), *pinlog = malloc(3 * frames * sizeof *pinlog);
+    unsigned char *masks = malloc(2 * frames + 1);
+    if (!partner || !pinlog || !masks) {
+        free(partner), free(pinlog), free(masks);
+        return MT_ENOMEM;
+    }
+    const struct plan p = {opt, frames, points, clearance, planted, enforced, partner, pinlog, masks, masks + frames};
+    knee[3] = knee_reaches(leg, frames, angles, knee, opt, reaches);
+    double foot[3];
+    for (int e = 0; e < 3; e++)
+        foot[e] = leg->segment[2][e] - leg->segment[3][e];
+    enforce_targets(planted, targets, clearance, norm3(foot), opt, frames, enforced, partner);
+    pin_turns(&p);
+    turn_planted(&p, goal, turn);
+    blend_free(&p, goal, turn, weight);
+    shifts_to_goals(&p, goal);
     free(partner), free(pinlog), free(masks);
     return MT_OK;
 }
