@@ -8,285 +8,19 @@
  * only through the plants' targets (phase 1, in frame order), the blending
  * of adjustments around constraints (phase 2), the root's smoothing (phase
  * 3) and the lifting of a sinking foot (phase 5).  The per-frame work runs
- * BLOCK frames side by side, each quantity an array over them ("lanes"), so
+ * BLOCK frames side by side, each quantity an array over them (lanes.h), so
  * that it vectorises.  The Python twin in tests/twins/footskate.py computes
  * the same, phase by phase, in numpy.
  */
-#include "blocks.h"
 #include "clones.h"
+#include "lanes.h"
 #include "mtcore.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-static const double pi = 3.14159265358979323846;
-static const double tiny = 1e-12; /* below this a length or sine counts as zero */
 enum { HEEL = 0, BALL = 1 };
-
-/* ---------------------------------------------------------------- lanes */
-
-/*
- * Quantities over n lanes (frames solved side by side): a number x[l], a
- * vector v[e n + l], a matrix m[e n + l] (its entries row-major), l = 0 ..
- * n - 1, n <= BLOCK.  With n = 1 that is the plain layout of a number, a
- * vector or a matrix: the plan's code, a frame at a time, shares these
- * functions with the solve, which runs them BLOCK frames at a time, where
- * their loops over lanes vectorise (the elementary functions included: those
- * of blocks.h).  An output may be an input of the same lane only where said.
- */
-
-static MT_INLINE void dot_n(const double *a, const double *b, double *out, int n)
-{
-    for (int l = 0; l < n; l++)
-        out[l] = a[l] * b[l] + a[n + l] * b[n + l] + a[2 * n + l] * b[2 * n + l];
-}
-
-/* out may be a or b */
-static MT_INLINE void cross_n(const double *a, const double *b, double *out, int n)
-{
-    for (int l = 0; l < n; l++) {
-        const double x = a[n + l] * b[2 * n + l] - a[2 * n + l] * b[n + l];
-        const double y = a[2 * n + l] * b[l] - a[l] * b[2 * n + l];
-        const double z = a[l] * b[n + l] - a[n + l] * b[l];
-        out[l] = x, out[n + l] = y, out[2 * n + l] = z;
-    }
-}
-
-/* out may be a */
-static MT_INLINE void unit_n(const double *a, double *out, int n)
-{
-    for (int l = 0; l < n; l++) {
-        const double m = sqrt(a[l] * a[l] + a[n + l] * a[n + l] + a[2 * n + l] * a[2 * n + l]);
-        for (int e = 0; e < 3; e++)
-            out[e * n + l] = m > 0 ? a[e * n + l] / m : 0.0;
-    }
-}
-
-/* out = a with its component along the unit vector e (the same in every lane) removed; out may be a */
-static MT_INLINE void perpendicular_n(const double *a, const double *e, double *out, int n)
-{
-    for (int l = 0; l < n; l++) {
-        const double d = a[l] * e[0] + a[n + l] * e[1] + a[2 * n + l] * e[2];
-        for (int c = 0; c < 3; c++)
-            out[c * n + l] = a[c * n + l] - d * e[c];
-    }
-}
-
-/* out = m v (out may be v) */
-static MT_INLINE void mat_vec_n(const double *m, const double *v, double *out, int n)
-{
-    for (int l = 0; l < n; l++) {
-        double r[3];
-        for (int i = 0; i < 3; i++)
-            r[i] = m[3 * i * n + l] * v[l] + m[(3 * i + 1) * n + l] * v[n + l] +
-                   m[(3 * i + 2) * n + l] * v[2 * n + l];
-        for (int i = 0; i < 3; i++)
-            out[i * n + l] = r[i];
-    }
-}
-
-/* out = m^T v (out may be v) */
-static MT_INLINE void mat_tvec_n(const double *m, const double *v, double *out, int n)
-{
-    for (int l = 0; l < n; l++) {
-        double r[3];
-        for (int i = 0; i < 3; i++)
-            r[i] = m[i * n + l] * v[l] + m[(3 + i) * n + l] * v[n + l] + m[(6 + i) * n + l] * v[2 * n + l];
-        for (int i = 0; i < 3; i++)
-            out[i * n + l] = r[i];
-    }
-}
-
-/* out = a b, a^T b, a b^T (out may be a or b) */
-static MT_INLINE void mat_mul_n(const double *a, const double *b, double *out, int n)
-{
-    for (int l = 0; l < n; l++) {
-        double r[9];
-        for (int i = 0; i < 3; i++)
-            for (int k = 0; k < 3; k++)
-                r[3 * i + k] = a[3 * i * n + l] * b[k * n + l] + a[(3 * i + 1) * n + l] * b[(3 + k) * n + l] +
-                               a[(3 * i + 2) * n + l] * b[(6 + k) * n + l];
-        for (int e = 0; e < 9; e++)
-            out[e * n + l] = r[e];
-    }
-}
-
-static MT_INLINE void mat_tmul_n(const double *a, const double *b, double *out, int n)
-{
-    for (int l = 0; l < n; l++) {
-        double r[9];
-        for (int i = 0; i < 3; i++)
-            for (int k = 0; k < 3; k++)
-                r[3 * i + k] = a[i * n + l] * b[k * n + l] + a[(3 + i) * n + l] * b[(3 + k) * n + l] +
-                               a[(6 + i) * n + l] * b[(6 + k) * n + l];
-        for (int e = 0; e < 9; e++)
-            out[e * n + l] = r[e];
-    }
-}
-
-static MT_INLINE void mat_mult_n(const double *a, const double *b, double *out, int n)
-{
-    for (int l = 0; l < n; l++) {
-        double r[9];
-        for (int i = 0; i < 3; i++)
-            for (int k = 0; k < 3; k++)
-                r[3 * i + k] = a[3 * i * n + l] * b[3 * k * n + l] + a[(3 * i + 1) * n + l] * b[(3 * k + 1) * n + l] +
-                               a[(3 * i + 2) * n + l] * b[(3 * k + 2) * n + l];
-        for (int e = 0; e < 9; e++)
-            out[e * n + l] = r[e];
-    }
-}
-
-/* out (count entries over the lanes) = v, the same in every lane */
-static MT_INLINE void spread_n(const double *v, int count, double *out, int n)
-{
-    for (int e = 0; e < count; e++)
-        for (int l = 0; l < n; l++)
-            out[e * n + l] = v[e];
-}
-
-/* The rotations about the unit axes by the angles of cosines c and sines s (Rodrigues). */
-static MT_INLINE void about_cs_n(const double *axis, const double *c, const double *s, double *out, int n)
-{
-    for (int l = 0; l < n; l++) {
-        const double x = axis[l], y = axis[n + l], z = axis[2 * n + l], cl = c[l], sl = s[l], t = 1 - cl;
-        const double r[9] = {cl + t * x * x,     t * x * y - sl * z, t * x * z + sl * y,
-                             t * x * y + sl * z, cl + t * y * y,     t * y * z - sl * x,
-                             t * x * z - sl * y, t * y * z + sl * x, cl + t * z * z};
-        for (int e = 0; e < 9; e++)
-            out[e * n + l] = r[e];
-    }
-}
-
-/* The rotations by the angles about the unit axes. */
-static MT_INLINE void about_n(const double *axis, const double *angle, double *out, int n)
-{
-    double s[BLOCK], c[BLOCK];
-    sincos_lanes(angle, s, c, n);
-    about_cs_n(axis, c, s, out, n);
-}
-
-/* acos of x in [-1, 1]: (1 - x)(1 + x) keeps the digits of 1 - x^2 near either end */
-static MT_INLINE void acos_n(const double *x, double *out, int n)
-{
-    double y[BLOCK];
-    for (int l = 0; l < n; l++)
-        y[l] = sqrt((1 - x[l]) * (1 + x[l]));
-    atan2_lanes(y, x, out, n);
-}
-
-/* The smallest rotations taking the directions of u onto those of v (half turns for opposite ones). */
-static MT_INLINE void between_n(const double *u0, const double *v0, double *out, int n)
-{
-    double u[3 * BLOCK], v[3 * BLOCK], k[3 * BLOCK], s[BLOCK], c[BLOCK];
-    unit_n(u0, u, n);
-    unit_n(v0, v, n);
-    cross_n(u, v, k, n);
-    dot_n(k, k, s, n);
-    dot_n(u, v, c, n);
-    int wide = 0;
-    for (int l = 0; l < n; l++) { /* R = c I + [k]x + k k^T / (1 + c), k = u x v: no trigonometry */
-        const double f = 1 / (1 + c[l]), x = k[l], y = k[n + l], z = k[2 * n + l], cl = c[l];
-        const double r[9] = {cl + f * x * x, -z + f * x * y, y + f * x * z,  z + f * y * x, cl + f * y * y,
-                             -x + f * y * z, -y + f * z * x, x + f * z * y, cl + f * z * z};
-        for (int e = 0; e < 9; e++)
-            out[e * n + l] = r[e];
-        s[l] = sqrt(s[l]);
-        wide |= !(cl > -0.5);
-    }
-    if (!wide)
-        return;
-    /* a turn of 120 degrees or more, where 1 + c loses digits: about the axis by atan2(s, c), or
-     * for opposite directions a half turn about an axis perpendicular to u */
-    double axis[3 * BLOCK], angle[BLOCK], turn[9 * BLOCK];
-    for (int l = 0; l < n; l++) {
-        const int along = s[l] > tiny, low = fabs(u[l]) < 0.9;
-        const double other[3] = {low, low ? 0.0 : 1.0, 0.0};
-        const double p[3] = {u[n + l] * other[2] - u[2 * n + l] * other[1],
-                             u[2 * n + l] * other[0] - u[l] * other[2], u[l] * other[1] - u[n + l] * other[0]};
-        for (int e = 0; e < 3; e++)
-            axis[e * n + l] = along ? k[e * n + l] : p[e];
-    }
-    unit_n(axis, axis, n);
-    atan2_lanes(s, c, angle, n);
-    for (int l = 0; l < n; l++)
-        angle[l] = s[l] > tiny ? angle[l] : c[l] < 0 ? pi : 0.0;
-    about_n(axis, angle, turn, n);
-    for (int l = 0; l < n; l++)
-        if (!(c[l] > -0.5))
-            for (int e = 0; e < 9; e++)
-                out[e * n + l] = turn[e * n + l];
-}
-
-static MT_INLINE void rotvec_exp_n(const double *v, double *m, int n)
-{
-    double axis[3 * BLOCK], angle[BLOCK];
-    dot_n(v, v, angle, n);
-    for (int l = 0; l < n; l++)
-        angle[l] = sqrt(angle[l]);
-    unit_n(v, axis, n);
-    about_n(axis, angle, m, n);
-}
-
-/* the one-lane forms, for the code that takes a frame at a time */
-
-static double dot3(const double *a, const double *b)
-{
-    double d;
-    dot_n(a, b, &d, 1);
-    return d;
-}
-
-static void cross3(const double *a, const double *b, double *out)
-{
-    cross_n(a, b, out, 1);
-}
-
-static double norm3(const double *a)
-{
-    return sqrt(dot3(a, a));
-}
-
-static void unit3(const double *a, double *out)
-{
-    unit_n(a, out, 1);
-}
-
-static void perpendicular(const double *a, const double *e, double *out)
-{
-    perpendicular_n(a, e, out, 1);
-}
-
-static void mat_vec(const double *m, const double *v, double *out)
-{
-    mat_vec_n(m, v, out, 1);
-}
-
-static void mat_tvec(const double *m, const double *v, double *out)
-{
-    mat_tvec_n(m, v, out, 1);
-}
-
-static void mat_mul(const double *a, const double *b, double *out)
-{
-    mat_mul_n(a, b, out, 1);
-}
-
-static void about(const double *axis, double angle, double *out)
-{
-    about_n(axis, &angle, out, 1);
-}
-
-static void between(const double *u, const double *v, double *out)
-{
-    between_n(u, v, out, 1);
-}
-
-static void rotvec_exp(const double *v, double *m)
-{
-    rotvec_exp_n(v, m, 1);
-}
 
 /* The rotation vector (angle in [0, pi]) of a rotation. */
 static void rotvec_of(const double *m, double *v)
@@ -358,52 +92,6 @@ static int channels(const struct mt_leg *leg, int j)
     while (n < 3 && leg->axes[j][n] >= 0)
         n++;
     return n;
-}
-
-/* the rows (or columns) p, q that a turn about a coordinate axis mixes */
-static int mixed_first(int axis)
-{
-    return axis == 0 ? 1 : axis == 1 ? 2 : 0;
-}
-
-static int mixed_second(int axis)
-{
-    return axis == 0 ? 2 : axis == 1 ? 0 : 1;
-}
-
-/* m = R(axis) m, R the rotations about a coordinate axis of the given sines and cosines: they mix two rows */
-static MT_INLINE void rotate_left_n(double *m, int axis, const double *s, const double *c, int n)
-{
-    const int p = mixed_first(axis), q = mixed_second(axis);
-    for (int k = 0; k < 3; k++)
-        for (int l = 0; l < n; l++) {
-            const double a = m[(3 * p + k) * n + l], b = m[(3 * q + k) * n + l];
-            m[(3 * p + k) * n + l] = c[l] * a - s[l] * b;
-            m[(3 * q + k) * n + l] = s[l] * a + c[l] * b;
-        }
-}
-
-/* v = R(axis) v, R as for rotate_left_n */
-static MT_INLINE void rotate_vector_n(double *v, int axis, const double *s, const double *c, int n)
-{
-    const int p = mixed_first(axis), q = mixed_second(axis);
-    for (int l = 0; l < n; l++) {
-        const double a = v[p * n + l], b = v[q * n + l];
-        v[p * n + l] = c[l] * a - s[l] * b;
-        v[q * n + l] = s[l] * a + c[l] * b;
-    }
-}
-
-/* m = m R(axis), R as for rotate_left_n: it mixes two columns */
-static MT_INLINE void rotate_right_n(double *m, int axis, const double *s, const double *c, int n)
-{
-    const int p = mixed_first(axis), q = mixed_second(axis);
-    for (int k = 0; k < 9; k += 3)
-        for (int l = 0; l < n; l++) {
-            const double a = m[(k + p) * n + l], b = m[(k + q) * n + l];
-            m[(k + p) * n + l] = c[l] * a + s[l] * b;
-            m[(k + q) * n + l] = -s[l] * a + c[l] * b;
-        }
 }
 
 static int is_identity(const double *m)
@@ -956,53 +644,41 @@ static MT_CLONES void knee_block(const struct mt_leg *leg, size_t n, const doubl
 
 /* ---------------------------------------------------------------- phases 1 and 2 */
 
-int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *angles, const double *points,
-                      const unsigned char *planted, const double *targets, const double *clearance,
-                      const struct mt_footskate *opt, double *enforced, double *goal, double *turn, double *weight,
-                      double *reaches, double *knee)
+/* The knee's hinge axis: its channel's axis, or the mean bend axis of the take, since the reach
+ * and the solve turn the knee about one axis whatever channels it has. */
+static void knee_hinge(const struct mt_leg *leg, size_t frames, const double *angles, double *axis)
 {
-    if (check_leg(leg) != MT_OK || check_options(opt) != MT_OK || !clearance || !knee)
-        return MT_EINVAL;
-    if (frames > 0 && (!angles || !points || !planted || !targets || !enforced || !goal || !turn || !weight ||
-                       !reaches))
-        return MT_EINVAL;
-    const double *s = leg->segment[0];
-    double axis[3];
-    /* the knee's hinge: its channel's axis, or the mean bend axis of the take */
     if (channels(leg, 1) == 1) {
         const int a = leg->axes[1][0];
         for (int e = 0; e < 3; e++)
             axis[e] = leg->axis[1][3 * e + a];
-    } else {
-        double total[3] = {0, 0, 0};
-        for (size_t t = 0; t < frames; t++) {
-            double l[9], u[3], c[3];
-            local_rotation(leg, 1, angles + 12 * t + 3, l);
-            mat_vec(l, leg->segment[1], u);
-            cross3(s, u, c);
-            for (int e = 0; e < 3; e++)
-                total[e] += c[e];
-        }
-        const double scale = norm3(s) * norm3(leg->segment[1]);
-        if (!(norm3(total) > tiny * (scale > 1 ? scale : 1.0) * (double)frames)) {
-            double down[3];
-            for (int e = 0; e < 3; e++)
-                down[e] = leg->segment[1][e] + leg->segment[2][e];
-            cross3(s, down, total);
-        }
-        unit3(total, axis);
+        return;
     }
-    memcpy(knee, axis, sizeof axis);
-    knee[3] = 1.0;
-    if (frames == 0)
-        return MT_OK;
-    double *partner = malloc(3 * frames * sizeof *partner), *pinlog = malloc(3 * frames * sizeof *pinlog);
-    unsigned char *masks = malloc(2 * frames + 1);
-    if (!partner || !pinlog || !masks) {
-        free(partner), free(pinlog), free(masks);
-        return MT_ENOMEM;
+    const double *s = leg->segment[0];
+    double total[3] = {0, 0, 0};
+    for (size_t t = 0; t < frames; t++) {
+        double l[9], u[3], c[3];
+        local_rotation(leg, 1, angles + 12 * t + 3, l);
+        mat_vec(l, leg->segment[1], u);
+        cross3(s, u, c);
+        for (int e = 0; e < 3; e++)
+            total[e] += c[e];
     }
-    /* the knee's reach and the side it bends to */
+    const double scale = norm3(s) * norm3(leg->segment[1]);
+    if (!(norm3(total) > tiny * (scale > 1 ? scale : 1.0) * (double)frames)) {
+        double down[3];
+        for (int e = 0; e < 3; e++)
+            down[e] = leg->segment[1][e] + leg->segment[2][e];
+        cross3(s, down, total);
+    }
+    unit3(total, axis);
+}
+
+/* The knee's reach in each frame and the side (+1 or -1) most frames bend it to: the root and
+ * the solve keep each hip within the reach, and bend the knee to the side the take does. */
+static double knee_reaches(const struct mt_leg *leg, size_t frames, const double *angles, const double *axis,
+                           const struct mt_footskate *opt, double *reaches)
+{
     double sides = 0;
     for (size_t t0 = 0; t0 < frames; t0 += BLOCK) {
         const size_t n = frames - t0 < BLOCK ? frames - t0 : BLOCK;
@@ -1011,61 +687,76 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *ang
         for (size_t f = 0; f < n; f++)
             sides += (bends[f] > 0) - (bends[f] < 0);
     }
-    memcpy(knee, axis, sizeof axis);
-    knee[3] = sides >= 0 ? 1.0 : -1.0;
-    unsigned char *pins = masks, *some = masks + frames;
-    double foot[3];
-    for (int e = 0; e < 3; e++)
-        foot[e] = leg->segment[2][e] - leg->segment[3][e];
-    enforce_targets(planted, targets, clearance, norm3(foot), opt, frames, enforced, partner);
+    return sides >= 0 ? 1.0 : -1.0;
+}
 
-    /* the pinned turns: both points planted, or a roll from one to the other */
-    for (size_t t = 0; t < frames; t++) {
-        const unsigned char *now = planted + 2 * t;
-        const double *ball = points + 15 * t + 6, *heel = points + 15 * t + 9;
-        const int rolled = !isnan(partner[3 * t]);
-        some[t] = now[HEEL] || now[BALL];
-        pins[t] = (now[HEEL] && now[BALL]) || rolled;
-        memset(pinlog + 3 * t, 0, 3 * sizeof *pinlog);
-        if (!pins[t])
+/* What the steps of phase 2 share (see mt_footskate_plan), and its scratch. */
+struct plan {
+    const struct mt_footskate *opt;
+    size_t frames;
+    const double *points, *clearance;
+    const unsigned char *planted;
+    const double *enforced; /* the targets of phase 1 */
+    double *partner;        /* a roll's other target at its first frame, else NaN (frames x 3) */
+    double *pinlog;         /* the pinned turns as rotation vectors, else zero (frames x 3) */
+    unsigned char *pins;    /* frames that pin the foot's turn */
+    unsigned char *some;    /* frames with a point planted */
+};
+
+/* The foot's turns where both points are planted, or it rolls from one to the other: the two
+ * targets fix its direction there, and the turns of the other planted frames blend from them. */
+static void pin_turns(const struct plan *p)
+{
+    for (size_t t = 0; t < p->frames; t++) {
+        const unsigned char *now = p->planted + 2 * t;
+        const double *ball = p->points + 15 * t + 6, *heel = p->points + 15 * t + 9;
+        const int rolled = !isnan(p->partner[3 * t]);
+        p->some[t] = now[HEEL] || now[BALL];
+        p->pins[t] = (now[HEEL] && now[BALL]) || rolled;
+        memset(p->pinlog + 3 * t, 0, 3 * sizeof *p->pinlog);
+        if (!p->pins[t])
             continue;
-        const double *heel_goal = rolled && now[BALL] ? partner + 3 * t : enforced + 6 * t;
-        const double *ball_goal = rolled && now[HEEL] ? partner + 3 * t : enforced + 6 * t + 3;
+        const double *heel_goal = rolled && now[BALL] ? p->partner + 3 * t : p->enforced + 6 * t;
+        const double *ball_goal = rolled && now[HEEL] ? p->partner + 3 * t : p->enforced + 6 * t + 3;
         double from[3], to[3], r[9];
         for (int e = 0; e < 3; e++)
             from[e] = ball[e] - heel[e], to[e] = ball_goal[e] - heel_goal[e];
         between(from, to, r);
-        rotvec_of(r, pinlog + 3 * t);
+        rotvec_of(r, p->pinlog + 3 * t);
     }
-    /* constrained frames: the turn blended from the pins (raised about the pivot where one point is
-     * planted and the other below the floor), the ankle following the planted point; goal holds the
-     * ankle's shift for now */
+}
+
+/* The turns (and, in goal, the ankle's shifts) of the frames with a point planted: the turn
+ * blended from the pins, raised about the pivot where one point is planted and the other would
+ * sink below the floor, and the ankle following the planted point, so that it lands on its target. */
+static void turn_planted(const struct plan *p, double *goal, double *turn)
+{
     struct neighbours around;
-    neighbours_start(&around, pins, frames, opt->blend);
-    for (size_t t = 0; t < frames; t++) {
+    neighbours_start(&around, p->pins, p->frames, p->opt->blend);
+    for (size_t t = 0; t < p->frames; t++) {
         double wp, wn;
         neighbours_at(&around, t, &wp, &wn);
-        if (!some[t])
+        if (!p->some[t])
             continue;
-        const unsigned char *now = planted + 2 * t;
-        const double *ankle = points + 15 * t + 3;
+        const unsigned char *now = p->planted + 2 * t;
+        const double *ankle = p->points + 15 * t + 3;
         double log[3], q[9];
-        if (pins[t])
-            memcpy(log, pinlog + 3 * t, sizeof log);
+        if (p->pins[t])
+            memcpy(log, p->pinlog + 3 * t, sizeof log);
         else
             for (int e = 0; e < 3; e++)
-                log[e] = (around.prev >= 0 ? wp * pinlog[3 * around.prev + e] : 0.0) +
-                         (around.next >= 0 ? wn * pinlog[3 * around.next + e] : 0.0);
+                log[e] = (around.prev >= 0 ? wp * p->pinlog[3 * around.prev + e] : 0.0) +
+                         (around.next >= 0 ? wn * p->pinlog[3 * around.next + e] : 0.0);
         rotvec_exp(log, q);
         const int on_ball = now[BALL] && !now[HEEL];
-        const double *pivot = points + 15 * t + (on_ball ? 6 : 9), *other = points + 15 * t + (on_ball ? 9 : 6);
-        const double *target = enforced + 6 * t + 3 * on_ball;
-        if ((!now[HEEL] || !now[BALL]) && isnan(partner[3 * t])) {
+        const double *pivot = p->points + 15 * t + (on_ball ? 6 : 9), *other = p->points + 15 * t + (on_ball ? 9 : 6);
+        const double *target = p->enforced + 6 * t + 3 * on_ball;
+        if ((!now[HEEL] || !now[BALL]) && isnan(p->partner[3 * t])) {
             double arm[3], lever[3], r[9];
             for (int e = 0; e < 3; e++)
                 arm[e] = other[e] - pivot[e];
             mat_vec(q, arm, lever);
-            raise_lever(lever, target, clearance[on_ball ? HEEL : BALL], opt, r);
+            raise_lever(lever, target, p->clearance[on_ball ? HEEL : BALL], p->opt, r);
             mat_mul(r, q, q);
         }
         double arm[3], moved[3];
@@ -1076,12 +767,18 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *ang
             goal[3 * t + e] = target[e] + moved[e] - ankle[e];
         rotvec_of(q, turn + 3 * t);
     }
-    /* free frames: shift and turn blended from the constrained frames (which this pass does not change) */
-    neighbours_start(&around, some, frames, opt->blend);
-    for (size_t t = 0; t < frames; t++) {
+}
+
+/* The shifts and turns of the free frames, and every frame's weight: blended from the planted
+ * frames (which this pass does not change), so that a foot eases into and out of a plant. */
+static void blend_free(const struct plan *p, double *goal, double *turn, double *weight)
+{
+    struct neighbours around;
+    neighbours_start(&around, p->some, p->frames, p->opt->blend);
+    for (size_t t = 0; t < p->frames; t++) {
         double wp, wn;
         neighbours_at(&around, t, &wp, &wn);
-        if (some[t]) {
+        if (p->some[t]) {
             weight[t] = 1.0;
             continue;
         }
@@ -1093,9 +790,46 @@ int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *ang
         }
         weight[t] = wp > wn ? wp : wn;
     }
-    for (size_t t = 0; t < frames; t++) /* goals from shifts */
+}
+
+/* goal = the ankle plus its shift: the later phases aim the ankle at a point, not by a shift */
+static void shifts_to_goals(const struct plan *p, double *goal)
+{
+    for (size_t t = 0; t < p->frames; t++)
         for (int e = 0; e < 3; e++)
-            goal[3 * t + e] += points[15 * t + 3 + e];
+            goal[3 * t + e] += p->points[15 * t + 3 + e];
+}
+
+int mt_footskate_plan(const struct mt_leg *leg, size_t frames, const double *angles, const double *points,
+                      const unsigned char *planted, const double *targets, const double *clearance,
+                      const struct mt_footskate *opt, double *enforced, double *goal, double *turn, double *weight,
+                      double *reaches, double *knee)
+{
+    if (check_leg(leg) != MT_OK || check_options(opt) != MT_OK || !clearance || !knee)
+        return MT_EINVAL;
+    if (frames > 0 && (!angles || !points || !planted || !targets || !enforced || !goal || !turn || !weight ||
+                       !reaches))
+        return MT_EINVAL;
+    knee_hinge(leg, frames, angles, knee);
+    knee[3] = 1.0;
+    if (frames == 0)
+        return MT_OK;
+    double *partner = malloc(3 * frames * sizeof *partner), *pinlog = malloc(3 * frames * sizeof *pinlog);
+    unsigned char *masks = malloc(2 * frames + 1);
+    if (!partner || !pinlog || !masks) {
+        free(partner), free(pinlog), free(masks);
+        return MT_ENOMEM;
+    }
+    const struct plan p = {opt, frames, points, clearance, planted, enforced, partner, pinlog, masks, masks + frames};
+    knee[3] = knee_reaches(leg, frames, angles, knee, opt, reaches);
+    double foot[3];
+    for (int e = 0; e < 3; e++)
+        foot[e] = leg->segment[2][e] - leg->segment[3][e];
+    enforce_targets(planted, targets, clearance, norm3(foot), opt, frames, enforced, partner);
+    pin_turns(&p);
+    turn_planted(&p, goal, turn);
+    blend_free(&p, goal, turn, weight);
+    shifts_to_goals(&p, goal);
     free(partner), free(pinlog), free(masks);
     return MT_OK;
 }

@@ -12,8 +12,8 @@
  * swivelling over a hinge, joints with one or two channels) runs frame by
  * frame in the lanes of a block.
  */
-#include "blocks.h"
 #include "clones.h"
+#include "lanes.h"
 #include "mtcore.h"
 
 #include <float.h>
@@ -25,43 +25,6 @@ enum { CHUNK = 8 * BLOCK };
 
 /* Below this sine the direction a channel aims is taken as lying along the channel's axis. */
 static const double aim_floor = 1e-6;
-
-static const double pi = 3.14159265358979323846;
-
-/* out = x y */
-static void mul(const double *x, const double *y, double *out)
-{
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            out[3 * i + k] = x[3 * i] * y[k] + x[3 * i + 1] * y[3 + k] + x[3 * i + 2] * y[6 + k];
-}
-
-/* out = x y^T */
-static void mul_nt(const double *x, const double *y, double *out)
-{
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            out[3 * i + k] = x[3 * i] * y[3 * k] + x[3 * i + 1] * y[3 * k + 1] + x[3 * i + 2] * y[3 * k + 2];
-}
-
-/* out = m v */
-static void apply(const double *m, const double *v, double *out)
-{
-    for (int i = 0; i < 3; i++)
-        out[i] = m[3 * i] * v[0] + m[3 * i + 1] * v[1] + m[3 * i + 2] * v[2];
-}
-
-static double dot(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross(const double *a, const double *b, double *out)
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 /* The rotation by angle about coordinate axis `axis` (0, 1, 2). */
 static void axis_rotation(int axis, double angle, double *out)
@@ -81,20 +44,20 @@ static void axis_rotation(int axis, double angle, double *out)
  */
 static void smallest_rotation(const double *u0, const double *w0, double *out)
 {
-    const double nu = sqrt(dot(u0, u0)), nw = sqrt(dot(w0, w0));
+    const double nu = sqrt(dot3(u0, u0)), nw = sqrt(dot3(w0, w0));
     memcpy(out, identity, sizeof identity);
     if (!(nu > 0 && nw > 0 && isfinite(nu) && isfinite(nw)))
         return;
     double u[3] = {u0[0] / nu, u0[1] / nu, u0[2] / nu}, w[3] = {w0[0] / nw, w0[1] / nw, w0[2] / nw}, v[3];
-    cross(u, w, v);
-    const double c = dot(u, w);
+    cross3(u, w, v);
+    const double c = dot3(u, w);
     if (c < -1 + 1e-12) {
         /* the axis: u crossed with the coordinate axis least along it */
         const double a0 = fabs(u[0]), a1 = fabs(u[1]), a2 = fabs(u[2]);
         const double e[3] = {a0 <= a1 && a0 <= a2, a1 < a0 && a1 <= a2, a2 < a0 && a2 < a1};
         double n[3];
-        cross(u, e, n);
-        const double nn = sqrt(dot(n, n));
+        cross3(u, e, n);
+        const double nn = sqrt(dot3(n, n));
         for (int i = 0; i < 3; i++)
             for (int k = 0; k < 3; k++)
                 out[3 * i + k] = 2 * n[i] * n[k] / (nn * nn) - (i == k);
@@ -103,7 +66,7 @@ static void smallest_rotation(const double *u0, const double *w0, double *out)
     const double k = 1 / (1 + c);
     const double vx[9] = {0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0};
     double vx2[9];
-    mul(vx, vx, vx2);
+    mat_mul(vx, vx, vx2);
     for (int e = 0; e < 9; e++)
         out[e] += vx[e] + vx2[e] * k;
 }
@@ -112,14 +75,14 @@ static void smallest_rotation(const double *u0, const double *w0, double *out)
 static double aim_angle(const double *e, const double *d, const double *t)
 {
     double dp[3], tp[3], x[3];
-    const double de = dot(d, e), te = dot(t, e);
+    const double de = dot3(d, e), te = dot3(t, e);
     for (int i = 0; i < 3; i++)
         dp[i] = d[i] - de * e[i], tp[i] = t[i] - te * e[i];
-    const double nd = sqrt(dot(dp, dp)), nt = sqrt(dot(tp, tp)), nd0 = sqrt(dot(d, d)), nt0 = sqrt(dot(t, t));
+    const double nd = sqrt(dot3(dp, dp)), nt = sqrt(dot3(tp, tp)), nd0 = sqrt(dot3(d, d)), nt0 = sqrt(dot3(t, t));
     if (!(nd > aim_floor * nd0 && nt > aim_floor * nt0))
         return NAN;
-    cross(dp, tp, x);
-    return atan2(dot(x, e), dot(dp, tp));
+    cross3(dp, tp, x);
+    return atan2(dot3(x, e), dot3(dp, tp));
 }
 
 /* The angle about coordinate axis `axis` of m's twist about it (swing-twist decomposition). */
@@ -155,29 +118,29 @@ static void swivel(double *want, const double *bone, const double *child_bone, c
                    const double *goal)
 {
     double d[3], n[3], a[3], g[3], side[3], perp[3];
-    apply(want, bone, d);
-    apply(want, hinge, n);
-    apply(want, child_bone, a);
-    const double nd = sqrt(dot(d, d)), nn = sqrt(dot(n, n)), na = sqrt(dot(a, a)), ng = sqrt(dot(goal, goal));
+    mat_vec(want, bone, d);
+    mat_vec(want, hinge, n);
+    mat_vec(want, child_bone, a);
+    const double nd = sqrt(dot3(d, d)), nn = sqrt(dot3(n, n)), na = sqrt(dot3(a, a)), ng = sqrt(dot3(goal, goal));
     if (!(nd > 0 && nn > 0 && na > 0 && ng > 0))
         return;
     for (int e = 0; e < 3; e++)
         d[e] /= nd, n[e] /= nn, a[e] /= na, g[e] = goal[e] / ng;
     double across[3];
-    cross(d, g, across);
-    const double bend = sqrt(dot(across, across));
+    cross3(d, g, across);
+    const double bend = sqrt(dot3(across, across));
     const double weight = bend >= swivel_bend ? 1.0 : bend <= swivel_bend / 5 ? 0.0 : (bend / swivel_bend - 0.2) / 0.8;
     if (weight == 0)
         return;
     /* (R(d, psi) n) . g = n . a, with R(d, psi) n = (n.d) d + cos psi n_perp + sin psi (d x n_perp) */
-    const double along = dot(n, d);
+    const double along = dot3(n, d);
     for (int e = 0; e < 3; e++)
         perp[e] = n[e] - along * d[e];
-    cross(d, perp, side);
-    const double beta = dot(perp, g), gamma = dot(side, g), rho = hypot(beta, gamma);
+    cross3(d, perp, side);
+    const double beta = dot3(perp, g), gamma = dot3(side, g), rho = hypot(beta, gamma);
     if (!(rho > 0))
         return;
-    const double phi = atan2(gamma, beta), c = (dot(n, a) - along * dot(d, g)) / rho;
+    const double phi = atan2(gamma, beta), c = (dot3(n, a) - along * dot3(d, g)) / rho;
     const double spread = acos(c > 1 ? 1 : c < -1 ? -1 : c);
     double psi = remainder(phi - spread, 2 * pi);
     const double other = remainder(phi + spread, 2 * pi);
@@ -185,7 +148,7 @@ static void swivel(double *want, const double *bone, const double *child_bone, c
         psi = other;
     double r[9], turned[9];
     turn_about(d, weight * psi, r);
-    mul(r, want, turned);
+    mat_mul(r, want, turned);
     memcpy(want, turned, sizeof turned);
 }
 
@@ -217,8 +180,8 @@ static int reduce(const double *m, const int *axes, size_t count, const double *
         return MT_OK;
     }
     double t[3];
-    apply(m, aim, t);
-    const int aims = dot(aim, aim) > 0;
+    mat_vec(m, aim, t);
+    const int aims = dot3(aim, aim) > 0;
     if (count == 1) {
         const double e[3] = {axes[0] == 0, axes[0] == 1, axes[0] == 2};
         double a = aims ? aim_angle(e, aim, t) : NAN;
@@ -232,13 +195,13 @@ static int reduce(const double *m, const int *axes, size_t count, const double *
     const double e1[3] = {i == 0, i == 1, i == 2}, e2[3] = {k == 0, k == 1, k == 2};
     /* solve e2 . R1(a) aim = e2 . t for a (rotation about e2 keeps that part), then b about e2 */
     double perp[3], side[3];
-    const double along = dot(aim, e1);
+    const double along = dot3(aim, e1);
     for (int n = 0; n < 3; n++)
         perp[n] = aim[n] - along * e1[n];
-    cross(e1, perp, side);
-    const double beta = dot(e2, perp), gamma = dot(e2, side), rho = hypot(beta, gamma);
-    const double want = dot(e2, t) - along * dot(e2, e1);
-    if (aims && rho > aim_floor * sqrt(dot(aim, aim))) {
+    cross3(e1, perp, side);
+    const double beta = dot3(e2, perp), gamma = dot3(e2, side), rho = hypot(beta, gamma);
+    const double want = dot3(e2, t) - along * dot3(e2, e1);
+    if (aims && rho > aim_floor * sqrt(dot3(aim, aim))) {
         const double phi = atan2(gamma, beta), c = want / rho;
         const double spread = acos(c > 1 ? 1 : c < -1 ? -1 : c);
         double best = -INFINITY;
@@ -246,12 +209,12 @@ static int reduce(const double *m, const int *axes, size_t count, const double *
             const double a = phi + sign * spread;
             double r1[9], r2[9], r[9], w[3];
             axis_rotation(i, a, r1);
-            apply(r1, aim, w);
+            mat_vec(r1, aim, w);
             double b = aim_angle(e2, w, t);
             if (isnan(b))
                 b = 0;
             axis_rotation(k, b, r2);
-            mul(r2, r1, r);
+            mat_mul(r2, r1, r);
             const double near = agreement(r, m);
             if (near > best) {
                 best = near;
@@ -268,7 +231,7 @@ static int reduce(const double *m, const int *axes, size_t count, const double *
     angles[0] = three[0], angles[1] = three[2];
     axis_rotation(i, angles[0], r1);
     axis_rotation(k, angles[1], r2);
-    mul(r2, r1, achieved);
+    mat_mul(r2, r1, achieved);
     return status;
 }
 
@@ -321,38 +284,11 @@ static MT_INLINE void atan2_block(const double *y, const double *x, double *out)
     }
 }
 
-/* out = x c for block matrices x and a constant c. */
-static MT_INLINE void mul_block_const(double x[9][BLOCK], const double *c, double out[9][BLOCK])
-{
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            for (int f = 0; f < BLOCK; f++)
-                out[3 * i + k][f] = x[3 * i][f] * c[k] + x[3 * i + 1][f] * c[3 + k] + x[3 * i + 2][f] * c[6 + k];
-}
-
-/* out = c x for a constant c and block matrices x. */
-static MT_INLINE void mul_const_block(const double *c, double x[9][BLOCK], double out[9][BLOCK])
-{
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            for (int f = 0; f < BLOCK; f++)
-                out[3 * i + k][f] = c[3 * i] * x[k][f] + c[3 * i + 1] * x[3 + k][f] + c[3 * i + 2] * x[6 + k][f];
-}
-
-/* out = x^T y for block matrices. */
-static MT_INLINE void mul_tn_block(double x[9][BLOCK], double y[9][BLOCK], double out[9][BLOCK])
-{
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            for (int f = 0; f < BLOCK; f++)
-                out[3 * i + k][f] = x[i][f] * y[k][f] + x[3 + i][f] * y[3 + k][f] + x[6 + i][f] * y[6 + k][f];
-}
-
 /*
  * Extrinsic Euler angles about axes (Tait-Bryan or proper) of block
  * matrices r, as mt_matrices_to_euler computes them (see rotation.c).
  */
-static MT_INLINE void euler_block(double r[9][BLOCK], const int *axes, double angles[3][BLOCK])
+static MT_INLINE void euler_block(const double *r, const int *axes, double *angles)
 {
     const int i = axes[0], j = axes[1], k = 3 - i - j, proper = axes[2] == i;
     const double e = (j - i + 3) % 3 == 1 ? 1.0 : -1.0;
@@ -360,26 +296,26 @@ static MT_INLINE void euler_block(double r[9][BLOCK], const int *axes, double an
     const double f = proper ? e : -e;
     double by[BLOCK], bx[BLOCK], y[BLOCK], x[BLOCK], ay[BLOCK], ax[BLOCK], squares[BLOCK], root[BLOCK];
     for (int b = 0; b < BLOCK; b++) {
-        const double u = proper ? r[3 * i + j][b] : r[3 * k + j][b], v = proper ? r[3 * i + k][b] : r[3 * k + k][b];
+        const double u = proper ? r[(3 * i + j) * BLOCK + b] : r[(3 * k + j) * BLOCK + b], v = proper ? r[(3 * i + k) * BLOCK + b] : r[(3 * k + k) * BLOCK + b];
         squares[b] = u * u + v * v;
     }
     for (int b = 0; b < BLOCK; b++) /* alone: sqrt may set errno, which keeps a loop from vectorising */
         root[b] = sqrt(squares[b]);
     for (int b = 0; b < BLOCK; b++) {
-        const double rki = r[3 * k + i][b], rji = r[3 * j + i][b], rii = r[3 * i + i][b];
+        const double rki = r[(3 * k + i) * BLOCK + b], rji = r[(3 * j + i) * BLOCK + b], rii = r[(3 * i + i) * BLOCK + b];
         by[b] = proper ? root[b] : -e * rki;
         bx[b] = proper ? rii : root[b];
         const double yb = proper ? rji : e * rji, xb = proper ? -e * rki : rii;
         /* (cos c, sin c) times cos b: a's atan2 below needs their direction only */
         const int lock = xb * xb + yb * yb <= gimbal_lock * gimbal_lock;
         const double cc = pick(lock, 1.0, xb), sc = pick(lock, 0.0, yb);
-        ay[b] = -e * (cc * r[3 * j + k][b] + f * sc * r[3 * o + k][b]);
-        ax[b] = cc * r[3 * j + j][b] + f * sc * r[3 * o + j][b];
+        ay[b] = -e * (cc * r[(3 * j + k) * BLOCK + b] + f * sc * r[(3 * o + k) * BLOCK + b]);
+        ax[b] = cc * r[(3 * j + j) * BLOCK + b] + f * sc * r[(3 * o + j) * BLOCK + b];
         y[b] = pick(lock, 0.0, yb), x[b] = pick(lock, 1.0, xb);
     }
-    atan2_block(ay, ax, angles[0]);
-    atan2_block(by, bx, angles[1]);
-    atan2_block(y, x, angles[2]);
+    atan2_block(ay, ax, angles);
+    atan2_block(by, bx, angles + BLOCK);
+    atan2_block(y, x, angles + 2 * BLOCK);
 }
 
 /* Checks a tree's tables: sizes, kinds, columns, and an order that visits parents first. */
@@ -439,7 +375,7 @@ static void source_direction(const double *align, const double *points, long lon
     double d[3];
     for (int e = 0; e < 3; e++)
         d[e] = points[3 * b + e] - points[3 * a + e];
-    apply(align, d, out);
+    mat_vec(align, d, out);
 }
 
 struct job {
@@ -448,23 +384,10 @@ struct job {
     const struct channels *channels; /* per target joint */
     size_t sources;
     int plain_align;                /* A is the identity */
-    double (*unit)[BLOCK];          /* the identity over the block: what a root's rotations start from */
-    double (**global)[BLOCK];       /* each target joint's world rotation over the block: its store or its parent's */
-    double (*store)[9][BLOCK];      /* scratch: the world rotations of mapped joints */
+    const double *unit;             /* the identity over the block: what a root's rotations start from */
+    const double **global;          /* each target joint's world rotation over the block: its store or its parent's */
+    double *store;                  /* scratch: the world rotations of mapped joints (9 BLOCK values a joint) */
 };
-
-/* The frame's values of lane f of a block matrix, and back. */
-static void lane_get(double m[9][BLOCK], int f, double *out)
-{
-    for (int e = 0; e < 9; e++)
-        out[e] = m[e][f];
-}
-
-static void lane_set(double m[9][BLOCK], int f, const double *in)
-{
-    for (int e = 0; e < 9; e++)
-        m[e][f] = in[e];
-}
 
 /*
  * Frames f0 .. f0+n-1 of a chunk (n <= BLOCK): world and points hold the
@@ -488,7 +411,7 @@ static MT_CLONES int retarget_block(const struct job *k, const double *world, co
     for (size_t i = 0; i < target->joints; i++) {
         const size_t j = (size_t)target->order[i];
         const long long p = target->parent[j], s = plan->follow[j];
-        double(*up)[BLOCK] = p >= 0 ? k->global[p] : k->unit;
+        const double *up = p >= 0 ? k->global[p] : k->unit;
         const struct channels *ch = k->channels + j;
         if (s < 0) {
             k->global[j] = up; /* its world rotation is its parent's */
@@ -497,17 +420,16 @@ static MT_CLONES int retarget_block(const struct job *k, const double *world, co
                     rows[f][ch->columns[c]] = 0.0;
             continue;
         }
-        double(*g)[BLOCK] = k->global[j] = k->store[j];
-        double w[9][BLOCK], local[9][BLOCK], m[9][BLOCK];
-        double(*want)[BLOCK] = g; /* three channels make it exactly; fewer overwrite it below */
-        for (int e = 0; e < 9; e++)
-            for (int f = 0; f < BLOCK; f++)
-                w[e][f] = wsrc[f][9 * s + e];
+        double *g = k->store + 9 * BLOCK * j, w[9 * BLOCK], local[9 * BLOCK], m[9 * BLOCK];
+        double *want = g; /* three channels make it exactly; fewer overwrite it below */
+        k->global[j] = g;
+        for (int f = 0; f < BLOCK; f++)
+            lane_set(w, 9, f, wsrc[f] + 9 * s, BLOCK);
         if (k->plain_align) {
-            mul_block_const(w, plan->correction + 9 * j, want);
+            mat_mul_const_n(w, plan->correction + 9 * j, want, BLOCK);
         } else {
-            mul_block_const(w, plan->correction + 9 * j, local);
-            mul_const_block(plan->align, local, want);
+            mat_mul_const_n(w, plan->correction + 9 * j, local, BLOCK);
+            const_mat_mul_n(plan->align, local, want, BLOCK);
         }
         const long long a = plan->key_points[2 * j], b = plan->key_points[2 * j + 1];
         const long long h = plan->hinge[j];
@@ -517,13 +439,13 @@ static MT_CLONES int retarget_block(const struct job *k, const double *world, co
         if (refit || hinged) {
             for (int f = 0; f < BLOCK; f++) {
                 double x[9], turned[9];
-                lane_get(want, f, x);
+                lane_get(want, 9, f, x, BLOCK);
                 if (refit) {
                     double u[3], v[3], fix[9];
                     source_direction(plan->align, psrc[f], a, b, u);
-                    apply(x, plan->key_vector + 3 * j, v);
+                    mat_vec(x, plan->key_vector + 3 * j, v);
                     smallest_rotation(v, u, fix);
-                    mul(fix, x, turned);
+                    mat_mul(fix, x, turned);
                     memcpy(x, turned, sizeof turned);
                 }
                 if (hinged) {
@@ -534,27 +456,23 @@ static MT_CLONES int retarget_block(const struct job *k, const double *world, co
                     source_direction(plan->align, psrc[f], plan->key_points[2 * h], plan->key_points[2 * h + 1], goal);
                     swivel(x, plan->key_vector + 3 * j, plan->aim + 3 * h, hinge, goal);
                 }
-                lane_set(want, f, x);
+                lane_set(want, 9, f, x, BLOCK);
             }
         }
         const double *c9 = target->axis + 9 * j;
         if (ch->plain) {
-            mul_tn_block(up, want, m);
-        } else {
-            double cm[9][BLOCK], ct[9];
-            mul_tn_block(up, want, local);
-            for (int r = 0; r < 3; r++)
-                for (int c = 0; c < 3; c++)
-                    ct[3 * r + c] = c9[3 * c + r];
-            mul_const_block(ct, local, cm);
-            mul_block_const(cm, c9, m);
+            mat_tmul_n(up, want, m, BLOCK);
+        } else { /* C^T (U^T W) C */
+            const double ct[9] = {c9[0], c9[3], c9[6], c9[1], c9[4], c9[7], c9[2], c9[5], c9[8]};
+            mat_tmul_n(up, want, local, BLOCK);
+            conjugate_n(ct, local, m, BLOCK);
         }
         if (ch->count == 3) {
-            double angles[3][BLOCK];
+            double angles[3 * BLOCK];
             euler_block(m, ch->axes, angles);
             for (size_t c = 0; c < 3; c++)
                 for (size_t f = 0; f < n; f++)
-                    rows[f][ch->columns[c]] = angles[c][f] / target->angle_scale;
+                    rows[f][ch->columns[c]] = angles[c * BLOCK + f] / target->angle_scale;
             continue;
         }
         double aim[3];
@@ -563,18 +481,18 @@ static MT_CLONES int retarget_block(const struct job *k, const double *world, co
             aim[e] = c9[e] * rest[0] + c9[3 + e] * rest[1] + c9[6 + e] * rest[2];
         for (int f = 0; f < BLOCK; f++) {
             double x[9], angles[3], achieved[9], cm[9], turn[9], u[9], gf[9];
-            lane_get(m, f, x);
+            lane_get(m, 9, f, x, BLOCK);
             int status = reduce(x, ch->axes, ch->count, aim, angles, achieved);
             if (status != MT_OK)
                 return status;
             if ((size_t)f < n)
                 for (size_t c = 0; c < ch->count; c++)
                     rows[f][ch->columns[c]] = angles[c] / target->angle_scale;
-            mul(c9, achieved, cm);
-            mul_nt(cm, c9, turn);
-            lane_get(up, f, u);
-            mul(u, turn, gf);
-            lane_set(g, f, gf);
+            mat_mul(c9, achieved, cm);
+            mat_mult(cm, c9, turn);
+            lane_get(up, 9, f, u, BLOCK);
+            mat_mul(u, turn, gf);
+            lane_set(g, 9, f, gf, BLOCK);
         }
     }
     return MT_OK;
@@ -600,12 +518,9 @@ int mt_retarget(const double *values, size_t frames, const struct mt_tree *sourc
     struct channels *channels = malloc(jt * sizeof *channels);
     double *points = malloc(CHUNK * js * 3 * sizeof *points);
     double *world = malloc(CHUNK * js * 9 * sizeof *world);
-    double(*store)[9][BLOCK] = malloc(jt * sizeof *store);
-    double(**global)[BLOCK] = malloc(jt * sizeof *global);
-    double unit[9][BLOCK];
-    for (int e = 0; e < 9; e++)
-        for (int f = 0; f < BLOCK; f++)
-            unit[e][f] = identity[e];
+    double *store = malloc(jt * 9 * BLOCK * sizeof *store), unit[9 * BLOCK];
+    const double **global = malloc(jt * sizeof *global);
+    spread_n(identity, 9, unit, BLOCK);
     if (!channels || !points || !world || !store || !global)
         status = MT_ENOMEM;
     for (size_t j = 0; j < jt && status == MT_OK; j++) {

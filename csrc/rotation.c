@@ -8,14 +8,14 @@
  * asin, and series where a quotient tends to 0/0.
  *
  * Every conversion is a stage over LANES rotations at a time, each quantity
- * an array over them (as in blocks.h), so that its loops vectorise, sin, cos
+ * an array over them (as in lanes.h), so that its loops vectorise, sin, cos
  * and atan2 included; enough of them that the stages' long chains of
  * dependent operations overlap.  The entry points run one stage or a few over their
  * arrays; mt_interpolate_euler runs them all, Euler keys to Euler angles, in
  * one pass.
  */
-#include "blocks.h"
 #include "clones.h"
+#include "lanes.h"
 #include "mtcore.h"
 
 #include <float.h>
@@ -25,8 +25,6 @@
 #include <string.h>
 
 enum { LANES = 32 };
-
-static const double pi = 3.14159265358979323846;
 
 /*
  * Below this |cos b| (Tait-Bryan) or |sin b| (proper Euler) the first and
@@ -62,21 +60,19 @@ static MT_CLONES void euler_block(const double *angles, size_t n, const int *axe
 {
     for (size_t f0 = 0; f0 < n; f0 += BLOCK) {
         const size_t m = n - f0 < BLOCK ? n - f0 : BLOCK;
-        double r[9][BLOCK], v[BLOCK], sn[BLOCK], cs[BLOCK];
-        for (int e = 0; e < 9; e++)
-            for (int f = 0; f < BLOCK; f++)
-                r[e][f] = identity[e];
+        double r[9 * BLOCK], v[BLOCK], sn[BLOCK], cs[BLOCK];
+        spread_n(identity, 9, r, BLOCK);
         for (size_t step = 0; step < count; step++) {
             /* each rotation is applied on the left: intrinsic ones in reverse */
             const size_t a = intrinsic ? count - 1 - step : step;
             for (int f = 0; f < BLOCK; f++)
                 v[f] = angles[(f0 + ((size_t)f < m ? (size_t)f : m - 1)) * count + a] * scale;
-            sincos_block(v, sn, cs);
-            rotate_left_block(r, axes[a], sn, cs);
+            sincos_lanes(v, sn, cs, BLOCK);
+            rotate_left_n(r, axes[a], sn, cs, BLOCK);
         }
         for (size_t f = 0; f < m; f++)
             for (int e = 0; e < 9; e++)
-                out[(f0 + f) * 9 + e] = r[e][f];
+                out[(f0 + f) * 9 + e] = r[e * BLOCK + f];
     }
 }
 
