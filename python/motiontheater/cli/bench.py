@@ -150,6 +150,7 @@ def measure(
         "scene": {"source": source, "shape": list(scene.shape), "rows": scene_rows},
         "hour": {"shape": list(hour.shape), "copyto": copyto, "copy": copy, "rows": hour_rows},
         "peers": {name: peer is not None for name, peer in available.items()},
+        "number_code": mtcore.text.number_code(),  # which code writes numbers here (the tables time filters)
     }
 
 
@@ -201,6 +202,7 @@ def markdown(report: dict) -> str:
             f"{hour['copyto'] / r['mtcore_output']:.0%} | {hour['copy'] / r['mtcore']:.0%} | {_t(r.get('scipy'))} | "
             f"{_x(r.get('scipy'), r['mtcore'])} | {_t(r.get('bottleneck'))} | {_x(r.get('bottleneck'), r['mtcore'])} |"
         )
+    lines += ["", f"Numbers are written here by the {report['number_code']} code (mtcore.text.number_code())."]
     missing = [name for name, present in report["peers"].items() if not present]
     if missing:
         lines += ["", f'Not installed, so not measured: {", ".join(missing)} (pip install "motiontheater[bench]").']
