@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
+from conftest import SOURCE, needs_source
 from motiontheater import registry
 from motiontheater.cli import build_parser, main
 
-ROOT = Path(__file__).resolve().parents[1]
-PACKAGE = ROOT / "python" / "motiontheater"
+PACKAGE = SOURCE / "python" / "motiontheater"
 
 
 def imports_of(path: Path) -> set[str]:
@@ -35,6 +35,7 @@ def imports_of(path: Path) -> set[str]:
     return found
 
 
+@needs_source
 def test_imports_flow_one_way():
     graph = {p.stem: imports_of(p) for p in PACKAGE.glob("*.py")}
     for module, imported in graph.items():
@@ -55,18 +56,19 @@ def test_imports_flow_one_way():
     assert order.index("registry") < order.index("motion") < order.index("filtering")
 
 
+@needs_source
 def test_the_cffi_stub_is_generated_from_the_header(tmp_path):
     subprocess.run(
         [
             sys.executable,
-            str(ROOT / "src" / "cffi_build.py"),
+            str(SOURCE / "src" / "cffi_build.py"),
             "--stub",
-            str(ROOT / "csrc" / "mtcore.h"),
+            str(SOURCE / "csrc" / "mtcore.h"),
             str(tmp_path / "stub.pyi"),
         ],
         check=True,
     )
-    committed = (ROOT / "src" / "mtcore" / "_mtcore.pyi").read_text()
+    committed = (SOURCE / "src" / "mtcore" / "_mtcore.pyi").read_text()
     assert (tmp_path / "stub.pyi").read_text() == committed, (
         "src/mtcore/_mtcore.pyi is stale: python src/cffi_build.py --stub csrc/mtcore.h src/mtcore/_mtcore.pyi"
     )
