@@ -1,9 +1,16 @@
+import os
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from corpus import DATA
+
+# The checkout whose own files (the header, the cffi build, the README, fuzz/) some tests read: the one
+# around tests/, or MOTIONTHEATER_SOURCE for a copy of tests/ run against an installed wheel (.ci/wheel).
+SOURCE = Path(os.environ.get("MOTIONTHEATER_SOURCE", Path(__file__).resolve().parents[1]))
+NO_SOURCE = f"no source tree at {SOURCE}: the tests run outside a checkout (set MOTIONTHEATER_SOURCE to one)"
+needs_source = pytest.mark.skipif(not (SOURCE / "csrc" / "mtcore.h").is_file(), reason=NO_SOURCE)
 
 
 @pytest.fixture

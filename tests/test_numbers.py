@@ -13,7 +13,6 @@ import struct
 import subprocess
 import sys
 from decimal import Decimal, localcontext
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,6 +20,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import motiontheater as mt
+from conftest import NO_SOURCE, SOURCE
 from mtcore._mtcore import ffi, lib
 from mtcore.errors import NumberError, SequenceError
 from mtcore.text import (
@@ -683,9 +683,9 @@ def test_files_written_back_byte_for_byte(data_dir, path):
 
 def test_the_table_generator_is_committed():
     """csrc/number_pow10.h is what csrc/gen_pow10.py writes (which also checks the fixed-point logarithms)."""
-    csrc = Path(__file__).resolve().parents[1] / "csrc"
+    csrc = SOURCE / "csrc"
     if not (csrc / "gen_pow10.py").is_file():
-        pytest.skip("csrc/ not beside the tests (an installed copy)")
+        pytest.skip(NO_SOURCE)
     done = subprocess.run([sys.executable, str(csrc / "gen_pow10.py")], capture_output=True, text=True, check=True)
     assert done.stdout == (csrc / "number_pow10.h").read_text()
 

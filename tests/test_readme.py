@@ -4,7 +4,10 @@ import re
 import shutil
 from pathlib import Path
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+from conftest import SOURCE, needs_source
+
+pytestmark = needs_source
+README = SOURCE / "README.md"
 FILES = ("cmu/01.asf", "cmu/01_01.amc", "cmu/02.asf", "cmu/02_01.amc", "cmu/02_02.amc", "bvh/walk01.bvh")
 
 

@@ -4,14 +4,14 @@ bottleneck's func_dict: none missing, none stale, results equal, inputs untouche
 import copy
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from conftest import SOURCE, needs_source
 from twins import EXEMPT, TWINS, Twin
 
-HEADER = Path(__file__).resolve().parents[1] / "csrc" / "mtcore.h"
+HEADER = SOURCE / "csrc" / "mtcore.h"
 
 
 def entry_points(header: str) -> set[str]:
@@ -25,12 +25,14 @@ def test_the_header_parser_finds_declarations():
     assert entry_points(text) == {"mt_a", "mt_c"}
 
 
+@needs_source
 def test_every_entry_point_has_a_twin():
     declared = entry_points(HEADER.read_text())
     missing = declared - TWINS.keys() - EXEMPT.keys()
     assert not missing, f"C entry points without a slow twin in tests/twins (or a reason in EXEMPT): {sorted(missing)}"
 
 
+@needs_source
 def test_no_twin_for_an_entry_point_that_is_gone():
     declared = entry_points(HEADER.read_text())
     assert not (TWINS.keys() | EXEMPT.keys()) - declared
