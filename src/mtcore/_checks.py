@@ -152,15 +152,20 @@ def _array(a, name: str) -> np.ndarray:
 
 def _fits(array: np.ndarray, shape: tuple) -> bool:
     """Whether array has ``shape``: None or a name is any length, a leading ... any leading axes."""
-
-    def free(want) -> bool:
-        return want is None or isinstance(want, str)
-
     if shape[:1] == (...,):
-        trailing = shape[1:]
-        got = array.shape[array.ndim - len(trailing) :]
-        return array.ndim >= len(trailing) and all(free(w) or w == n for w, n in zip(trailing, got))
-    return array.ndim == len(shape) and all(free(w) or w == n for w, n in zip(shape, array.shape))
+        shape = shape[1:]
+        if array.ndim < len(shape):
+            return False
+        got = array.shape[array.ndim - len(shape) :]
+    elif array.ndim != len(shape):
+        return False
+    else:
+        got = array.shape
+    # a plain loop: this runs on every call of the small wrappers, where a generator costs a microsecond
+    for want, n in zip(shape, got):
+        if want != n and want is not None and not isinstance(want, str):
+            return False
+    return True
 
 
 def _shown(shape: tuple) -> str:
