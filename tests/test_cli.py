@@ -34,7 +34,7 @@ def test_demo_smoothing_beats_the_noise(capsys):
 def test_bad_demo_argument_is_one_line_and_nonzero(capsys):
     assert main(["demo", "--size", "0", "--seconds", "1"]) == 2
     err = capsys.readouterr().err
-    assert err.strip() == "motiontheater demo: size must be at least 1, got 0"
+    assert err.strip() == "motiontheater demo: size must be in [1, 2147483647] samples, got 0"
 
 
 def test_console_script_runs_as_module():

@@ -243,7 +243,11 @@ BAD_COMBINE = [
     (dict(old=None, new=None), ValueError, "needs an old or a new motion"),
     (dict(old=np.zeros(5)), ValueError, r"old must be two-dimensional of shape \(any, any\), got shape \(5,\)"),
     (dict(new=np.ones((4, 2))), ValueError, r"new must have the 3 channels of old, got shape \(4, 2\)"),
-    (dict(new=np.ones((4, 3), complex)), TypeError, "new must hold real numbers, got dtype complex128"),
+    (
+        dict(new=np.ones((4, 3), complex)),
+        TypeError,
+        r"^new must hold real numbers \(bool, integer or float\), got dtype complex128$",
+    ),
     (dict(weight=None), TypeError, "weight must be an array, got None"),
     (dict(weight=[[0.0, 1.0]]), ValueError, "weight must be one-dimensional"),
     (dict(weight=[0.0, 1.5]), ValueError, r"weight must lie in \[0, 1\], got weight\[1\] = 1.5"),

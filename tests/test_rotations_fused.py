@@ -177,7 +177,11 @@ def test_interpolate_euler_shapes_and_nothing_to_do(rng):
         (lambda k, t: rot.interpolate_euler(k, k, t, "xyz", extrinsic=True, blend="nlerp"), ValueError, "blend must"),
         (lambda k, t: rot.interpolate_euler(k, k[:1], t, "xyz", extrinsic=True), ValueError, r"k0 and k1 must"),
         (lambda k, t: rot.interpolate_euler(k[None], k[None], t, "xyz", extrinsic=True), ValueError, "frames = len"),
-        (lambda k, t: rot.interpolate_euler(k, k, t[:, None], "xyz", extrinsic=True), ValueError, r"t must have"),
+        (
+            lambda k, t: rot.interpolate_euler(k, k, t[:, None], "xyz", extrinsic=True),
+            ValueError,
+            r"^t must be one-dimensional of shape \(frames,\), got shape \(4, 1\)$",
+        ),
         (lambda k, t: rot.interpolate_euler(k, k, t, "XYZ", extrinsic=True), ValueError, "lowercase"),
         (lambda k, t: rot.interpolate_euler(k, k, t, "xyz", extrinsic=1), TypeError, "extrinsic must"),
         (

@@ -15,7 +15,7 @@ polyphase resampling, gap filling; scipy.signal's signatures) in
 
 from . import errors, signal
 from ._parallel import cpu_count, share_cores
-from .filters import MODES, binomial_filter1d, median_filter1d, pascal_weights, uniform_filter1d
+from .filters import MODES, binomial_filter1d, filter_block, median_filter1d, pascal_weights, uniform_filter1d
 from .text import format_frames, format_number, scan_frames
 
 __all__ = [
@@ -23,6 +23,7 @@ __all__ = [
     "binomial_filter1d",
     "cpu_count",
     "errors",
+    "filter_block",
     "format_frames",
     "format_number",
     "median_filter1d",

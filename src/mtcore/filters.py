@@ -44,11 +44,11 @@ from __future__ import annotations
 
 import functools
 import math
-import operator
 
 import numpy as np
 from numpy.typing import ArrayLike, DTypeLike
 
+from . import _checks
 from ._mtcore import ffi, lib
 from ._parallel import run_ranges, thread_count
 
@@ -112,7 +112,7 @@ def pascal_weights(size: int) -> np.ndarray:
     Returns a new float64 array of length ``size``, 1 to
     :data:`MAX_BINOMIAL_SIZE`.
     """
-    return _pascal(_check_size(size, MAX_BINOMIAL_SIZE, "binomial ")).copy()
+    return _pascal(_check_size(size, binomial=True)).copy()
 
 
 def filter_block(size: int) -> int:
@@ -185,38 +185,20 @@ def binomial_filter1d(
     return _filter1d(lib.MT_FILTER_CORRELATE, input, size, axis, output, mode, cval, origin, workers)
 
 
-def _integer(value, name: str) -> int:
-    try:
-        return operator.index(value)
-    except TypeError:
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}") from None
-
-
-def _check_size(size: int, most: int = MAX_SIZE, what: str = "") -> int:
-    size = _integer(size, "size")
-    if size < 1:
-        raise ValueError(f"size must be at least 1, got {size}")
-    if size > most:
-        hint = " (see mtcore.filters: wider smoothing by uniform_filter1d three times)" if what else ""
-        raise ValueError(f"{what}size must be at most {most} samples, got {size}{hint}")
-    return size
+def _check_size(size, *, binomial: bool = False) -> int:
+    if binomial:
+        note = " samples for the binomial filter (wider smoothing: uniform_filter1d three times; see mtcore.filters)"
+        return _checks.integer(size, "size", 1, MAX_BINOMIAL_SIZE, note=note)
+    return _checks.integer(size, "size", 1, MAX_SIZE, note=" samples")
 
 
 def _work_dtype(dtype: np.dtype, role: str = "input") -> np.dtype:
     """The native float type the C kernel computes ``dtype`` in."""
-    if dtype.kind not in "biuf":
-        raise TypeError(f"{role} must hold real numbers (bool, integer or float), got dtype {dtype}")
+    _checks.real_dtype(dtype, role, "the filters compute in at most float64")
     native = dtype.newbyteorder("=")
     if native in _NATIVE:
         return native
-    if native == np.float16:
-        return _F32
-    if dtype.kind == "f":
-        raise TypeError(
-            f"{dtype} {role} is not supported: the filters compute in at most float64; "
-            "convert with .astype(numpy.float64) if the loss of precision is acceptable"
-        )
-    return _F64
+    return _F32 if native == np.float16 else _F64
 
 
 def _split(workers: int | None, values: int, frames: int, block: int) -> list[int]:
@@ -232,22 +214,14 @@ def _filter1d(kind, input, size, axis, output, mode, cval, origin, workers):
     a = np.asarray(input)
     work = _work_dtype(a.dtype)
     binomial = kind == lib.MT_FILTER_CORRELATE
-    size = _check_size(size, MAX_BINOMIAL_SIZE if binomial else MAX_SIZE, "binomial " if binomial else "")
-    axis = _integer(axis, "axis")
-    if not -a.ndim <= axis < a.ndim:
-        raise np.exceptions.AxisError(axis, a.ndim)
-    axis %= a.ndim
-    try:
-        code = MODES[mode]
-    except (KeyError, TypeError):
-        raise ValueError(f"mode must be one of {', '.join(map(repr, MODES))}; got {mode!r}") from None
+    size = _check_size(size, binomial=binomial)
+    axis = _checks.axis(axis, a.ndim)
+    code = _checks.choice(mode, "mode", MODES)
     try:
         cval = float(cval)
     except (TypeError, ValueError):
         raise TypeError(f"cval must be a real number, got {cval!r}") from None
-    origin = _integer(origin, "origin")
-    if not -(size // 2) <= origin <= (size - 1) // 2:
-        raise ValueError(f"origin must be in [{-(size // 2)}, {(size - 1) // 2}] for size {size}, got {origin}")
+    origin = _checks.integer(origin, "origin", -(size // 2), (size - 1) // 2, note=f" for size {size}")
     target = _target(output, a)
     if kind == lib.MT_FILTER_MEDIAN and not _exact_in_float64(a):
         return _median_by_rank(a, size, axis, target, mode, cval, origin, workers)
@@ -327,10 +301,7 @@ def _target(output, a: np.ndarray) -> np.ndarray:
     if output is None:
         return np.empty(a.shape, a.dtype.newbyteorder("="))
     if isinstance(output, np.ndarray):
-        if output.shape != a.shape:
-            raise ValueError(f"output must have the input's shape {a.shape}, got {output.shape}")
-        if not output.flags.writeable:
-            raise ValueError("output array is read-only")
+        _checks.output(output, "output", a.shape, None, contiguous=False)
         _work_dtype(output.dtype, "output")
         return output
     try:

@@ -37,8 +37,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.lib.array_utils import normalize_axis_index
 
+from . import _checks
 from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._status import check
@@ -72,34 +72,13 @@ ORDERS = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx", "xyx", "xzx", "yxy", "yzy", 
 AXES = {"x": lib.MT_DOF_RX, "y": lib.MT_DOF_RY, "z": lib.MT_DOF_RZ}
 
 
-def _real(a, name: str, trailing: tuple[int, ...]) -> np.ndarray:
-    """``a`` as a C-contiguous float64 array of shape (..., *trailing)."""
-    a = np.asarray(a)
-    if a.dtype.kind not in "biuf":
-        raise TypeError(f"{name} must hold real numbers, got dtype {a.dtype}")
-    if a.ndim < len(trailing) or a.shape[a.ndim - len(trailing) :] != trailing:
-        wanted = ", ".join(["..."] + [str(n) for n in trailing])
-        raise ValueError(f"{name} must have shape ({wanted}), got {a.shape}")
-    return np.asarray(a, dtype=np.float64, order="C")
-
-
-def _flag(value, name: str) -> bool:
-    if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"{name} must be True or False, got {value!r}")
-    return bool(value)
-
-
 def _order(order) -> list[int]:
-    if not isinstance(order, str):
-        raise TypeError(f"order must be a string such as 'xyz', got {type(order).__name__}")
-    if order not in ORDERS:
-        hint = " (lowercase; extrinsic= says fixed or turning axes)" if order.lower() in ORDERS else ""
-        raise ValueError(f"order must be one of {', '.join(ORDERS)}, got {order!r}{hint}")
-    return [AXES[letter] for letter in order]
+    hint = " (lowercase; extrinsic= says fixed or turning axes)" if str(order).lower() in ORDERS else ""
+    return [AXES[letter] for letter in _checks.choice(order, "order", ORDERS, hint=hint)]
 
 
 def _scale(degrees) -> float:
-    return math.pi / 180 if _flag(degrees, "degrees") else 1.0
+    return math.pi / 180 if _checks.flag(degrees, "degrees") else 1.0
 
 
 def _sequence_matrices(angles: np.ndarray, codes: list[int], intrinsic: bool, scale: float) -> np.ndarray:
@@ -148,35 +127,35 @@ def _from_rotvecs(v: np.ndarray) -> np.ndarray:
 
 def euler_to_matrices(angles, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
     """Rotation matrices (..., 3, 3) of Euler angles (..., 3) (see the module's conventions)."""
-    codes, intrinsic, scale = _order(order), not _flag(extrinsic, "extrinsic"), _scale(degrees)
-    return _sequence_matrices(_real(angles, "angles", (3,)), codes, intrinsic, scale)
+    codes, intrinsic, scale = _order(order), not _checks.flag(extrinsic, "extrinsic"), _scale(degrees)
+    return _sequence_matrices(_checks.real(angles, "angles", (..., 3)), codes, intrinsic, scale)
 
 
 def matrices_to_euler(matrices, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
     """Euler angles (..., 3) of rotation matrices (..., 3, 3), in scipy's ranges; c = 0 at gimbal lock."""
-    codes, intrinsic, scale = _order(order), not _flag(extrinsic, "extrinsic"), _scale(degrees)
-    return _euler(_real(matrices, "matrices", (3, 3)), codes, intrinsic, scale)
+    codes, intrinsic, scale = _order(order), not _checks.flag(extrinsic, "extrinsic"), _scale(degrees)
+    return _euler(_checks.real(matrices, "matrices", (..., 3, 3)), codes, intrinsic, scale)
 
 
 def matrices_to_quaternions(matrices) -> np.ndarray:
     """Unit quaternions (..., 4), w >= 0, of rotation matrices (..., 3, 3) (Shepperd's method)."""
-    return _quaternions(_real(matrices, "matrices", (3, 3)))
+    return _quaternions(_checks.real(matrices, "matrices", (..., 3, 3)))
 
 
 def quaternions_to_matrices(quaternions) -> np.ndarray:
     """Rotation matrices (..., 3, 3) of quaternions (..., 4), normalised first."""
-    return _matrices(_real(quaternions, "quaternions", (4,)))
+    return _matrices(_checks.real(quaternions, "quaternions", (..., 4)))
 
 
 def quaternions_to_rotvecs(quaternions) -> np.ndarray:
     """Rotation vectors (..., 3), angles in [0, pi], of quaternions (..., 4).  Accurate at
     angles near 0 (a series) and near pi."""
-    return _rotvecs(_real(quaternions, "quaternions", (4,)))
+    return _rotvecs(_checks.real(quaternions, "quaternions", (..., 4)))
 
 
 def rotvecs_to_quaternions(rotvecs) -> np.ndarray:
     """Unit quaternions (..., 4), w >= 0, of rotation vectors (..., 3), any angle."""
-    return _from_rotvecs(_real(rotvecs, "rotvecs", (3,)))
+    return _from_rotvecs(_checks.real(rotvecs, "rotvecs", (..., 3)))
 
 
 def euler_to_quaternions(angles, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
@@ -186,8 +165,8 @@ def euler_to_quaternions(angles, order: str, *, extrinsic: bool, degrees: bool =
 
 def quaternions_to_euler(quaternions, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
     """Euler angles (..., 3) of quaternions (..., 4), as :func:`matrices_to_euler`."""
-    codes, intrinsic, scale = _order(order), not _flag(extrinsic, "extrinsic"), _scale(degrees)
-    return _euler(_matrices(_real(quaternions, "quaternions", (4,))), codes, intrinsic, scale)
+    codes, intrinsic, scale = _order(order), not _checks.flag(extrinsic, "extrinsic"), _scale(degrees)
+    return _euler(_matrices(_checks.real(quaternions, "quaternions", (..., 4))), codes, intrinsic, scale)
 
 
 def euler_to_rotvecs(angles, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
@@ -197,8 +176,8 @@ def euler_to_rotvecs(angles, order: str, *, extrinsic: bool, degrees: bool = Fal
 
 def rotvecs_to_euler(rotvecs, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
     """Euler angles (..., 3) of rotation vectors (..., 3), as :func:`matrices_to_euler`."""
-    codes, intrinsic, scale = _order(order), not _flag(extrinsic, "extrinsic"), _scale(degrees)
-    return _euler(_matrices(_from_rotvecs(_real(rotvecs, "rotvecs", (3,)))), codes, intrinsic, scale)
+    codes, intrinsic, scale = _order(order), not _checks.flag(extrinsic, "extrinsic"), _scale(degrees)
+    return _euler(_matrices(_from_rotvecs(_checks.real(rotvecs, "rotvecs", (..., 3)))), codes, intrinsic, scale)
 
 
 def matrices_to_rotvecs(matrices) -> np.ndarray:
@@ -213,9 +192,7 @@ def rotvecs_to_matrices(rotvecs) -> np.ndarray:
 
 def _along(a: np.ndarray, axis, name: str, width: int) -> tuple[int, int, int]:
     """(outer, n, inner) of ``a`` (..., width) around its axis of frames ``axis``."""
-    if not isinstance(axis, (int, np.integer)) or isinstance(axis, (bool, np.bool_)):
-        raise TypeError(f"axis must be an integer, got {axis!r}")
-    axis = normalize_axis_index(int(axis), a.ndim)
+    axis = _checks.axis(axis, a.ndim)
     if axis == a.ndim - 1:
         raise ValueError(f"axis must be an axis of frames, not the last axis of {name} (its {width} components)")
     return math.prod(a.shape[:axis]), a.shape[axis], math.prod(a.shape[axis + 1 : -1])
@@ -225,7 +202,7 @@ def unroll_quaternions(quaternions, axis: int = 0) -> np.ndarray:
     """Quaternions (..., 4) with signs continuous along ``axis``: each one after the first
     is negated (the same rotation) where its dot product with the one before is negative.
     A quaternion after a NaN one is kept as it is."""
-    q = _real(quaternions, "quaternions", (4,))
+    q = _checks.real(quaternions, "quaternions", (..., 4))
     outer, n, inner = _along(q, axis, "quaternions", 4)
     out = np.empty_like(q)
     check(lib.mt_unroll_quaternions(c_array(q), outer, n, inner, c_array(out)), "mt_unroll_quaternions")
@@ -240,8 +217,8 @@ def unroll_euler(angles, order: str, *, axis: int = 0, degrees: bool = False) ->
     by any whole turns.  Intrinsic and extrinsic angles alike (``order`` only tells the kind).
     A triple next to one holding NaN is kept as it is.  The split of a + c or a - c at gimbal
     lock is kept as given."""
-    codes, half_turn = _order(order), 180.0 if _flag(degrees, "degrees") else math.pi
-    a = _real(angles, "angles", (3,))
+    codes, half_turn = _order(order), 180.0 if _checks.flag(degrees, "degrees") else math.pi
+    a = _checks.real(angles, "angles", (..., 3))
     outer, n, inner = _along(a, axis, "angles", 3)
     out = np.empty_like(a)
     check(
@@ -265,9 +242,7 @@ def unwrap_angles(
     (last, turns) as returned for the frames before: each column's last finite sample (NaN for
     none) and its whole turns counted (None at a take's start).  Returns (out, last, turns).
     """
-    a = _real(values, "values", ())
-    if a.ndim != 2:
-        raise ValueError(f"values must be (frames, channels), got shape {a.shape}")
+    a = _checks.real(values, "values", ("frames", "channels"))
     out = np.array(a, dtype=np.float64, order="C")
     chosen = _columns(columns, a.shape[1])
     period = float(period)
@@ -313,12 +288,7 @@ def wrap_angles(values: np.ndarray, low, high, period: float, columns=None) -> N
     lie within [0, period] that one, else the column is left; each finite sample outside its
     column's range [a, a + period] becomes ``v - period floor((v - a) / period)``.  The inverse
     of :func:`unwrap_angles` once a take is smoothed."""
-    if not (isinstance(values, np.ndarray) and values.dtype == np.float64 and values.flags.c_contiguous):
-        raise TypeError("values must be a C-contiguous float64 array (it is changed in place)")
-    if values.ndim != 2:
-        raise ValueError(f"values must be (frames, channels), got shape {values.shape}")
-    if not values.flags.writeable:
-        raise ValueError("values must be writeable (it is changed in place)")
+    _checks.output(values, "values (changed in place)", ("frames", "channels"))
     chosen = _columns(columns, values.shape[1])
     low, high = (np.ascontiguousarray(x, dtype=np.float64).reshape(-1) for x in (low, high))
     if low.size != chosen.size or high.size != chosen.size:
@@ -349,9 +319,7 @@ def finite_ranges(
     first), the least and greatest finite sample of each column (+inf and -inf where it has
     none) and its first finite sample (NaN for none).  ``state`` is that of the frames before
     (a take given in pieces), widened into new arrays."""
-    a = _real(values, "values", ())
-    if a.ndim != 2:
-        raise ValueError(f"values must be (frames, channels), got shape {a.shape}")
+    a = _checks.real(values, "values", ("frames", "channels"))
     channels = a.shape[1]
     if state is None:
         low, high, first = np.full(channels, np.inf), np.full(channels, -np.inf), np.full(channels, np.nan)
@@ -368,8 +336,8 @@ def finite_ranges(
 
 def _keys(k0, k1, t, names: tuple[str, str], width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Keys (..., width) and fractions (...) broadcast together, C-contiguous float64."""
-    k0, k1 = _real(k0, names[0], (width,)), _real(k1, names[1], (width,))
-    t = _real(t, "t", ())
+    k0, k1 = _checks.real(k0, names[0], (..., width)), _checks.real(k1, names[1], (..., width))
+    t = _checks.real(t, "t", (...,))
     try:
         shape = np.broadcast_shapes(k0.shape[:-1], k1.shape[:-1], t.shape)
     except ValueError:
@@ -403,7 +371,7 @@ def interpolate_rotvecs(v0, v1, t, *, aligned: bool = False) -> np.ndarray:
     v0 (1 - 2 pi / |v0|), where the keys' quaternions have a negative dot product, so that
     keys near the same rotation interpolate through it."""
     v0, v1, t = _keys(v0, v1, t, ("v0", "v1"), 3)
-    aligned = _flag(aligned, "aligned")
+    aligned = _checks.flag(aligned, "aligned")
     out = np.empty_like(v0)
     check(
         lib.mt_interpolate_rotvecs(c_array(v0), c_array(v1), c_array(t), t.size, aligned, c_array(out)),
@@ -443,13 +411,14 @@ def interpolate_euler(
     rotation vectors, and the one taken may differ.  NaN in a frame gives NaN there; along
     a path, the frame after one holding NaN starts afresh.
     """
-    codes, intrinsic, degrees = _order(order), not _flag(extrinsic, "extrinsic"), _flag(degrees, "degrees")
-    if blend not in BLENDS:
-        raise ValueError(f"blend must be one of {', '.join(BLENDS)}, got {blend!r}")
-    k0, k1 = _real(k0, "k0", (3,)), _real(k1, "k1", (3,))
-    t = _real(t, "t", ())
-    if t.ndim != 1:
-        raise ValueError(f"t must have shape (frames,), got {t.shape}")
+    codes, intrinsic, degrees = (
+        _order(order),
+        not _checks.flag(extrinsic, "extrinsic"),
+        _checks.flag(degrees, "degrees"),
+    )
+    blend_code = _checks.choice(blend, "blend", BLENDS)
+    k0, k1 = _checks.real(k0, "k0", (..., 3)), _checks.real(k1, "k1", (..., 3))
+    t = _checks.real(t, "t", ("frames",))
     frames = len(t)
     if k0.ndim not in (2, 3) or k0.shape != k1.shape or (k0.ndim == 3 and len(k0) != frames):
         raise ValueError(
@@ -461,11 +430,11 @@ def interpolate_euler(
     if start is not None and reference is not None:
         raise ValueError("give start (a path) or reference (nearest turns), not both")
     if start is not None:
-        continuity, ref = lib.MT_CONTINUITY_PATH, _real(start, "start", (3,))
+        continuity, ref = lib.MT_CONTINUITY_PATH, _checks.real(start, "start", (..., 3))
         if ref.shape != (joints, 3):
             raise ValueError(f"start must have shape (joints, 3) = ({joints}, 3), got {ref.shape}")
     elif reference is not None:
-        continuity, ref = lib.MT_CONTINUITY_REFERENCE, _real(reference, "reference", (3,))
+        continuity, ref = lib.MT_CONTINUITY_REFERENCE, _checks.real(reference, "reference", (..., 3))
         if ref.shape != (frames, joints, 3):
             raise ValueError(
                 f"reference must have shape (frames, joints, 3) = ({frames}, {joints}, 3), got {ref.shape}"
@@ -482,7 +451,7 @@ def interpolate_euler(
             ffi.new("int[]", codes),
             intrinsic,
             degrees,
-            BLENDS[blend],
+            blend_code,
             continuity,
             c_array(ref),
             c_array(out),

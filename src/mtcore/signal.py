@@ -29,7 +29,6 @@ thread, -1 uses every core; the result does not depend on it.
 from __future__ import annotations
 
 import math
-import operator
 from collections.abc import Callable, Sequence
 from fractions import Fraction
 from typing import NamedTuple
@@ -37,6 +36,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
+from . import _checks
 from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._parallel import even_bounds, run_ranges, thread_count
@@ -107,23 +107,14 @@ _EXTENSIONS = ("constant", "line", "edge", "smooth", "symmetric", "reflect", "wr
 
 def _float_array(x: ArrayLike, name: str = "x") -> np.ndarray:
     a = np.asarray(x)
-    if a.dtype.kind not in "biuf":
-        raise TypeError(f"{name} must hold real numbers (bool, integer or float), got dtype {a.dtype}")
-    if a.dtype.kind == "f" and a.dtype.itemsize > 8:
-        raise TypeError(f"{a.dtype} {name} is not supported: the signal functions compute in float64")
+    _checks.real_dtype(a.dtype, name, "the signal functions compute in float64")
     return a
 
 
 def _axis(a: np.ndarray, axis) -> int:
-    try:
-        axis = operator.index(axis)
-    except TypeError:
-        raise TypeError(f"axis must be an integer, got {type(axis).__name__}") from None
     if a.ndim == 0:
-        raise ValueError("x must have at least one dimension")
-    if not -a.ndim <= axis < a.ndim:
-        raise np.exceptions.AxisError(axis, a.ndim)
-    return axis % a.ndim
+        raise ValueError("x must have at least one dimension, got a 0-dimensional array")
+    return _checks.axis(axis, a.ndim)
 
 
 def _lines(a: np.ndarray, axis: int) -> np.ndarray:
@@ -163,25 +154,13 @@ def _run_slabs(
     run_ranges(lambda c0, c1: call(src + c0, dst + c0, c1 - c0), bounds, name)
 
 
-def _index(value, name: str, minimum: int = 0) -> int:
-    if isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"{name} must be an integer, got {value!r}")
-    try:
-        value = operator.index(value)
-    except TypeError:
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}") from None
-    if value < minimum:
-        raise ValueError(f"{name} must be at least {minimum}, got {value}")
-    return value
-
-
 # ---------------------------------------------------------------------------
 # the band equaliser
 
 
 def band_count(frames: int) -> int:
     """Bands of a line of ``frames`` samples: floor(log2(frames)) (0 for fewer than 2 frames)."""
-    frames = _index(frames, "frames")
+    frames = _checks.integer(frames, "frames", 0)
     return frames.bit_length() - 1 if frames else 0
 
 
@@ -216,10 +195,7 @@ def equalize(
     """
     a = _float_array(x)
     axis = _axis(a, axis)
-    try:
-        code = _EQUALIZE_MODES[mode]
-    except (KeyError, TypeError):
-        raise ValueError(f"mode must be one of {', '.join(map(repr, _EQUALIZE_MODES))}; got {mode!r}") from None
+    code = _checks.choice(mode, "mode", _EQUALIZE_MODES)
     try:
         g = np.array(gains, dtype=np.float64)
     except (TypeError, ValueError):
@@ -265,11 +241,8 @@ def butter_sos(N: int, Wn: float | Sequence[float], btype: str = "low", *, fs: f
     or "band" (or scipy's "lowpass", "highpass", "bandpass").  A band-pass of
     order N has 2N poles.
     """
-    order = _index(N, "N", 1)
-    try:
-        kind = _BTYPES[btype]
-    except (KeyError, TypeError):
-        raise ValueError(f"btype must be 'low', 'high' or 'band', got {btype!r}") from None
+    order = _checks.integer(N, "N", 1)
+    kind = _checks.choice(btype, "btype", _BTYPES)
     w = np.atleast_1d(np.asarray(Wn, dtype=np.float64))
     if w.ndim != 1 or len(w) != (2 if kind == "band" else 1):
         need = "two frequencies (low, high)" if kind == "band" else "one frequency"
@@ -434,16 +407,13 @@ def sosfiltfilt(
     s = _sos(sos)
     a = _float_array(x)
     axis = _axis(a, axis)
-    try:
-        pad_code = _PADTYPES[padtype]
-    except (KeyError, TypeError):
-        raise ValueError(f"padtype must be 'odd', 'even', 'constant' or None, got {padtype!r}") from None
+    pad_code = _checks.choice(padtype, "padtype", _PADTYPES)
     if padtype is None:
         edge = 0
     elif padlen is None:
         edge = 3 * (2 * len(s) + 1 - min(int((s[:, 2] == 0).sum()), int((s[:, 5] == 0).sum())))
     else:
-        edge = _index(padlen, "padlen")
+        edge = _checks.integer(padlen, "padlen", 0)
     n = a.shape[axis]
     if n <= edge:
         raise ValueError(f"the length of x along axis {axis} ({n}) must be greater than padlen, which is {edge}")
@@ -519,7 +489,7 @@ def residual_cutoff(
     fs = float(fs)
     if not (math.isfinite(fs) and fs > 0):
         raise ValueError(f"fs must be a positive sampling rate in Hz, got {fs}")
-    steps = _index(steps, "steps", 3)
+    steps = _checks.integer(steps, "steps", 3)
     lo, hi = (float(f) for f in fit)
     if not 0 < lo < hi < 1:
         raise ValueError(f"fit must be two fractions of the Nyquist frequency, 0 < low < high < 1; got {fit!r}")
@@ -679,11 +649,8 @@ def resample_poly(
     """
     a = _float_array(x)
     axis = _axis(a, axis)
-    up, down = _index(up, "up", 1), _index(down, "down", 1)
-    if padtype not in _EXTENSIONS and padtype not in _BACKGROUNDS:
-        raise ValueError(
-            f"padtype must be one of {', '.join(map(repr, (*_BACKGROUNDS, *_EXTENSIONS)))}; got {padtype!r}"
-        )
+    up, down = _checks.integer(up, "up", 1), _checks.integer(down, "down", 1)
+    _checks.choice(padtype, "padtype", (*_BACKGROUNDS, *_EXTENSIONS))
     if cval is not None and padtype != "constant":
         raise ValueError(f"cval has no effect with padtype {padtype!r}")
     g = math.gcd(up, down)
@@ -800,11 +767,8 @@ def fill_gaps(
     """
     a = _float_array(x)
     axis = _axis(a, axis)
-    max_gap = _index(max_gap, "max_gap")
-    try:
-        code = _FILL_METHODS[method]
-    except (KeyError, TypeError):
-        raise ValueError(f"method must be 'linear' or 'cubic', got {method!r}") from None
+    max_gap = _checks.integer(max_gap, "max_gap", 0)
+    code = _checks.choice(method, "method", _FILL_METHODS)
     lines = _lines(a, axis)
     if missing is not None:
         flags = np.asarray(missing)
