@@ -73,6 +73,8 @@ AXES = {"x": lib.MT_DOF_RX, "y": lib.MT_DOF_RY, "z": lib.MT_DOF_RZ}
 
 
 def _order(order) -> list[int]:
+    if isinstance(order, str) and order in ORDERS:  # every call asks: the message only for a wrong one
+        return [AXES[letter] for letter in order]
     hint = " (lowercase; extrinsic= says fixed or turning axes)" if str(order).lower() in ORDERS else ""
     return [AXES[letter] for letter in _checks.choice(order, "order", ORDERS, hint=hint)]
 
