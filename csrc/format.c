@@ -62,10 +62,10 @@ struct style {
     struct line_end newline, frame_newline;
 };
 
-/* The bytes of a line ending code; 0 for a code that is none. */
-static int unpack_line_end(int code, struct line_end *end)
+/* The bytes of a line ending (enum mt_newline); 0 for a value that is none. */
+static int unpack_line_end(int newline, struct line_end *end)
 {
-    switch (code) {
+    switch (newline) {
     case MT_NEWLINE_LF:
         *end = (struct line_end){1, {'\n', 0}};
         return 1;

@@ -16,7 +16,7 @@
  * never prints, aborts or exits.  mt_strerror() names a code.
  *
  * The region between the MT_CDEF markers is read by the cffi build
- * (src/mtcore/_cffi_build.py): it must stay plain declarations and enums.
+ * (src/cffi_build.py): it must stay plain declarations and enums.
  */
 #ifndef MTCORE_H
 #define MTCORE_H

@@ -26,6 +26,7 @@ from typing import IO, Any, NamedTuple
 
 import numpy as np
 
+from . import _checks
 from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._parallel import run_all, thread_count
@@ -95,22 +96,11 @@ def _number_code(code: str) -> int:
 def _style(digits: int | None, exponent_digits: int, newline: bytes = b"\n", frame_newline: bytes | None = None):
     """The C style of numbers and lines, checked: see format_frames."""
     if digits is not None:
-        try:
-            digits = operator.index(digits)
-        except TypeError:
-            raise TypeError(f"digits must be None or an integer, got {type(digits).__name__}") from None
-        if not 1 <= digits <= 17:
-            raise ValueError(f"digits must be None (the shortest exact text) or 1 to 17, got {digits}")
-    try:
-        exponent_digits = operator.index(exponent_digits)
-    except TypeError:
-        raise TypeError(f"exponent_digits must be an integer, got {type(exponent_digits).__name__}") from None
-    if not 1 <= exponent_digits <= 3:
-        raise ValueError(f"exponent_digits must be 1, 2 or 3, got {exponent_digits}")
+        digits = _checks.integer(digits, "digits", 1, 17, note=" (or None: the shortest exact text)")
+    exponent_digits = _checks.integer(exponent_digits, "exponent_digits", 1, 3)
     frame_newline = newline if frame_newline is None else frame_newline
-    for name, ending in (("newline", newline), ("frame_newline", frame_newline)):
-        if ending not in _NEWLINES:
-            raise ValueError(f"{name} must be one of {sorted(_NEWLINES)}, got {ending!r}")
+    _checks.choice(newline, "newline", _NEWLINES)
+    _checks.choice(frame_newline, "frame_newline", _NEWLINES)
     return ffi.new(
         "struct mt_format_style *", [digits or 0, exponent_digits, _NEWLINES[newline], _NEWLINES[frame_newline]]
     )
