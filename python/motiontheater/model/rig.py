@@ -73,11 +73,11 @@ class BodyView:
         return self.original.replace(values=values, frame_rate=result.frame_rate, first_frame=result.first_frame)
 
 
-def body_joint(motion: Motion) -> str:
+def body_joint(motion: Motion, still: set[int] | None = None) -> str:
     """The joint that carries the body: the first whose position channels move, else the hips by
-    name, else the root (``"root"``)."""
+    name, else the root (``"root"``).  ``still``: the take's still columns, where known."""
     skeleton = motion.skeleton
-    still = _still_columns(motion)
+    still = _still_columns(motion) if still is None else still
     for joint in skeleton.joint_names:
         columns = [c for c, d in zip(motion.columns(joint), skeleton.dofs(joint)) if d in TRANSLATIONS]
         if any(c not in still for c in columns):
@@ -95,7 +95,7 @@ def body_view(motion: Motion) -> BodyView:
     if skeleton.convention != "bvh" or not motion.frames:
         return identity
     still = _still_columns(motion)
-    body = body_joint(motion)
+    body = body_joint(motion, still)  # one pass over the values for both
     chain = _chain_above(skeleton, body)
     if any(c not in still for joint in chain for c in motion.columns(joint)):
         body, chain = "root", []  # a moving joint above the body: the take is seen from its root
