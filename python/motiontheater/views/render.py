@@ -23,6 +23,7 @@ import numpy as np
 from .._io import Source, output
 from .._optional import require
 from ..model.motion import Motion
+from ..feet.upright import take_up
 from ..model.rig import body_view
 
 FORMATS = ("gif", "mp4")
@@ -105,8 +106,8 @@ def render(
     ``frames`` (first, last frame numbers; default all).  ``size`` is
     (width, height) in pixels (even numbers for MP4).  ``names`` label the
     takes in the corner.  ``up`` is the axis that points up ("y", "z",
-    "-y", ...; default: y for ASF, the one a BVH's figure stands along, see
-    :meth:`~motiontheater.model.skeleton.Skeleton.sizing`): it is drawn up.
+    "-y", ...; default: the first take's, found from its frames, see
+    :func:`~motiontheater.feet.upright.take_up`): it is drawn up.
     Takes are drawn as their bodies (:func:`~motiontheater.model.rig.body_view`):
     the camera follows the joint that travels, and no bone is drawn from a
     static joint above it.  ``progress(done, total)`` is called after each
@@ -143,8 +144,7 @@ def render(
             f"a GIF of {len(shown)} frames is too long (at most {MAX_GIF_FRAMES}, held in memory until written): "
             "choose fewer frames, a lower fps, or write .mp4"
         )
-    axis = up or (takes[0].skeleton.sizing().up if takes[0].skeleton.convention == "bvh" else "y")
-    turn = up_to_y(axis)
+    turn = take_up(takes[0], up).turn
     pictures = _pictures([body_view(m).motion for m in takes], labels, shown, (width, height), follow, turn)
     total = len(shown)
 
@@ -159,24 +159,6 @@ def render(
     else:
         _write_mp4(counted(), target, fps, (width, height))
     return total
-
-
-_UP = {  # a turn (det 1) that takes the axis named up to +y
-    "y": ((1, 0, 0), (0, 1, 0), (0, 0, 1)),
-    "z": ((1, 0, 0), (0, 0, 1), (0, -1, 0)),
-    "x": ((0, -1, 0), (1, 0, 0), (0, 0, 1)),
-    "-y": ((1, 0, 0), (0, -1, 0), (0, 0, -1)),
-    "-z": ((1, 0, 0), (0, 0, -1), (0, 1, 0)),
-    "-x": ((0, 1, 0), (-1, 0, 0), (0, 0, 1)),
-}
-
-
-def up_to_y(up: str) -> np.ndarray:
-    """The rotation (3 x 3) that turns a take whose ``up`` axis is "y", "z", "-y", ... to stand along +y."""
-    key = up.strip().lower().lstrip("+")
-    if key not in _UP:
-        raise ValueError(f"up must be one of {', '.join(_UP)}, got {up!r}")
-    return np.array(_UP[key], dtype=float)
 
 
 def _pictures(takes, labels, shown, size, follow, turn):

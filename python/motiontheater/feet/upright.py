@@ -1,0 +1,78 @@
+"""Which way is up in a take: what the viewer, the renders and the feet's floor stand on.
+
+A rest pose does not tell it: game rigs and Rokoko draw theirs along x, some exports lie down,
+and y-up BVH files and z-up ones use the same grammar.  The frames do: over a take, a person's
+hips are above their ankles.  Where no legs are found by name, the axis (y or z) along which the
+frames span most is up, as :func:`~motiontheater.model.units.size_up_poses` finds it for the
+unit.  ASF/AMC is y-up by Acclaim's convention.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.motion import Motion
+from ..model.rig import body_view
+from ..model.units import size_up_poses
+from .legs import axis_name, parse_up, resolve_legs
+
+SAMPLES = 32  # frames, spread over the take: enough for a mean direction, quick on hours of frames
+
+
+@dataclass(frozen=True)
+class Up:
+    """A take's up axis (``axis``: "y", "-z", ...) and why it is taken as up (``reason``)."""
+
+    axis: str
+    reason: str
+
+    @property
+    def vector(self) -> np.ndarray:
+        """The axis as a unit vector."""
+        return parse_up(self.axis)
+
+    @property
+    def turn(self) -> np.ndarray:
+        """The rotation (3 x 3, det 1) that stands the take along +y, as the viewer and renders draw."""
+        return np.array(_TURNS[self.axis], dtype=float)
+
+
+_TURNS = {  # per up axis, a turn that takes it to +y
+    "y": ((1, 0, 0), (0, 1, 0), (0, 0, 1)),
+    "z": ((1, 0, 0), (0, 0, 1), (0, -1, 0)),
+    "x": ((0, -1, 0), (1, 0, 0), (0, 0, 1)),
+    "-y": ((1, 0, 0), (0, -1, 0), (0, 0, -1)),
+    "-z": ((1, 0, 0), (0, 0, -1), (0, 1, 0)),
+    "-x": ((0, 1, 0), (-1, 0, 0), (0, 0, 1)),
+}
+
+
+def take_up(motion: Motion, up: str | None = None) -> Up:
+    """The up axis of a take: ``up`` where given ("y", "-z"...; ValueError naming what is
+    accepted otherwise), else as the module docstring says."""
+    if up is not None:
+        return Up(axis_name(parse_up(up)), "given")
+    if motion.skeleton.convention != "bvh":
+        return Up("y", "ASF/AMC is y-up by Acclaim's convention")
+    if not motion.frames:
+        return Up(motion.skeleton.sizing().up, "the rest pose spans most along it (the take has no frames)")
+    view = body_view(motion).motion
+    chosen = np.unique(np.linspace(0, view.frames - 1, min(SAMPLES, view.frames)).round().astype(int))
+    poses = view.replace(values=view.values[chosen]).positions()
+    try:
+        legs = resolve_legs(view.skeleton)
+    except ValueError:
+        legs = None
+    if legs is not None:
+        rise = (poses[:, legs.points[:, 0]] - poses[:, legs.points[:, 2]]).reshape(-1, 3)
+        rise = rise[np.isfinite(rise).all(axis=1)]
+        if len(rise) and np.any(mean := rise.mean(axis=0)):
+            return Up(axis_name(mean), f"the hips are above the ankles along it in {_frames(len(chosen))}")
+    axis = size_up_poses(poses).up
+    return Up(axis, f"no legs found by name; {_frames(len(chosen))} span most along it")
+
+
+def _frames(count: int) -> str:
+    return f"{count} frame" if count == 1 else f"{count} frames"
