@@ -22,8 +22,8 @@ import numpy as np
 
 from .._io import Source, output
 from .._optional import require
-from ..model.motion import Motion
 from ..feet.upright import take_up
+from ..model.motion import Motion
 from ..model.rig import body_view
 
 FORMATS = ("gif", "mp4")
