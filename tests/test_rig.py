@@ -117,3 +117,19 @@ def test_a_track_of_another_rate_is_refused_with_the_way_through(data_dir):
     fast = take.replace(frame_rate=4 * take.frame_rate)
     with pytest.raises(ValueError, match=r"new: a motion at 96 Hz and the old one at 24 Hz: .* resample it first"):
         mt.combine(take, fast, cut=(1, 10))
+
+
+@pytest.mark.parametrize("name", ["walk01.bvh", "16_15.bvh"])
+def test_retargeting_from_and_onto_a_game_rig_retargets_its_body(data_dir, name):
+    """A game rig's static root and offset channels are no joints to follow or to drive: from it,
+    the result is the take's own; onto it, the take's layout with its offsets and static root."""
+    take = mt.read_bvh(next(data_dir.glob(f"*/{name}")), unit="cm")
+    game = with_static_root(with_offset_channels(take))
+    cmu = mt.read_asf(data_dir / "cmu" / "01.asf")
+    np.testing.assert_allclose(mt.retarget(game, cmu).values, mt.retarget(take, cmu).values, rtol=0, atol=1e-9)
+    walk = mt.read_amc(data_dir / "cmu" / "01_01.amc", cmu)
+    walk = walk.replace(values=walk.values[:240])
+    onto_game, onto_take = mt.retarget(walk, game.skeleton), mt.retarget(walk, take.skeleton)
+    assert onto_game.skeleton is game.skeleton
+    expected = with_static_root(with_offset_channels(onto_take))
+    np.testing.assert_allclose(onto_game.values, expected.values, rtol=0, atol=1e-9)

@@ -72,6 +72,7 @@ from ..formats.table import read_skeleton, skeleton_suffixes
 from ..model import units
 from ..model.motion import Motion
 from ..model.registry import is_step, step
+from ..model.rig import body_view, rest_values, rest_view
 from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 from . import rigs
 from .rigs import JointMap
@@ -275,7 +276,18 @@ def plan_retarget(
     ValueError naming what is wrong: no joints in common, a map naming
     unknown joints (UnknownNameError), an unknown length unit, a rest pose
     that does not stand, "rotations" for two rigs that differ.
+
+    Both skeletons are planned as their bodies carry them (:func:`~motiontheater.model.rig.rest_view`):
+    a game rig's static root and its position channels that hold only OFFSETs are no joints to
+    follow; the plan's ``source`` and ``target`` are those views.
     """
+    return _plan_of_views(rest_view(source).motion.skeleton, rest_view(target).motion.skeleton, joint_map, mode)
+
+
+def _plan_of_views(
+    source: Skeleton, target: Skeleton, joint_map: JointMap | str | os.PathLike | None, mode: str
+) -> RetargetPlan:
+    """:func:`plan_retarget` of skeletons seen from their bodies (:mod:`motiontheater.model.rig`)."""
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     if isinstance(joint_map, JointMap):
@@ -631,41 +643,32 @@ def retarget(
     Rotation channels come out continuous over frames.  Raises ValueError
     (see :func:`plan_retarget`).
     """
-    source = motion.skeleton
+    seen, on = body_view(motion), rest_view(target)
     if plan is None:
-        plan = plan_retarget(source, target, joint_map, mode=mode)
-    elif plan.source != source or plan.target != target:
+        plan = _plan_of_views(seen.motion.skeleton, on.motion.skeleton, joint_map, mode)
+    elif plan.source != seen.motion.skeleton or plan.target != on.motion.skeleton:
         raise ValueError("the plan given is for other skeletons than the motion's and the target")
-    values = np.zeros((motion.frames, len(target.channels)))
-    _rest_channels(target, values)
+    source, inner = seen.motion, on.motion.skeleton
+    values = rest_values(inner, motion.frames)
     if plan.kernel is None or plan.source_tree is None:
         for a, b in plan.copies:
-            values[:, b] = motion.values[:, a]
+            values[:, b] = source.values[:, a]
     else:
         retarget_rotations(
-            motion.values, plan.source_tree, target.tree, len(target.channels), plan.kernel, out=values, workers=workers
+            source.values, plan.source_tree, inner.tree, len(inner.channels), plan.kernel, out=values, workers=workers
         )
-        _unroll(target, values, plan.kernel.follow)
-    _root_positions(motion, plan, values)
+        _unroll(inner, values, plan.kernel.follow)
+    _root_positions(source, plan, values)
     values.flags.writeable = False
+    result = on.restore(Motion(inner, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame))
     if target.convention == "bvh":
-        header = motion.header if source.convention == "bvh" else ()
+        header = motion.header if motion.skeleton.convention == "bvh" else ()
     else:
         header = (":FULLY-SPECIFIED", ":RADIANS" if target.angle_unit == "rad" else ":DEGREES")
-    result = Motion(target, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame, header=header)
+    result = result.replace(header=header)
     if cleanup and is_step("cleanup"):
         result = result.cleanup(**_cleanup_options(plan))
     return result
-
-
-def _rest_channels(target: Skeleton, values: np.ndarray) -> None:
-    """Translation channels of joints other than the root at rest: a BVH joint's position channels
-    hold its OFFSET (they replace it), ASF translations and stretch 0."""
-    if target.convention != "bvh":
-        return
-    for column, (joint, dof) in enumerate(target.channels):
-        if dof in TRANSLATIONS and not target.is_root(joint):
-            values[:, column] = target.bone(joint).direction[TRANSLATIONS.index(dof)]
 
 
 def _unroll(target: Skeleton, values: np.ndarray, follow: np.ndarray) -> None:

@@ -9,7 +9,8 @@ only an offset folded into the offsets.  ``BodyView.restore`` puts a result back
 take's own layout, every channel the step did not change exactly as found.
 
 - The **body** is the first joint (in the file's order) whose position channels move; where
-  none does, the hips by name; else the root.
+  none does, the hips by name (the root's name first, else the one nearest the root: SMPL-named
+  rigs hold a ``Pelvis_L_Hip`` below their ``Pelvis``); else the root.
 - A position channel **holds an offset** where it is constant over the take to a millionth of
   the figure's size (1.7 µm for a person: below any file's printed precision).
 """
@@ -75,15 +76,17 @@ class BodyView:
 
 def body_joint(motion: Motion, still: set[int] | None = None) -> str:
     """The joint that carries the body: the first whose position channels move, else the hips by
-    name, else the root (``"root"``).  ``still``: the take's still columns, where known."""
+    name (the root's, else the one nearest the root), else the root (``"root"``).  ``still``: the take's still columns, where known."""
     skeleton = motion.skeleton
     still = _still_columns(motion) if still is None else still
     for joint in skeleton.joint_names:
         columns = [c for c, d in zip(motion.columns(joint), skeleton.dofs(joint)) if d in TRANSLATIONS]
         if any(c not in still for c in columns):
             return joint
+    if _HIPS.match(skeleton.root.name):
+        return "root"
     named = [b.name for b in skeleton.bones if _HIPS.match(b.name) and not b.end_site]
-    return named[0] if named else "root"
+    return min(named, key=lambda name: len(_chain_above(skeleton, name))) if named else "root"
 
 
 def body_view(motion: Motion) -> BodyView:
@@ -155,6 +158,26 @@ def body_view(motion: Motion) -> BodyView:
     )
     view = Motion(view_skeleton, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame)
     return BodyView(view, motion, body, np.array(columns, dtype=np.intp), above)
+
+
+def rest_view(skeleton: Skeleton) -> BodyView:
+    """A skeleton seen from its body as :func:`body_view` sees a take of it standing still at rest
+    (every rotation channel zero, every position channel below the root holding its OFFSET): the
+    hips by name carry the body, every other joint's position channels are offsets.  What a plan
+    made for a skeleton without its frames (a retarget target) works on."""
+    return body_view(Motion(skeleton, rest_values(skeleton)))
+
+
+def rest_values(skeleton: Skeleton, frames: int = 1) -> np.ndarray:
+    """(frames, channels) of the skeleton at rest: a BVH joint's position channels below the root
+    hold its OFFSET (they replace it); every other channel (rotations, ASF translations and
+    stretch, the root's position) is zero."""
+    values = np.zeros((frames, len(skeleton.channels)))
+    if skeleton.convention == "bvh":
+        for column, (joint, dof) in enumerate(skeleton.channels):
+            if dof in TRANSLATIONS and not skeleton.is_root(joint):
+                values[:, column] = skeleton.bone(joint).direction[TRANSLATIONS.index(dof)]
+    return values
 
 
 def _still_columns(motion: Motion) -> set[int]:
