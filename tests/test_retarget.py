@@ -102,6 +102,10 @@ CROSS = [
     ("cmu/02_01.amc", "bvh-producers/lafan1-resolved_Geno_bind.bvh"),  # six channels on every joint
     ("bvh-producers/makehuman_cmu_10_01.bvh", "bvh/walk01.bvh"),  # Character Studio names
     ("bvh-producers/video2bvh_cxk.bvh", "cmu/01.asf"),  # z-up, millimetres
+    ("cmu/01_01.amc", "bvh-producers/bvhTools_test2_lafan1.bvh"),  # a rest pose lying along x
+    ("bvh-producers/bvhTools_test2_lafan1.bvh", "cmu/01.asf"),
+    ("cmu/01_01.bvh", "bvh/jesse_dance.bvh"),  # a rest pose whose spine runs along x
+    ("bvh/jesse_dance.bvh", "bvh-producers/bvhTools_test2_lafan1.bvh"),  # neither rest pose stands
 ]
 SEGMENTS = [
     (f"{side}_{a}", f"{side}_{b}")
@@ -339,8 +343,10 @@ def test_unknown_units_are_an_error(data_dir, cmu):
 
 def test_a_rest_pose_that_does_not_stand_is_an_error(data_dir, cmu):
     lying = mt.read_bvh(data_dir / "bvh" / "jesse_dance.bvh").skeleton  # every bone along x at rest
-    with pytest.raises(ValueError, match="does not stand in its rest pose.*OFFSETs"):
-        mt.plan_retarget(cmu.skeleton, lying)
+    mt.plan_retarget(cmu.skeleton, lying)  # planned on the twin of a frame that stands (characters.standing)
+    no_frame = dataclasses.replace(lying, standing=None)  # a skeleton without its take
+    with pytest.raises(ValueError, match="does not stand in its rest pose.*OFFSETs draw, and no frame"):
+        mt.plan_retarget(cmu.skeleton, no_frame)
 
 
 def test_a_length_unit_that_is_only_assumed_is_refused(data_dir, cmu):

@@ -92,7 +92,7 @@ def test_dry_run_prints_the_plan_and_writes_nothing(data_dir, tmp_path, capsys):
     ("target", "map_text", "message"),
     [
         ("bvh/sinusoidal.bvh", None, "no joints in common"),
-        ("bvh/jesse_dance.bvh", None, "the target skeleton 'jesse_dance' does not stand in its rest pose"),
+        ("lying.bvh", None, "the target skeleton 'lying' does not stand in its rest pose"),
         ("bvh/walk01.bvh", '[joints]\nlfemurr = "LeftUpLeg"\n', "map.toml: 'lfemurr' is not a joint of the source"),
         ("bvh/walk01.bvh", '[joints]\nlfemur = "Nowhere"\n', "map.toml: 'Nowhere' is not a joint of the target"),
         ("furlong.asf", None, "unknown length unit 'furlong'"),
@@ -110,6 +110,10 @@ def test_bad_input_is_one_line_and_writes_nothing(data_dir, tmp_path, capsys, ta
         text = (data_dir / "cmu" / "01_01.bvh").read_bytes().replace(b"HipJoint", b"Hip_")
         target_path = tmp_path / target
         target_path.write_bytes(text)
+    elif target == "lying.bvh":  # jesse_dance's rig, every bone along x at rest, and no frame that stands
+        text = (data_dir / "bvh" / "jesse_dance.bvh").read_bytes().split(b"MOTION")[0]
+        target_path = tmp_path / target
+        target_path.write_bytes(text + b"MOTION\nFrames: 0\nFrame Time: 0.0333333\n")
     else:
         target_path = data_dir / target if target != "missing.bvh" else tmp_path / target
     args = ["retarget", str(data_dir / "cmu" / "01_01.amc"), "--to", str(target_path), "-o", str(tmp_path / "o.bvh")]

@@ -46,8 +46,12 @@ footskate cleanup's thresholds in metres: an assumed unit is refused.
 
 *Rest poses*: an ASF's is its calibration pose; a BVH target's is the pose
 its OFFSETs draw with every rotation channel zero (not its first frame), as
-for every BVH reader here.  A rest pose that does not stand (its root not
-above its feet) cannot give a hip height and is refused.
+for every BVH reader here.  A BVH rest pose that does not stand (its root not
+above its feet: rigs whose OFFSETs lie along each bone's own axes, as LAFAN1's
+and Rokoko's do) is replaced by the pose of a frame of its take that stands
+(:mod:`motiontheater.characters.standing`); where none is known it cannot give
+a hip height and is refused.  A game rig's static root and its offset-only
+position channels are seen through its body view (:mod:`motiontheater.model.rig`).
 """
 
 from __future__ import annotations
@@ -72,15 +76,15 @@ from ..formats.table import read_skeleton, skeleton_suffixes
 from ..model import units
 from ..model.motion import Motion
 from ..model.registry import is_step, step
-from ..model.rig import body_view, rest_values, rest_view
+from ..model.rig import STANDING, BodyView, body_view, rest_values, rest_view, standing_height
 from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 from . import rigs
 from .rigs import JointMap
+from .standing import Rested, rested
 
 MODES = ("auto", "rotations", "directions")
 DEGENERATE = 1e-3
 """A segment shorter than this fraction of its rest pose's size has no direction to follow."""
-STANDING = 0.25
 """A rest pose stands when its root is at least this fraction of its size above its lowest point."""
 
 
@@ -281,7 +285,18 @@ def plan_retarget(
     a game rig's static root and its position channels that hold only OFFSETs are no joints to
     follow; the plan's ``source`` and ``target`` are those views.
     """
-    return _plan_of_views(rest_view(source).motion.skeleton, rest_view(target).motion.skeleton, joint_map, mode)
+    planned = _planned_rig(rest_view(source), source.standing)[0]
+    return _plan_of_views(planned, _planned_rig(rest_view(target), target.standing)[0], joint_map, mode)
+
+
+def _planned_rig(view: BodyView, standing: tuple[float, ...] | None) -> tuple[Skeleton, Rested | None]:
+    """The skeleton a plan works on for a rig seen from its body: the view's, or where its rest
+    pose does not stand and a standing frame is known, its re-rested twin (:mod:`.standing`)."""
+    skeleton = view.motion.skeleton
+    if standing is None or standing_height(skeleton.rest_positions()) > STANDING:
+        return skeleton, None
+    twin = rested(skeleton, np.asarray(standing)[view.columns])
+    return (skeleton, None) if twin is None else (twin.skeleton, twin)
 
 
 def _plan_of_views(
@@ -400,7 +415,11 @@ def _hip_height(pose: _Pose, up: np.ndarray, side: str) -> float:
             f"the {side} skeleton '{name}' does not stand in its rest pose: its root is {height:.4g} units above "
             f"its lowest point along {_axis_name(up)}, in a pose {pose.size:.4g} units across, so its leg length "
             "(hip height at rest) cannot be measured"
-            + (" (a BVH's rest pose is the one its OFFSETs draw)" if pose.skeleton.convention == "bvh" else "")
+            + (
+                " (a BVH's rest pose is the one its OFFSETs draw, and no frame of its take was found to stand)"
+                if pose.skeleton.convention == "bvh"
+                else ""
+            )
         )
     return height
 
@@ -644,23 +663,30 @@ def retarget(
     (see :func:`plan_retarget`).
     """
     seen, on = body_view(motion), rest_view(target)
+    source, source_twin = _planned_rig(seen, motion.skeleton.standing)
+    inner, target_twin = _planned_rig(on, target.standing)
     if plan is None:
-        plan = _plan_of_views(seen.motion.skeleton, on.motion.skeleton, joint_map, mode)
-    elif plan.source != seen.motion.skeleton or plan.target != on.motion.skeleton:
+        plan = _plan_of_views(source, inner, joint_map, mode)
+    elif plan.source != source or plan.target != inner:
         raise ValueError("the plan given is for other skeletons than the motion's and the target")
-    source, inner = seen.motion, on.motion.skeleton
+    moves = seen.motion.values if source_twin is None else source_twin.into(seen.motion.values)
     values = rest_values(inner, motion.frames)
     if plan.kernel is None or plan.source_tree is None:
         for a, b in plan.copies:
-            values[:, b] = source.values[:, a]
+            values[:, b] = moves[:, a]
     else:
         retarget_rotations(
-            source.values, plan.source_tree, inner.tree, len(inner.channels), plan.kernel, out=values, workers=workers
+            moves, plan.source_tree, inner.tree, len(inner.channels), plan.kernel, out=values, workers=workers
         )
-        _unroll(inner, values, plan.kernel.follow)
-    _root_positions(source, plan, values)
+    if target_twin is not None:
+        values = target_twin.back(values)
+    if plan.kernel is not None:
+        _unroll(on.motion.skeleton, values, plan.kernel.follow)
+    _root_positions(Motion(source, moves, frame_rate=motion.frame_rate), plan, values)
     values.flags.writeable = False
-    result = on.restore(Motion(inner, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame))
+    result = on.restore(
+        Motion(on.motion.skeleton, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame)
+    )
     if target.convention == "bvh":
         header = motion.header if motion.skeleton.convention == "bvh" else ()
     else:

@@ -21,6 +21,7 @@ from mtcore.text import format_number, format_table, parse_number, scan_table
 from .._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
 from ..model.motion import Motion
 from ..model.rates import rate_of_frame_time
+from ..model.rig import STANDING, standing_height
 from ..model.skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem, settle_length_unit
 from ..model.units import size_up_poses
 
@@ -75,13 +76,23 @@ POSES = 16  # frames of a take sized where its rest pose is no standing pose
 
 def _posed(motion: Motion) -> Skeleton:
     """The skeleton, sized from the take's poses where its rest pose tells no unit or tells it
-    only by an extent other than its height (a rig drawn along x, a rest pose lying down)."""
+    only by an extent other than its height (a rig drawn along x, a rest pose lying down); and
+    where the rest pose does not stand, with the channels of the frame that stands best
+    (``Skeleton.standing``: what retargeting plans such a rig on)."""
     skeleton = motion.skeleton
     rest = skeleton.sizing()
-    if (rest.unit is not None and rest.axis == rest.up) or not motion.frames:
+    stands = standing_height(skeleton.rest_positions()) > STANDING
+    if (rest.unit is not None and rest.axis == rest.up and stands) or not motion.frames:
         return skeleton
     chosen = np.unique(np.linspace(0, motion.frames - 1, min(POSES, motion.frames)).round().astype(int))
     poses = motion.replace(values=motion.values[chosen]).positions()
+    if not stands:
+        heights = [standing_height(pose) for pose in poses]
+        best = int(np.argmax(heights))
+        if heights[best] > STANDING:
+            skeleton = replace(skeleton, standing=tuple(float(v) for v in motion.values[chosen[best]]))
+    if rest.unit is not None and rest.axis == rest.up:
+        return skeleton
     posed = size_up_poses(poses, cmu=skeleton.cmu_named)
     return replace(skeleton, posed=posed) if posed.unit is not None else skeleton
 

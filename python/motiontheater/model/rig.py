@@ -29,6 +29,7 @@ from .skeleton import ROTATIONS, TRANSLATIONS, Bone, Root, Skeleton, canonical_h
 
 _HIPS = re.compile(r"^(?:.*[:_|])?(?:hips?|pelvis)$", re.IGNORECASE)
 STILL = 1e-6  # of the figure's size: a channel whose spread is below it holds an offset
+STANDING = 0.25  # of a pose's largest extent: the least height of a standing figure's root
 
 
 @dataclass(frozen=True)
@@ -178,6 +179,18 @@ def rest_values(skeleton: Skeleton, frames: int = 1) -> np.ndarray:
             if dof in TRANSLATIONS and not skeleton.is_root(joint):
                 values[:, column] = skeleton.bone(joint).direction[TRANSLATIONS.index(dof)]
     return values
+
+
+def standing_height(points: np.ndarray) -> float:
+    """How high the root (point 0) of a pose (points, 3) stands above its lowest point, along y or
+    z (whichever the pose spans more), as a fraction of the pose's largest extent (NaN: 0)."""
+    points = np.asarray(points, dtype=float)
+    finite = points[np.isfinite(points).all(axis=1)]
+    if len(points) < 2 or not np.isfinite(points[0]).all() or len(finite) < 2:
+        return 0.0
+    spans = np.ptp(finite, axis=0)
+    up = 2 if spans[2] > spans[1] else 1
+    return float((points[0, up] - finite[:, up].min()) / spans.max()) if spans.max() > 0 else 0.0
 
 
 def _still_columns(motion: Motion) -> set[int]:

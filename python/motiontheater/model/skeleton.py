@@ -126,6 +126,8 @@ class Skeleton:
     convention: str = "asf"  # "asf", or "bvh": a joint's offset turns with its parent, see kinematics
     length_choice: tuple[str, str] | None = None
     posed: length_units.Sizing | None = field(default=None, compare=False, repr=False)
+    # a frame's channels in which the figure stands, where the rest pose does not (formats.bvh)
+    standing: tuple[float, ...] | None = field(default=None, compare=False, repr=False)
     style: TextStyle = field(default=PLAIN, compare=False, repr=False)  # how its ASF file was laid out
     origin: Origin | None = field(default=None, compare=False, repr=False)  # the ASF file it was read from
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
