@@ -10,6 +10,7 @@ import motiontheater as mt
 from corpus import ids, real_files
 from motiontheater.cli import main
 from motiontheater.cli.info import as_text, describe
+from variants import with_offset_channels, with_static_root
 
 TAKES = real_files("*/*.bvh") + real_files("*/*.amc")
 
@@ -173,3 +174,22 @@ def test_batch_reads_with_the_unit_given(data_dir, tmp_path):
     args = ["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--recipe", str(tmp_path / "r.toml")]
     assert main([*args, "--jobs", "1", "--quiet", "--unit", "mm"]) == 0
     assert (tmp_path / "out" / "walk01.csv").read_text().split(",")[2] == "Hips.x [mm]"
+
+
+def test_a_game_rig_names_its_body_its_static_root_and_its_offset_channels(data_dir, tmp_path):
+    take = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    game = with_static_root(with_offset_channels(take), turn=(90.0, 0.0, 0.0), keep_world=False)
+    path = tmp_path / "game.bvh"
+    mt.write_bvh(game, path)
+    facts = describe(mt.read_bvh(path), path)
+    moving = [j for j in take.skeleton.bone_names if take.skeleton.dofs(j) and not take.skeleton.bone(j).end_site]
+    assert facts["body"] == {
+        "joint": "Hips",
+        "why": "the first joint in the file whose position channels move; the joints above it stand still (Reference)",
+        "static_joints": ["Reference"],
+        "offset_channels": 3 * len(moving),
+        "offset_joints": len(moving),
+    }
+    assert facts["up_axis"] == "z" and "hips are above the ankles" in facts["up_reason"]
+    text = as_text(facts)
+    assert "body         Hips: the first joint" in text and "only hold their OFFSET" in text

@@ -18,10 +18,13 @@ from typing import Any
 
 import numpy as np
 
+from ..feet.upright import take_up
 from ..formats.bvh import NAMES as BVH_CHANNEL_NAMES
 from ..formats.table import format_for, format_of, skeleton_for, states_unit
 from ..model import units
 from ..model.motion import Motion
+from ..model.rig import body_view
+from ..model.skeleton import TRANSLATIONS
 from .takes import add_take_options, take_of
 from .verb import Verb
 
@@ -50,6 +53,8 @@ def describe(
     bvh = skeleton.convention == "bvh"
     meters = skeleton.meters_per_unit
     sizing = skeleton.sizing()
+    up = take_up(motion)
+    axis = up.axis.lstrip("-")
     first = motion.positions()[0] if motion.frames else None
     lows, highs = _ranges(motion.values)
     joints = []
@@ -96,15 +101,17 @@ def describe(
             "why": _why(skeleton, sizing),
             "how_to_set": SET_UNIT,
         },
-        "up_axis": sizing.up,
+        "up_axis": up.axis,
+        "up_reason": up.reason,
+        "body": _body(motion),
         "rest_pose": {
             "extents": list(sizing.extents),
             "extents_m": [e * meters for e in sizing.extents],
-            "height": sizing.height,
-            "height_m": sizing.height * meters,
+            "height": sizing.extents["xyz".index(axis)],
+            "height_m": sizing.extents["xyz".index(axis)] * meters,
         },
-        "first_frame_height": None if first is None else _clean(_extent(first, sizing.up)),
-        "first_frame_height_m": None if first is None else _clean(_extent(first, sizing.up) * meters),
+        "first_frame_height": None if first is None else _clean(_extent(first, axis)),
+        "first_frame_height_m": None if first is None else _clean(_extent(first, axis) * meters),
         "channels": len(skeleton.channels),
         "joints": joints,
     }
@@ -128,11 +135,20 @@ def as_text(facts: dict[str, Any]) -> str:
     )
     unit_name = label if label == "m" else f"{label} = {_g(meters)} m"
     field(lines, "length unit", f"{unit_name}, {unit['source']}: {unit['why']}. {SET_UNIT[0].upper()}{SET_UNIT[1:]}")
-    field(lines, "up axis", f"{facts['up_axis']} (of y and z, the one the rest pose spans more)")
+    field(lines, "up axis", f"{facts['up_axis']}: {facts['up_reason']}. Set another with --up AXIS where a verb has it")
+    body = facts["body"]
+    field(lines, "body", f"{body['joint']}: {body['why']}")
+    if body["offset_channels"]:
+        field(
+            lines,
+            "offsets",
+            f"{body['offset_channels']} position channels of {body['offset_joints']} joints below it only hold "
+            "their OFFSET (constant over the take): steps treat them as offsets and write them back as found",
+        )
     height = f"{_g(rest['height_m'])} m = {_g(rest['height'])} {label} in the rest pose"
     if facts["first_frame_height"] is not None:
         height += f", {_g(facts['first_frame_height_m'])} m = {_g(facts['first_frame_height'])} {label} in frame 1"
-    field(lines, "height", f"{height} (the extent along {facts['up_axis']})")
+    field(lines, "height", f"{height} (the extent along {facts['up_axis'].lstrip('-')})")
     extents = " x ".join(_g(e) for e in rest["extents"])
     field(lines, "rest pose", f"{extents} {label} along x, y, z")
     joints = facts["joints"]
@@ -229,6 +245,50 @@ def _why(skeleton, sizing: units.Sizing) -> str:
         f"{sizing.up}, {_g(max(sizing.extents))} at most) a human size ({low:g} to {high:g} m), so {unit}, "
         f"the unit of most BVH files, is assumed"
     )
+
+
+def _body(motion: Motion) -> dict[str, Any]:
+    """Which joint carries the body and why; which joints above it stand still, and how many
+    position channels below it only hold offsets (:mod:`motiontheater.model.rig`)."""
+    skeleton = motion.skeleton
+    view = body_view(motion)
+    kept = set(view.columns.tolist())
+    above = [] if view.body == "root" else _chain(skeleton, view.body)
+    offsets = [
+        (joint, column)
+        for joint in skeleton.bone_names
+        if joint != view.body and joint not in above
+        for column, dof in zip(motion.columns(joint), skeleton.dofs(joint))
+        if dof in TRANSLATIONS and column not in kept
+    ]
+    name = skeleton.root.name if view.body == "root" else view.body
+    if skeleton.convention != "bvh":
+        why = "the root of an ASF skeleton carries the body"
+    elif view.body == "root" and not above:
+        why = "the root carries the body"
+    elif any(np.ptp(motion.values[:, c]) > 0 for c in motion.columns(view.body) if motion.frames):
+        why = "the first joint in the file whose position channels move"
+    else:
+        why = "named as the hips; no position channel moves"
+    if above:
+        why += (
+            f"; the joints above it stand still ({', '.join(skeleton.root.name if j == 'root' else j for j in above)})"
+        )
+    return {
+        "joint": name,
+        "why": why,
+        "static_joints": [skeleton.root.name if j == "root" else j for j in above],
+        "offset_channels": len(offsets),
+        "offset_joints": len({j for j, _ in offsets}),
+    }
+
+
+def _chain(skeleton, joint: str) -> list[str]:
+    chain = []
+    while joint != "root":
+        joint = skeleton.parent(joint)
+        chain.append(joint)
+    return chain[::-1]
 
 
 def _ranges(values: np.ndarray) -> tuple[list[float | None], list[float | None]]:
