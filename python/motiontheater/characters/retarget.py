@@ -76,7 +76,7 @@ from ..formats.table import read_skeleton, skeleton_suffixes
 from ..model import units
 from ..model.motion import Motion
 from ..model.registry import is_step, step
-from ..model.rig import STANDING, BodyView, body_view, rest_values, rest_view, standing_height
+from ..model.rig import STANDING, BodyView, body_view, rest_values, rest_view, standing_frame, standing_height
 from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 from . import rigs
 from .rigs import JointMap
@@ -663,13 +663,14 @@ def retarget(
     (see :func:`plan_retarget`).
     """
     seen, on = body_view(motion), rest_view(target)
-    source, source_twin = _planned_rig(seen, motion.skeleton.standing)
+    source, source_twin = _planned_rig(seen, motion.skeleton.standing or standing_frame(motion))
     inner, target_twin = _planned_rig(on, target.standing)
     if plan is None:
         plan = _plan_of_views(source, inner, joint_map, mode)
     elif plan.source != source or plan.target != inner:
         raise ValueError("the plan given is for other skeletons than the motion's and the target")
-    moves = seen.motion.values if source_twin is None else source_twin.into(seen.motion.values)
+    moves = seen.unturned().values  # a static root's turn is the file's axes, not the body's motion
+    moves = moves if source_twin is None else source_twin.into(moves)
     values = rest_values(inner, motion.frames)
     if plan.kernel is None or plan.source_tree is None:
         for a, b in plan.copies:

@@ -24,7 +24,7 @@ from mtcore.combine import combine_frames
 
 from ..model.errors import UnknownNameError
 from ..model.motion import Motion
-from ..model.rig import body_view
+from ..model.rig import body_view, pose_up
 from ..model.skeleton import TRANSLATIONS
 
 PRESERVE = (None, "literal", "ground")
@@ -311,7 +311,8 @@ def combine(old: Motion, new: Motion, **options: Any) -> Motion:
       of repeated frames become linear ramps to the next source frame.
     - ``rotation_blend``: "slerp" (quaternions, for joints with three rotation
       channels) or "linear" on the stored Euler angles (the thesis).
-    - ``up``: the vertical axis for "ground" ("x", "y" or "z"; "y" by default).
+    - ``up``: the vertical axis for "ground" ("x", "y" or "z"; default: y for ASF/AMC, for BVH
+      the one the old take's poses stand along, :func:`~motiontheater.model.rig.pose_up`).
     - ``workers``: threads, as for the filters.
     Raises ValueError naming the argument at fault.  The options and their
     defaults are those of :func:`combine_planned` and :func:`plan`.
@@ -325,7 +326,7 @@ def combine_planned(
     *,
     joints: Iterable[str] | None = None,
     rotation_blend: str = "slerp",
-    up: str = "y",
+    up: str | None = None,
     workers: int | None = None,
     **frame_map: Any,
 ) -> tuple[Plan, Motion]:
@@ -349,6 +350,7 @@ def combine_planned(
         return p, seen.restore(result)
     if rotation_blend not in ROTATION_BLENDS:
         raise ValueError(f"rotation_blend must be one of {ROTATION_BLENDS}, got {rotation_blend!r}")
+    up = pose_up(old) if up is None else up
     if up not in UP_AXES:
         raise ValueError(f"up must be one of {UP_AXES}, got {up!r}")
     skeleton = old.skeleton
@@ -473,6 +475,15 @@ def _root_offsets(old: Motion, new: Motion, p: Plan, up: str):
     return offset_row, np.concatenate(tables), root.tolist()
 
 
+def _forward_axis(turns: np.ndarray, up: int) -> int:
+    """The root's own axis whose heading is the take's: z, else x, else y, the first that lies
+    within 60 degrees of the ground plane over the take's root rotations (frames, 3, 3).  Chosen
+    by the frames, not the world's up alone, so that a take turned by a static root (a z-up
+    export) is spliced with the turn it has y-up."""
+    tilt = np.nanmean(np.abs(turns[:, up, :]), axis=0) if len(turns) else np.zeros(3)
+    return next((k for k in (2, 0, 1) if tilt[k] < 0.5), 2 if up != 2 else 0)
+
+
 def _ground_moved(motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: np.ndarray, up: str) -> np.ndarray:
     """Root channel rows moved rigidly so that ``start`` lands on ``anchor``: translated on the
     ground plane, turned about the ``up`` axis to the anchor's heading."""
@@ -489,10 +500,12 @@ def _ground_moved(motion: Motion, rows: np.ndarray, start: np.ndarray, anchor: n
     def matrices(angles: np.ndarray) -> np.ndarray:
         return rot.euler_to_matrices(angles, axes, extrinsic=extrinsic, degrees=degrees)
 
+    forward = _forward_axis(matrices(motion.values[:, rot_cols]), u)
+
     def heading(row: np.ndarray) -> float:
         m = matrices(row[r_cols])
-        forward = m[:, ground[1]] if up != "z" else m[:, 0]  # the root's forward, on the ground
-        return math.atan2(forward[ground[0]], forward[ground[1]])
+        # the angle about up, right-handed: from axis u+1 towards axis u+2 (z to x about y, x to y about z)
+        return math.atan2(m[(u + 2) % 3, forward], m[(u + 1) % 3, forward])
 
     turn = heading(anchor) - heading(start)
     spin = rot.rotvecs_to_matrices(np.eye(3)[u] * turn)

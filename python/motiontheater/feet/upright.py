@@ -14,11 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.motion import Motion
-from ..model.rig import body_view
-from ..model.units import size_up_poses
+from ..model.rig import body_view, pose_up, sampled_poses
 from .legs import axis_name, parse_up, resolve_legs
-
-SAMPLES = 32  # frames, spread over the take: enough for a mean direction, quick on hours of frames
 
 
 @dataclass(frozen=True)
@@ -57,21 +54,18 @@ def take_up(motion: Motion, up: str | None = None) -> Up:
     if motion.skeleton.convention != "bvh":
         return Up("y", "ASF/AMC is y-up by Acclaim's convention")
     if not motion.frames:
-        return Up(motion.skeleton.sizing().up, "the rest pose spans most along it (the take has no frames)")
-    view = body_view(motion).motion
-    chosen = np.unique(np.linspace(0, view.frames - 1, min(SAMPLES, view.frames)).round().astype(int))
-    poses = view.replace(values=view.values[chosen]).positions()
+        return Up(pose_up(motion), "the rest pose spans most along it (the take has no frames)")
+    poses = sampled_poses(motion)
     try:
-        legs = resolve_legs(view.skeleton)
+        legs = resolve_legs(body_view(motion).motion.skeleton)
     except ValueError:
         legs = None
     if legs is not None:
         rise = (poses[:, legs.points[:, 0]] - poses[:, legs.points[:, 2]]).reshape(-1, 3)
         rise = rise[np.isfinite(rise).all(axis=1)]
         if len(rise) and np.any(mean := rise.mean(axis=0)):
-            return Up(axis_name(mean), f"the hips are above the ankles along it in {_frames(len(chosen))}")
-    axis = size_up_poses(poses).up
-    return Up(axis, f"no legs found by name; {_frames(len(chosen))} span most along it")
+            return Up(axis_name(mean), f"the hips are above the ankles along it in {_frames(len(poses))}")
+    return Up(pose_up(motion), f"no legs found by name; {_frames(len(poses))} span most along it")
 
 
 def _frames(count: int) -> str:

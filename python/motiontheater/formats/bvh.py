@@ -21,7 +21,7 @@ from mtcore.text import format_number, format_table, parse_number, scan_table
 from .._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
 from ..model.motion import Motion
 from ..model.rates import rate_of_frame_time
-from ..model.rig import STANDING, standing_height
+from ..model.rig import STANDING, sampled_poses, standing_frame, standing_height
 from ..model.skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem, settle_length_unit
 from ..model.units import size_up_poses
 
@@ -71,9 +71,6 @@ def read_bvh(source: Source, *, unit: str | None = None, frame_rate: float | Non
     return motion.replace(frame_rate=float(frame_rate))  # no longer the file's: written with its own Frame Time
 
 
-POSES = 16  # frames of a take sized where its rest pose is no standing pose
-
-
 def _posed(motion: Motion) -> Skeleton:
     """The skeleton, sized from the take's poses where its rest pose tells no unit or tells it
     only by an extent other than its height (a rig drawn along x, a rest pose lying down); and
@@ -84,16 +81,11 @@ def _posed(motion: Motion) -> Skeleton:
     stands = standing_height(skeleton.rest_positions()) > STANDING
     if (rest.unit is not None and rest.axis == rest.up and stands) or not motion.frames:
         return skeleton
-    chosen = np.unique(np.linspace(0, motion.frames - 1, min(POSES, motion.frames)).round().astype(int))
-    poses = motion.replace(values=motion.values[chosen]).positions()
     if not stands:
-        heights = [standing_height(pose) for pose in poses]
-        best = int(np.argmax(heights))
-        if heights[best] > STANDING:
-            skeleton = replace(skeleton, standing=tuple(float(v) for v in motion.values[chosen[best]]))
+        skeleton = replace(skeleton, standing=standing_frame(motion))
     if rest.unit is not None and rest.axis == rest.up:
         return skeleton
-    posed = size_up_poses(poses, cmu=skeleton.cmu_named)
+    posed = size_up_poses(sampled_poses(motion), cmu=skeleton.cmu_named)
     return replace(skeleton, posed=posed) if posed.unit is not None else skeleton
 
 

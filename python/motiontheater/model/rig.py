@@ -22,12 +22,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mtcore.rotations import euler_to_matrices, matrices_to_euler
+from mtcore.rotations import euler_to_matrices, matrices_to_euler, unroll_euler
 
 from .motion import Motion
 from .skeleton import ROTATIONS, TRANSLATIONS, Bone, Root, Skeleton, canonical_hierarchy
+from .units import size_up_poses
 
-_HIPS = re.compile(r"^(?:.*[:_|])?(?:hips?|pelvis)$", re.IGNORECASE)
+_HIPS = re.compile(r"^(?:.*[:_| ])?(?:hips?|pelvis)$", re.IGNORECASE)  # mixamorig:Hips, Bip01 Pelvis
 STILL = 1e-6  # of the figure's size: a channel whose spread is below it holds an offset
 STANDING = 0.25  # of a pose's largest extent: the least height of a standing figure's root
 
@@ -52,6 +53,20 @@ class BodyView:
     def identity(self) -> bool:
         """Whether the view is the take itself (nothing static above the body, nothing folded)."""
         return self.motion is self.original
+
+    def unturned(self) -> Motion:
+        """The view with the static joints' turn taken out (their shift kept): the body as it moves
+        in the axes the static joints stand it in.  A z-up export whose static root turns a y-up
+        take is y-up here, as its rest pose is: what retargeting compares rest poses by."""
+        if self.above is None or np.allclose(self.above[:3, :3], np.eye(3), rtol=0, atol=1e-12):
+            return self.motion
+        back = np.eye(4)
+        back[:3, :3] = self.above[:3, :3].T
+        order = self.motion.skeleton.root.order
+        values = np.array(self.motion.values)
+        values[:, : len(order)] = _through(values[:, : len(order)], order, back)
+        values.flags.writeable = False
+        return self.motion.replace(values=values)
 
     def restore(self, result: Motion) -> Motion:
         """A result computed on the view, in the take's layout: the view's channels put back
@@ -181,6 +196,42 @@ def rest_values(skeleton: Skeleton, frames: int = 1) -> np.ndarray:
     return values
 
 
+POSES = 32  # frames, spread over a take, whose poses tell its up axis: quick on hours of frames
+
+
+def sampled_poses(motion: Motion) -> np.ndarray:
+    """World positions (poses, points, 3) of up to :data:`POSES` frames spread over the take, as
+    its body view draws them (the static joints' turn folded in)."""
+    view = body_view(motion).motion
+    return view.replace(values=view.values[_sampled(view.frames)]).positions()
+
+
+def _sampled(frames: int) -> np.ndarray:
+    return np.unique(np.linspace(0, frames - 1, min(POSES, frames)).round().astype(int))
+
+
+def pose_up(motion: Motion) -> str:
+    """ "y" or "z": the axis along which most of the take's poses stand taller (the rest pose's
+    where it has no frames); ASF/AMC is y-up by Acclaim's convention.  Where legs are known by
+    name, :func:`motiontheater.feet.upright.take_up` tells the sign as well."""
+    if motion.skeleton.convention != "bvh":
+        return "y"
+    if not motion.frames:
+        return motion.skeleton.sizing().up
+    return size_up_poses(sampled_poses(motion)).up
+
+
+def standing_frame(motion: Motion) -> tuple[float, ...] | None:
+    """The channels of the frame, of the :func:`sampled_poses`, whose figure stands tallest
+    (:func:`standing_height`, the body as the root), or None where none stands."""
+    if not motion.frames:
+        return None
+    chosen = _sampled(motion.frames)
+    heights = [standing_height(pose) for pose in sampled_poses(motion)]
+    best = int(np.argmax(heights))
+    return tuple(float(v) for v in motion.values[chosen[best]]) if heights[best] > STANDING else None
+
+
 def standing_height(points: np.ndarray) -> float:
     """How high the root (point 0) of a pose (points, 3) stands above its lowest point, along y or
     z (whichever the pose spans more), as a fraction of the pose's largest extent (NaN: 0)."""
@@ -258,7 +309,12 @@ def _through(channels: np.ndarray, dofs: tuple[str, ...], transform: np.ndarray)
         if d in TRANSLATIONS:
             out[:, i] = moved[:, TRANSLATIONS.index(d), 3]
     turning = [i for i, d in enumerate(dofs) if d in ROTATIONS]
-    if turning:
+    if turning and not np.array_equal(transform[:3, :3], np.eye(3)):  # a shift alone keeps the angles as found
         order = "".join(dofs[i][1] for i in turning)
-        out[:, turning] = matrices_to_euler(moved[:, :3, :3], order, extrinsic=False, degrees=True)
+        angles = matrices_to_euler(moved[:, :3, :3], order, extrinsic=False, degrees=True)
+        if len(turning) == 3:  # continuous over frames, not wrapped into (-180, 180]
+            angles = unroll_euler(angles, order, degrees=True)
+        # whole turns that bring the first frame nearest the channels' own: a filter sees no jump
+        angles += 360.0 * np.round((channels[:1, turning] - angles[:1]) / 360.0)
+        out[:, turning] = angles
     return out

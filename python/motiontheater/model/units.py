@@ -170,7 +170,8 @@ def size_up(points: np.ndarray, *, cmu: bool = False) -> Sizing:
 
 def size_up_poses(poses: np.ndarray, *, cmu: bool = False) -> Sizing:
     """What a take's poses (frames, n, 3) say, as :func:`size_up` says of one: the unit and up
-    axis that most of the poses tell (the earlier pose on a tie), with their median extents.
+    axis that most of the poses tell (the earlier pose on a tie; a unit only where at least half
+    of the poses tell it), with their median extents.
     For a take whose rest pose is not a standing pose (drawn along x, or lying down)."""
     told = [size_up(pose, cmu=cmu) for pose in poses]
     if not told:
@@ -179,6 +180,8 @@ def size_up_poses(poses: np.ndarray, *, cmu: bool = False) -> Sizing:
     for sizing in told:
         votes[sizing.unit, sizing.up] = votes.get((sizing.unit, sizing.up), 0) + 1
     unit, up = max(votes, key=lambda k: (k[0] is not None, votes[k]))
+    if 2 * sum(n for (u, _), n in votes.items() if u == unit) < len(told):  # a few odd poses tell nothing
+        unit, up = max(votes, key=lambda k: votes[k])
     chosen = [s for s in told if (s.unit, s.up) == (unit, up)]
     x, y, z = (float(v) for v in np.median([s.extents for s in chosen], axis=0))
     return Sizing((x, y, z), up, unit, next(s.axis for s in chosen))
