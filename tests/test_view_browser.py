@@ -172,9 +172,7 @@ def test_every_kind_of_file_opens(browser, tmp_path, path):
         got = np.array(browser.execute_script("return mtView.positions(0, arguments[0])", frame))
         np.testing.assert_allclose(got.reshape(-1, 3), expected[frame], rtol=1e-12, atol=1e-9)
         assert_in_view(browser, frame)
-    browser.execute_script("mtView.play()")
-    time.sleep(0.3)
-    browser.execute_script("mtView.pause()")
+    play_and_look(browser)
     assert console_errors(browser) == []
     assert not browser.find_element(By.ID, "error").is_displayed()
 
@@ -195,6 +193,7 @@ def assert_in_view(browser, index, least=0.2):
 
 
 def play_and_look(browser):
+    """Play a moment and pause (the drawing of frames in between runs too)."""
     browser.execute_script("mtView.play()")
     time.sleep(0.3)
     browser.execute_script("mtView.pause()")
@@ -231,10 +230,19 @@ def test_a_z_up_file_stands_upright(browser, tmp_path, path):
 
 def test_a_take_turned_z_up_by_its_exporter_stands_upright(browser, data_dir, tmp_path):
     """walk01 under a static root that turns it a quarter about x, as a z-up exporter writes it: it
-    stands as walk01 does; told it is y-up (--up y), it lies on the floor."""
-    take = with_static_root(mt.read_bvh(data_dir / "bvh" / "walk01.bvh"), turn=(90.0, 0.0, 0.0), keep_world=False)
+    stands as walk01 does, on the same pixels when the two are compared; told it is y-up (--up y),
+    it lies on the floor."""
+    walk = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    take = with_static_root(walk, turn=(90.0, 0.0, 0.0), keep_world=False)
     assert_stands(browser, tmp_path, take, 2, "walk01 z-up")
     tall = drawn_extent(browser)[1]
+    # compared with walk01 as it is, each stands on its own up axis: drawn on the same pixels
+    open_page(browser, tmp_path, [take, walk])
+    browser.execute_script("mtView.seek(arguments[0])", standing_frame(take, 2)[0])
+    settle(browser)
+    turned, plain = (browser.execute_script("return mtView.drawn(arguments[0])", k) for k in (0, 1))
+    assert turned[0] is None  # the static root
+    np.testing.assert_allclose(np.array(turned[1:], float), np.array(plain, float), atol=1e-6)
     open_page(browser, tmp_path, [take], up="y")
     assert browser.execute_script("return mtView.state.takes[0].up") == "y"
     browser.execute_script("mtView.seek(arguments[0])", standing_frame(take, 2)[0])
@@ -297,8 +305,9 @@ def test_the_camera_keeps_a_travelling_game_rig_in_view(browser, tmp_path, make)
     names = motion.skeleton.joint_names
     static = motion.skeleton.root.name == "Reference"
     assert browser.execute_script("return mtView.state.takes[0].body") == names.index("Hips" if static else "root")
-    bones = browser.execute_script("return mtView.bones(0)")
-    assert not any(parent == "root" for parent, _ in bones) if static else len(bones) == len(names) - 1
+    skeleton, hidden = motion.skeleton, {"root"} if static else set()
+    drawn_bones = [[skeleton.parent(j), j] for j in names[1:] if skeleton.parent(j) not in hidden]
+    assert browser.execute_script("return mtView.bones(0)") == drawn_bones
     assert browser.find_element(By.ID, "joint-name").text == ("Hips" if static else motion.skeleton.root.name)
     for index in sorted({0, motion.frames // 2, motion.frames - 1}):
         assert_in_view(browser, index, least=0.3)
@@ -718,3 +727,24 @@ def test_editing_through_the_controls(browser, data_dir, tmp_path):
     recipe = browser.find_element(By.ID, "recipe").get_attribute("value")
     assert recipe.count("[[step]]") == 1
     assert np.abs(previewed(browser, motion.values.shape) - apply_recipe(recipe, motion, tmp_path).values).max() <= 1e-6
+
+
+def test_edits_on_a_game_rig_name_its_own_joints(browser, data_dir, tmp_path):
+    """Drawn from its body, a game rig is still edited as the take it is: the recipe names its joints
+    (the static root too), and motiontheater apply gives the motion previewed."""
+    motion = with_static_root(with_offset_channels(mt.read_bvh(data_dir / "bvh" / "walk01.bvh")), shift=(50, 0, 80))
+    open_page(browser, tmp_path, [motion])
+    browser.find_element(By.CSS_SELECTOR, ".jname[data-name='root']").click()  # the still root is listed, as Reference
+    assert browser.find_element(By.ID, "joint-name").text == "Reference"
+    steps = [
+        dict(kind="slerp", first=20, last=60, joints=["Hips", "LeftUpLeg"]),
+        dict(kind="binomial", first=1, last=101, joints=None, size=5),
+    ]
+    for step in steps:
+        browser.execute_script("mtView.addStep(arguments[0])", step)
+    recipe = browser.execute_script("return mtView.recipe()")
+    assert tomllib.loads(recipe)["step"][0]["joints"] == ["Hips", "LeftUpLeg"]
+    expected = apply_recipe(recipe, motion, tmp_path).values
+    got = previewed(browser, motion.values.shape)
+    assert np.abs(got - expected).max() <= 1e-6 and not np.array_equal(expected, motion.values)
+    assert console_errors(browser) == []
