@@ -10,7 +10,9 @@ import pytest
 
 import motiontheater as mt
 from corpus import real_files
+from motiontheater.feet.upright import take_up
 from motiontheater.views.viewer import DEFAULT_MAX_FRAMES, EDIT_STEPS, page, write_page
+from variants import with_offset_channels, with_static_root
 
 
 def page_data(html: str) -> dict:
@@ -144,6 +146,54 @@ def test_a_contacts_table_marks_heels_and_balls(data_dir):
         page([motion.replace(values=motion.values[:100])], contacts=[table])
     with pytest.raises(mt.errors.UnknownNameError, match="nose"):
         page([motion], contacts=[Contacts([Plant("nose", "ball", 1, 2)], 1, motion.frames)])
+
+
+def test_each_take_is_drawn_on_its_own_up_axis(data_dir):
+    """The data holds each take's up axis and the turn that stands it along +y (take_up's); compared
+    takes keep their own; a given up is every take's; the values stay the take's own."""
+    walk = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    lying = with_static_root(walk, turn=(90.0, 0.0, 0.0), keep_world=False)
+    zombie = mt.read_bvh(data_dir / "bvh" / "zombie.bvh")
+    amc = cmu_take()
+    takes = page_data(page([lying, walk, zombie, amc]))["takes"]
+    assert [t["up"] for t in takes] == ["z", "y", "z", "y"]
+    for t, motion in zip(takes, [lying, walk, zombie, amc]):
+        np.testing.assert_array_equal(np.reshape(t["turn"], (3, 3)), take_up(motion).turn)
+    assert np.array_equal(decoded(takes[0]), lying.values)  # drawn turned, stored as it is
+    given = page_data(page([lying, walk], up="-x"))["takes"]
+    assert [t["up"] for t in given] == ["-x", "-x"]
+    np.testing.assert_array_equal(np.reshape(given[1]["turn"], (3, 3)), take_up(walk, "-x").turn)
+    with pytest.raises(ValueError, match="up must be an axis"):
+        page([walk], up="up")
+
+
+def test_the_body_is_followed_and_what_stands_still_above_it_is_not_drawn(data_dir):
+    """A game rig (six channels everywhere, a static root): its body is the hips and the static
+    root is marked still; the joints, channels and values are still the take's own."""
+    walk = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    rig = with_static_root(with_offset_channels(walk), shift=(300.0, 0.0, -200.0))
+    plain, game = page_data(page([walk, rig]))["takes"]
+    assert (plain["body"], plain["still"]) == (0, [])
+    names = rig.skeleton.joint_names
+    assert (game["body"], game["still"]) == (names.index("Hips"), [names.index("root")])
+    assert game["joints"] == list(names) and game["channels"] == [list(c) for c in rig.channels]
+    assert np.array_equal(decoded(game), rig.values)
+    # a root that moves carries the body itself: nothing is hidden
+    values = rig.values.copy()
+    values[:, 0] += np.linspace(0.0, 50.0, rig.frames)
+    moving = page_data(page([rig.replace(values=values)]))["takes"][0]
+    assert (moving["body"], moving["still"]) == (0, [])
+
+
+def test_cli_view_up_turns_every_take(tmp_path, data_dir, monkeypatch):
+    from motiontheater.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    take, other = data_dir / "bvh" / "zombie.bvh", data_dir / "bvh" / "walk01.bvh"
+    found = page_data_of(main, ["view", str(take), str(other), "--no-open"], tmp_path / "zombie.html")
+    assert [t["up"] for t in found["takes"]] == ["z", "y"]
+    given = page_data_of(main, ["view", str(take), str(other), "--no-open", "--up", "y"], tmp_path / "zombie.html")
+    assert [t["up"] for t in given["takes"]] == ["y", "y"]
 
 
 def test_editor_steps_are_registered_steps():

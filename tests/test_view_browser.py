@@ -4,6 +4,7 @@ Skipped, with the reason, only where no Chromium with its driver (Debian: apt-ge
 chromium-driver) or no selenium is installed.
 """
 
+import base64
 import io
 import shutil
 import sys
@@ -15,6 +16,7 @@ import pytest
 import motiontheater as mt
 from corpus import ids, real_files
 from motiontheater.views.viewer import write_page
+from variants import with_offset_channels, with_static_root
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -102,20 +104,27 @@ def screenshot(browser):
 
 
 def joints_on_screen(browser, k=0):
-    """Page pixel (x, y) of every joint of take k at the current frame, by the page's own camera."""
+    """Page pixel (x, y) of every joint of take k at the current frame as the page draws it (None
+    for a joint it does not draw)."""
     return browser.execute_script(
         """
-        const k = arguments[0], S = mtView.state, t = S.takes[k], J = t.joints.length;
-        const i = k === 0 ? S.cur : Math.round(S.time * t.frameRate / t.step);
-        const P = mtView.positions(k, i), r = document.getElementById('view3d').getBoundingClientRect();
-        const dpr = window.devicePixelRatio || 1, out = [];
-        for (let j = 0; j < J; j++) {
-          const s = mtView.project(P[3 * j], P[3 * j + 1], P[3 * j + 2]);
-          if (s) out.push([r.left + s[0] / dpr, r.top + s[1] / dpr]);
-        }
-        return out;""",
+        const r = document.getElementById('view3d').getBoundingClientRect(), dpr = window.devicePixelRatio || 1;
+        return mtView.drawn(arguments[0]).map((s) => (s ? [r.left + s[0] / dpr, r.top + s[1] / dpr] : null));""",
         k,
     )
+
+
+def canvas_picture(browser):
+    """The 3D view's own pixels (rows, columns, RGB), in the canvas pixels mtView.drawn gives."""
+    image = pytest.importorskip("PIL.Image", reason="pillow is not installed")
+    url = browser.execute_script("return document.getElementById('view3d').toDataURL('image/png')")
+    png = base64.b64decode(url.split(",", 1)[1])
+    return np.asarray(image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+
+
+def drawn_points(browser, k=0) -> np.ndarray:
+    """Canvas pixels (n, 2) of the joints of take k the page draws at the shown frame."""
+    return np.array([s for s in browser.execute_script("return mtView.drawn(arguments[0])", k) if s is not None])
 
 
 def inked(picture, x, y, radius=2):
@@ -144,12 +153,14 @@ def test_real_take_opens_and_its_skeleton_is_drawn(browser, data_dir, tmp_path, 
     assert not inked(picture, box["x"] + box["width"] - 6, box["y"] + 30)
 
 
-VARIETY = real_files("bvh/*.bvh") + real_files("edge/*.amc") + real_files("hdm05/HDM_bd_squat1Reps_003_120.amc")
+VARIETY = real_files("*/*.bvh") + real_files("edge/*.amc") + real_files("hdm05/HDM_bd_squat1Reps_003_120.amc")
 
 
 @pytest.mark.parametrize("path", VARIETY, ids=ids(VARIETY))
 def test_every_kind_of_file_opens(browser, tmp_path, path):
-    """Every producer's BVH (orders, odd names, a one-frame rest pose), a non-CMU ASF, HDM05."""
+    """Every real BVH (every producer: orders, odd names, z-up, game rigs, a one-frame rest pose), a
+    non-CMU ASF, HDM05: no console error, the page's forward kinematics, and the figure in view at
+    its first, middle and last frame with the camera following it."""
     if path.suffix == ".bvh":
         motion = mt.read_bvh(path)
     else:
@@ -157,14 +168,156 @@ def test_every_kind_of_file_opens(browser, tmp_path, path):
     open_page(browser, tmp_path, [motion], names=[path.name])
     assert console_errors(browser) == []
     expected = motion.positions()
-    for frame in {0, motion.frames // 2, motion.frames - 1}:
+    for frame in sorted({0, motion.frames // 2, motion.frames - 1}):
         got = np.array(browser.execute_script("return mtView.positions(0, arguments[0])", frame))
         np.testing.assert_allclose(got.reshape(-1, 3), expected[frame], rtol=1e-12, atol=1e-9)
+        assert_in_view(browser, frame)
+    play_and_look(browser)
+    assert console_errors(browser) == []
+    assert not browser.find_element(By.ID, "error").is_displayed()
+
+
+def assert_in_view(browser, index, least=0.2):
+    """At frame index, every drawn joint of the first take lies on the canvas and the figure spans at
+    least ``least`` of the canvas's height (not a tiny far-away figure)."""
+    browser.execute_script("mtView.seek(arguments[0])", index)
+    settle(browser)
+    width, height = browser.execute_script("const c = document.getElementById('view3d'); return [c.width, c.height]")
+    shown = browser.execute_script("return mtView.drawn(0)")
+    points = np.array([s for s in shown if s is not None])
+    assert len(points), f"frame {index}: no joint drawn"
+    assert (points >= 0).all() and (points[:, 0] <= width).all() and (points[:, 1] <= height).all(), (
+        f"frame {index}: joints off the {width}x{height} canvas: {points.min(axis=0)} .. {points.max(axis=0)}"
+    )
+    assert np.ptp(points, axis=0).max() >= least * height, f"frame {index}: the figure is {np.ptp(points, axis=0)}"
+
+
+def play_and_look(browser):
+    """Play a moment and pause (the drawing of frames in between runs too)."""
     browser.execute_script("mtView.play()")
     time.sleep(0.3)
     browser.execute_script("mtView.pause()")
+
+
+def standing_frame(motion: mt.Motion, up: int) -> tuple[int, float]:
+    """The frame at which the figure is tallest for its width along the coordinate axis ``up`` (its
+    producer's), and that height over width."""
+    positions = motion.positions()
+    across = [a for a in range(3) if a != up]
+    tall = np.ptp(positions[:, :, up], axis=1)
+    wide = np.ptp(positions[:, :, across], axis=1).max(axis=1)
+    ratio = tall / wide
+    best = int(np.nanargmax(ratio))
+    return best, float(ratio[best])
+
+
+def drawn_extent(browser) -> tuple[float, float]:
+    points = drawn_points(browser)
+    return tuple(np.ptp(points, axis=0))
+
+
+Z_UP_FILES = real_files("bvh/zombie.bvh") + real_files("bvh-producers/*.bvh")
+Z_UP_FILES = [p for p in Z_UP_FILES if p.name in {"zombie.bvh", "video2bvh_cxk.bvh", "pybvh_bvh_example.bvh"}]
+
+
+@pytest.mark.parametrize("path", Z_UP_FILES, ids=ids(Z_UP_FILES))
+def test_a_z_up_file_stands_upright(browser, tmp_path, path):
+    """Real z-up files (their producers' frame): at the frame where the figure stands tallest along
+    z, the drawn figure is taller than wide, with its top joint above its bottom one on screen."""
+    motion = mt.read_bvh(path)
+    assert_stands(browser, tmp_path, motion, 2, path.name)
+
+
+def test_a_take_turned_z_up_by_its_exporter_stands_upright(browser, data_dir, tmp_path):
+    """walk01 under a static root that turns it a quarter about x, as a z-up exporter writes it: it
+    stands as walk01 does, on the same pixels when the two are compared; told it is y-up (--up y),
+    it lies on the floor."""
+    walk = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    take = with_static_root(walk, turn=(90.0, 0.0, 0.0), keep_world=False)
+    assert_stands(browser, tmp_path, take, 2, "walk01 z-up")
+    tall = drawn_extent(browser)[1]
+    # compared with walk01 as it is, each stands on its own up axis: drawn on the same pixels
+    open_page(browser, tmp_path, [take, walk])
+    browser.execute_script("mtView.seek(arguments[0])", standing_frame(take, 2)[0])
+    settle(browser)
+    turned, plain = (browser.execute_script("return mtView.drawn(arguments[0])", k) for k in (0, 1))
+    assert turned[0] is None  # the static root
+    np.testing.assert_allclose(np.array(turned[1:], float), np.array(plain, float), atol=1e-6)
+    open_page(browser, tmp_path, [take], up="y")
+    assert browser.execute_script("return mtView.state.takes[0].up") == "y"
+    browser.execute_script("mtView.seek(arguments[0])", standing_frame(take, 2)[0])
+    settle(browser)
+    wide_lying, tall_lying = drawn_extent(browser)
+    assert tall_lying < wide_lying and tall_lying < tall / 2  # the test could fail: lying, it is drawn flat
+
+
+def assert_stands(browser, tmp_path, motion, up, name):
+    frame, ratio = standing_frame(motion, up)
+    assert ratio > 1.5, f"{name}: no frame stands along its up axis (best {ratio:.2f} at {frame})"
+    open_page(browser, tmp_path, [motion], names=[name])
+    assert browser.execute_script("return mtView.state.takes[0].up") == "z"
+    browser.execute_script("mtView.seek(arguments[0])", frame)
+    settle(browser)
+    wide, tall = drawn_extent(browser)
+    assert tall > wide, f"{name} at frame {frame + 1}: drawn {wide:.0f} wide, {tall:.0f} tall"
+    shown = browser.execute_script("return mtView.drawn(0)")
+    drawn = [j for j, s in enumerate(shown) if s is not None]
+    heights = motion.positions()[frame, drawn, up]
+    top, bottom = (shown[drawn[f(heights)]] for f in (np.nanargmax, np.nanargmin))
+    assert top[1] < bottom[1]  # head up: canvas y grows downwards
     assert console_errors(browser) == []
-    assert not browser.find_element(By.ID, "error").is_displayed()
+
+
+def shifted(motion: mt.Motion, dx: float, dz: float) -> mt.Motion:
+    """The take moved over the floor (dx, dz in its units): its root's position channels shifted."""
+    values = motion.values.copy()
+    tx, _, tz = (motion.columns("root")[motion.skeleton.root.order.index(d)] for d in ("tx", "ty", "tz"))
+    values[:, tx] += dx
+    values[:, tz] += dz
+    return motion.replace(values=values)
+
+
+def game_rigs():
+    """Travelling takes laid out as game studios write them (six channels on every joint, a static
+    root), and a real game rig's bind pose."""
+    walk, lafan = real_files("bvh/walk01.bvh"), real_files("bvh-producers/bvhTools_test2_lafan1.bvh")
+    geno = real_files("bvh-producers/lafan1-resolved_Geno_bind.bvh")
+    cases = []
+    if walk:
+        take = with_offset_channels(mt.read_bvh(walk[0]))
+        cases.append(pytest.param(lambda: with_static_root(shifted(take, 4000.0, -2500.0)), id="walk01-far-away"))
+        cases.append(pytest.param(lambda: with_static_root(take, shift=(-3000.0, 0.0, 5000.0)), id="walk01-far-root"))
+    if lafan:
+        cases.append(
+            pytest.param(lambda: with_static_root(with_offset_channels(mt.read_bvh(lafan[0]))), id="lafan1-take")
+        )
+    if geno:
+        cases.append(pytest.param(lambda: mt.read_bvh(geno[0]), id="lafan1-resolved-Geno-bind"))
+    return cases
+
+
+@pytest.mark.parametrize("make", game_rigs())
+def test_the_camera_keeps_a_travelling_game_rig_in_view(browser, tmp_path, make):
+    """The camera follows the body (the joint that travels), not the static root; no bone or point is
+    drawn from the static root: nothing of the figure's colour lies outside the drawn joints."""
+    motion = make()
+    open_page(browser, tmp_path, [motion])
+    names = motion.skeleton.joint_names
+    static = motion.skeleton.root.name == "Reference"
+    assert browser.execute_script("return mtView.state.takes[0].body") == names.index("Hips" if static else "root")
+    skeleton, hidden = motion.skeleton, {"root"} if static else set()
+    drawn_bones = [[skeleton.parent(j), j] for j in names[1:] if skeleton.parent(j) not in hidden]
+    assert browser.execute_script("return mtView.bones(0)") == drawn_bones
+    assert browser.find_element(By.ID, "joint-name").text == ("Hips" if static else motion.skeleton.root.name)
+    for index in sorted({0, motion.frames // 2, motion.frames - 1}):
+        assert_in_view(browser, index, least=0.3)
+        picture, points = canvas_picture(browser), drawn_points(browser)
+        lo, hi = np.floor(points.min(axis=0)).astype(int) - 8, np.ceil(points.max(axis=0)).astype(int) + 8
+        blue = (picture[..., 2] - picture[..., 0] > 60) & (picture[..., 2] > 100)
+        blue[max(lo[1], 0) : hi[1], max(lo[0], 0) : hi[0]] = False
+        assert not blue.any(), f"frame {index + 1}: the figure's colour away from its joints"
+    play_and_look(browser)
+    assert console_errors(browser) == []
 
 
 def test_play_advances_the_frame_and_the_picture(browser, data_dir, tmp_path):
@@ -574,3 +727,24 @@ def test_editing_through_the_controls(browser, data_dir, tmp_path):
     recipe = browser.find_element(By.ID, "recipe").get_attribute("value")
     assert recipe.count("[[step]]") == 1
     assert np.abs(previewed(browser, motion.values.shape) - apply_recipe(recipe, motion, tmp_path).values).max() <= 1e-6
+
+
+def test_edits_on_a_game_rig_name_its_own_joints(browser, data_dir, tmp_path):
+    """Drawn from its body, a game rig is still edited as the take it is: the recipe names its joints
+    (the static root too), and motiontheater apply gives the motion previewed."""
+    motion = with_static_root(with_offset_channels(mt.read_bvh(data_dir / "bvh" / "walk01.bvh")), shift=(50, 0, 80))
+    open_page(browser, tmp_path, [motion])
+    browser.find_element(By.CSS_SELECTOR, ".jname[data-name='root']").click()  # the still root is listed, as Reference
+    assert browser.find_element(By.ID, "joint-name").text == "Reference"
+    steps = [
+        dict(kind="slerp", first=20, last=60, joints=["Hips", "LeftUpLeg"]),
+        dict(kind="binomial", first=1, last=101, joints=None, size=5),
+    ]
+    for step in steps:
+        browser.execute_script("mtView.addStep(arguments[0])", step)
+    recipe = browser.execute_script("return mtView.recipe()")
+    assert tomllib.loads(recipe)["step"][0]["joints"] == ["Hips", "LeftUpLeg"]
+    expected = apply_recipe(recipe, motion, tmp_path).values
+    got = previewed(browser, motion.values.shape)
+    assert np.abs(got - expected).max() <= 1e-6 and not np.array_equal(expected, motion.values)
+    assert console_errors(browser) == []

@@ -64,7 +64,7 @@ def _view(args: argparse.Namespace) -> int:
             arrays, ground, mpu = prepare(motion, legs=args.legs, up=args.up, floor=args.floor)
             contacts[i] = contacts_of(given, motion, arrays, ground, mpu)
     names = [Path(p).name for p in paths]
-    write_page(takes, out, names=names, contacts=contacts, legs=args.legs, max_frames=args.max_frames)
+    write_page(takes, out, names=names, contacts=contacts, legs=args.legs, max_frames=args.max_frames, up=args.up)
     shown = "".join(f", {len(c)} footplants on {name}" for c, name in zip(contacts, names) if c is not None)
     print(f"wrote {out} ({out.stat().st_size / 1e6:.2f} MB, {len(takes)} take(s), {takes[0].frames} frames{shown})")
     if not args.no_open and not webbrowser.open(out.resolve().as_uri()):
@@ -158,13 +158,15 @@ VERBS = [
         description=(
             "Write ONE self-contained HTML file (no network needed, ever) and open it in the browser: a 3D "
             "skeleton player (drag to orbit, wheel to zoom, right-drag to pan; Space plays, arrows step, R "
-            "reverses, D doubles the speed, L loops, F follows the root), the joint tree with the selected "
+            "reverses, D doubles the speed, L loops, F follows the body), the joint tree with the selected "
             "joint's channels and an axis-angle glyph of its rotation, its curves (click to seek, drag to "
             "select frames), more takes overlaid for comparison, and an editor that stacks interpolators and "
             "filters over frame ranges, previews them and exports the stack as a recipe for motiontheater "
             "apply. Takes longer than --max-frames are shown decimated, with a note, and editing off. "
             "Footplants (--contacts: detected; --contacts FILE: a table) are marked green on the feet, listed "
-            "beside the clock and drawn as rows under the curves."
+            "beside the clock and drawn as rows under the curves. Each take is drawn standing on its up axis "
+            "(found from its frames, where the hips are above the ankles; --up gives it for every take), the camera "
+            "follows the joint that travels, and a static joint above it (a game rig's root) is not drawn."
         ),
         epilog="Example: motiontheater view 01_01.amc smooth.amc -o compare.html; "
         "motiontheater view 07_05.amc cleaned.amc --contacts",

@@ -3,7 +3,7 @@
 :func:`write_page` writes a page that needs no network and no other file:
 its script, style and data are inside it.  It shows a skeleton player (a
 perspective view drawn with Canvas 2D, a floor grid, orbit/zoom/pan and a
-camera that follows the root), the joint tree with the selected joint's
+camera that follows the body), the joint tree with the selected joint's
 channel values and an axis-angle glyph of its rotation, the selected joint's
 channel curves with a playhead, several takes compared (overlaid curves and
 ghosted skeletons, aligned in time), footplants when given (``contacts=``), and an editor that
@@ -27,6 +27,16 @@ channels) makes a page of 0.65 MB.
 Takes longer than ``max_frames`` frames are decimated (1 frame in k is kept,
 k the smallest that fits) and the page says so; editing is then off,
 since filters and interpolators work on every frame.
+
+Each take is drawn standing along +y: its up axis (given, or found from its
+frames by :func:`~motiontheater.feet.upright.take_up`) is turned up, and the
+floor grid, the footplant rings and the camera's orbit are in that turned
+frame.  The camera follows the take's body
+(:func:`~motiontheater.model.rig.body_view`: the joint that travels), and the
+joints that stand still above it (a game rig's static root) are not drawn,
+nor their bones.  Everything else the page shows and edits is the take's own:
+its joints, channels and values (the recipe names them as the take does), and
+forward kinematics in its own axes; only the drawing is turned.
 """
 
 from __future__ import annotations
@@ -47,8 +57,10 @@ from ...editing.filtering import FILTERS
 from ...editing.interpolators import INTERPOLATORS
 from ...feet.contacts import Contacts
 from ...feet.legs import resolve_legs
+from ...feet.upright import take_up
 from ...model.motion import Motion
 from ...model.registry import Joints, lookup
+from ...model.rig import _chain_above, body_view
 
 __all__ = ["DEFAULT_MAX_FRAMES", "EDIT_STEPS", "page", "write_page"]
 
@@ -129,13 +141,17 @@ def _plant_rows(motion: Motion, label: str, step: int, contacts: Footplants | No
     return rows
 
 
-def _take_data(motion: Motion, label: str, step: int, contacts: Footplants | None, legs: Joints) -> dict:
+def _take_data(
+    motion: Motion, label: str, step: int, contacts: Footplants | None, legs: Joints, up: str | None
+) -> dict:
     skeleton = motion.skeleton
     tree = skeleton.tree
     names = skeleton.joint_names
     index = {name: i for i, name in enumerate(names)}
     values = motion.values[::step]
     shown_plants = _plant_rows(motion, label, step, contacts, legs)
+    upright = take_up(motion, up)
+    body = body_view(motion).body
     return {
         "name": label,
         "frameRate": motion.frame_rate,
@@ -146,6 +162,10 @@ def _take_data(motion: Motion, label: str, step: int, contacts: Footplants | Non
         "convention": skeleton.convention,
         "angleUnit": skeleton.angle_unit,
         "metersPerUnit": skeleton.meters_per_unit,
+        "up": upright.axis,
+        "turn": upright.turn.ravel().tolist(),
+        "body": index[body],
+        "still": [index[j] for j in _chain_above(skeleton, body)],  # body_view's body: they do not move
         "joints": list(names),
         "points": list(skeleton.point_names),
         "children": [[index[c] for c in skeleton.children(n)] for n in names],
@@ -175,6 +195,7 @@ def page(
     legs: Joints = None,
     max_frames: int = DEFAULT_MAX_FRAMES,
     title: str | None = None,
+    up: str | None = None,
     plants: Sequence[Footplants | None] | None = None,
 ) -> str:
     """The HTML text of a viewer page for one or more takes.
@@ -190,7 +211,12 @@ def page(
     right leg), or a mapping point name (one of ``skeleton.point_names``) ->
     bool array with one flag per frame, True where the point is planted.  A
     take of more than ``max_frames`` frames is shown decimated to at most that
-    many, and editing is then off.  ``plants`` is the old name of ``contacts`` (deprecated).
+    many, and editing is then off.  ``up`` is the axis that points up in every
+    take ("y", "z", "-y", ...; ValueError otherwise), drawn up; by default each
+    take's own, found from its frames (:func:`~motiontheater.feet.upright.take_up`:
+    y for ASF/AMC).  The camera follows each take's body and no joint standing
+    still above it is drawn (see the module docstring).  ``plants`` is the old
+    name of ``contacts`` (deprecated).
     """
     contacts = _renamed(contacts, plants)
     if not takes:
@@ -218,7 +244,7 @@ def page(
         "note": (
             "; ".join(notes) + f" (pages hold up to {max_frames:,} frames per take; editing is off)" if notes else ""
         ),
-        "takes": [_take_data(m, label, k, p, legs) for m, label, k, p in zip(takes, labels, steps, plant_list)],
+        "takes": [_take_data(m, label, k, p, legs, up) for m, label, k, p in zip(takes, labels, steps, plant_list)],
     }
     text = title or "motiontheater: " + " vs ".join(labels)
     resources = files(__package__)

@@ -6,6 +6,11 @@
  * joint per frame to the file.  The editing steps are ports of motiontheater.editing.interpolators and
  * motiontheater.editing.filtering (and of the mtcore rotation kernels they call), so that a recipe written
  * here and applied by motiontheater gives the motion previewed here.
+ *
+ * Positions stay in the take's own axes (as motiontheater computes them); only the drawing turns
+ * them, by the take's "turn" that stands its up axis along +y (see placed).  The joints that stand
+ * still above the take's body (a game rig's static root) are not drawn, nor their bones, and the
+ * camera follows the body.
  */
 "use strict";
 (function () {
@@ -80,6 +85,8 @@
       dofKind: Int32Array.from(t.dofKind),
       dofColumn: Int32Array.from(t.dofColumn),
       parentFrame: Uint8Array.from(t.parentFrame),
+      turn: Float64Array.from(t.turn),
+      still: new Uint8Array(J),
       plain: new Uint8Array(J),
       jointIndex: new Map(t.joints.map((name, i) => [name, i])),
       plantRows: [],
@@ -89,6 +96,9 @@
       for (let e = 0; e < 9; e++) if (take.axis[9 * j + e] !== (e % 4 === 0 ? 1 : 0)) identity = false;
       take.plain[j] = identity ? 1 : 0;
     }
+    for (const j of t.still) take.still[j] = 1;
+    take.bones = []; // [parent, joint]: every bone but those from a joint that stands still above the body
+    for (let j = 0; j < J; j++) if (take.parent[j] >= 0 && !take.still[take.parent[j]]) take.bones.push([take.parent[j], j]);
     for (const { label, point, spans } of t.plants || []) {
       const flags = new Uint8Array(t.frames);
       for (const [a, b] of spans) flags.fill(1, a, b + 1);
@@ -566,33 +576,38 @@
   const cam = { yaw: 0.7, pitch: 0.28, dist: 1, target: [0, 0, 0], pan: [0, 0, 0], fov: (45 * Math.PI) / 180 };
   let basis = null;
 
+  /* the floor, the camera's distance and the grid, from the first take's drawn joints as drawn */
   function setUpCamera() {
     const t = take0(), P = t.positions, J = t.joints.length;
     let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
     let floor = Infinity;
-    for (let i = 0; i < P.length; i += 3) {
-      if (!Number.isFinite(P[i + 1])) continue;
-      floor = Math.min(floor, P[i + 1]);
-    }
-    for (let j = 0; j < J; j++)
+    for (let f = 0; f < t.frames; f++)
+      for (let j = 0; j < J; j++) {
+        if (t.still[j]) continue;
+        const y = placed(t, P, f * J * 3, j)[1];
+        if (Number.isFinite(y)) floor = Math.min(floor, y);
+      }
+    for (let j = 0; j < J; j++) {
+      if (t.still[j]) continue;
+      const p = placed(t, P, 0, j);
       for (let e = 0; e < 3; e++) {
-        const v = P[3 * j + e];
-        if (Number.isFinite(v)) {
-          lo[e] = Math.min(lo[e], v);
-          hi[e] = Math.max(hi[e], v);
+        if (Number.isFinite(p[e])) {
+          lo[e] = Math.min(lo[e], p[e]);
+          hi[e] = Math.max(hi[e], p[e]);
         }
       }
+    }
     const height = Math.max(hi[1] - lo[1], hi[0] - lo[0], hi[2] - lo[2], 1e-9);
     S.floor = Number.isFinite(floor) ? floor : 0;
     S.height = height;
     cam.dist = 2.2 * height;
     cam.centreY = (lo[1] + hi[1]) / 2;
     cam.target = [(lo[0] + hi[0]) / 2, cam.centreY, (lo[2] + hi[2]) / 2];
-    // the floor grid: lines every 0.5 m over the ground the root covers, and a margin
+    // the floor grid: lines every 0.5 m over the ground the body covers, and a margin
     let spacing = 0.5 / t.metersPerUnit;
     let x0 = Infinity, x1 = -Infinity, z0 = Infinity, z1 = -Infinity;
     for (let f = 0; f < t.frames; f++) {
-      const x = P[f * J * 3], z = P[f * J * 3 + 2];
+      const [x, , z] = placed(t, P, f * J * 3, t.body);
       if (!Number.isFinite(x) || !Number.isFinite(z)) continue;
       x0 = Math.min(x0, x); x1 = Math.max(x1, x); z0 = Math.min(z0, z); z1 = Math.max(z1, z);
     }
@@ -617,7 +632,7 @@
   function updateBasis() {
     const t = take0(), P = shownPositions(t), J = t.joints.length;
     if (S.follow) {
-      const x = P[S.cur * J * 3], z = P[S.cur * J * 3 + 2];
+      const [x, , z] = placed(t, P, S.cur * J * 3, t.body);
       if (Number.isFinite(x) && Number.isFinite(z)) cam.target = [x, cam.centreY, z];
     }
     const tg = [cam.target[0] + cam.pan[0], cam.target[1] + cam.pan[1], cam.target[2] + cam.pan[2]];
@@ -683,8 +698,23 @@
     }
   }
 
-  function point(P, base, j) {
-    return [P[base + 3 * j], P[base + 3 * j + 1], P[base + 3 * j + 2]];
+  /* joint j of the positions P (a frame's from base) as drawn: turned by the take's place (its turn
+   * to stand along +y, in the first take's length unit) */
+  function placed(take, P, base, j) {
+    const M = take.place, x = P[base + 3 * j], y = P[base + 3 * j + 1], z = P[base + 3 * j + 2];
+    return [M[0] * x + M[1] * y + M[2] * z, M[3] * x + M[4] * y + M[5] * z, M[6] * x + M[7] * y + M[8] * z];
+  }
+
+  /* the canvas pixels of the take's joints at frame i of P: null where one is not drawn (it stands
+   * still above the body) or is behind the camera */
+  function screenPoints(take, P, i) {
+    const J = take.joints.length, base = i * J * 3, out = [];
+    for (let j = 0; j < J; j++) out.push(take.still[j] ? null : project(...placed(take, P, base, j)));
+    return out;
+  }
+
+  function shownIndex(take) {
+    return take.index === 0 ? S.cur : indexAt(take, S.time);
   }
 
   function drawSkeleton(take, P, i, colour, alpha, main) {
@@ -694,11 +724,10 @@
     ctx.lineWidth = (main ? 3 : 2) * dpr;
     ctx.lineCap = "round";
     ctx.beginPath();
-    for (let j = 0; j < J; j++) if (take.parent[j] >= 0) segment(point(P, base, take.parent[j]), point(P, base, j));
+    for (const [p, j] of take.bones) segment(placed(take, P, base, p), placed(take, P, base, j));
     ctx.stroke();
     ctx.fillStyle = colour;
-    for (let j = 0; j < J; j++) {
-      const s = project(...point(P, base, j));
+    for (const s of screenPoints(take, P, i)) {
       if (!s) continue;
       ctx.beginPath();
       ctx.arc(s[0], s[1], (main ? 3 : 2) * dpr, 0, 2 * Math.PI);
@@ -707,7 +736,7 @@
     // contacts: a ring on the floor under each planted foot, and the foot point marked
     for (const { j, flags } of take.plantRows) {
       if (!flags[i]) continue;
-      const p = point(P, base, j);
+      const p = placed(take, P, base, j);
       ctx.strokeStyle = "#1a9e3a";
       ctx.fillStyle = "#1a9e3a";
       ctx.lineWidth = 2 * dpr;
@@ -737,11 +766,11 @@
     ctx.fillRect(0, 0, view.width, view.height);
     drawGrid();
     const t = take0();
-    for (const take of S.takes.slice(1)) drawSkeleton(take, take.drawn, indexAt(take, S.time), take.colour, 0.45, false);
+    for (const take of S.takes.slice(1)) drawSkeleton(take, take.positions, shownIndex(take), take.colour, 0.45, false);
     if (S.edited && S.preview) drawSkeleton(t, t.positions, S.cur, "#888", 0.35, false);
     const P = shownPositions(t);
     drawSkeleton(t, P, S.cur, t.colour, 1, true);
-    const s = S.selected >= 0 ? project(...point(P, S.cur * t.joints.length * 3, S.selected)) : null;
+    const s = S.selected >= 0 ? project(...placed(t, P, S.cur * t.joints.length * 3, S.selected)) : null;
     if (s) {
       const dpr = window.devicePixelRatio || 1;
       ctx.fillStyle = "#e07000";
@@ -824,8 +853,12 @@
     c.arc(W / 2, W / 2, R, 0, 2 * Math.PI);
     c.stroke();
     if (!basis) return;
-    // screen-space direction of a world direction, by the 3D view's camera
-    const dir = (d) => [d[0] * basis.r[0] + d[1] * basis.r[1] + d[2] * basis.r[2], d[0] * basis.u[0] + d[1] * basis.u[1] + d[2] * basis.u[2]];
+    // screen-space direction of a direction in the take's axes, turned as the 3D view draws it
+    const T = t.turn;
+    const dir = (v) => {
+      const d = [0, 1, 2].map((e) => T[3 * e] * v[0] + T[3 * e + 1] * v[1] + T[3 * e + 2] * v[2]);
+      return [d[0] * basis.r[0] + d[1] * basis.r[1] + d[2] * basis.r[2], d[0] * basis.u[0] + d[1] * basis.u[1] + d[2] * basis.u[2]];
+    };
     const toG = (d, s) => [W / 2 + s * R * d[0], W / 2 - s * R * d[1]];
     for (const [e, name] of [[[1, 0, 0], "x"], [[0, 1, 0], "y"], [[0, 0, 1], "z"]]) {
       const p = toG(dir(e), 0.5);
@@ -1318,10 +1351,10 @@
   function pick(e) {
     const t = take0(), r = view.getBoundingClientRect(), dpr = window.devicePixelRatio || 1;
     const x = (e.clientX - r.left) * dpr, y = (e.clientY - r.top) * dpr;
-    const P = shownPositions(t), base = S.cur * t.joints.length * 3;
+    const shown = screenPoints(t, shownPositions(t), S.cur);
     let best = -1, bestD = 12 * dpr;
     for (let j = 0; j < t.joints.length; j++) {
-      const s = project(...point(P, base, j));
+      const s = shown[j];
       if (!s) continue;
       const d = Math.hypot(s[0] - x, s[1] - y);
       if (d < bestD) { best = j; bestD = d; }
@@ -1374,24 +1407,24 @@
     for (const take of S.takes) {
       const span = document.createElement("span");
       span.innerHTML = `<i style="background:${take.colour}"></i>`;
-      span.append(take.name);
+      span.append(take.name + (take.up === "y" ? "" : ` (up: ${take.up})`));
       legend.append(span);
     }
     if (DATA.note) {
       $("note").textContent = DATA.note;
       $("note").hidden = false;
     }
-    // compared takes drawn in the first take's length unit (their own positions stay as computed)
+    // each take drawn standing along +y (its own turn), compared takes in the first take's length unit
     for (const take of S.takes) {
       const k = take.metersPerUnit / t.metersPerUnit;
-      take.drawn = k === 1 ? take.positions : take.positions.map((v) => v * k);
+      take.place = take.turn.map((v) => v * k);
     }
     setUpCamera();
     buildTree();
     setUpControls();
     setUpEditor();
     seek(0);
-    select(0);
+    select(t.body);
     $("e-from").value = frameNumber(t, 0);
     $("e-to").value = frameNumber(t, Math.min(t.frames - 1, 1));
     drawView();
@@ -1415,11 +1448,15 @@
     clearSteps: () => { S.stack = []; recompute(); },
     recipe: () => (S.stack.length ? recipe() : ""),
     values: (k = 0, edited = true) => Array.from(k === 0 && edited && S.edited ? S.edited : S.takes[k].values),
+    // positions in the take's own axes, as motiontheater computes them; project takes a point as drawn
     positions: (k = 0, i = 0) => {
       const take = S.takes[k], J = take.joints.length;
       return Array.from(take.positions.subarray(i * J * 3, (i + 1) * J * 3));
     },
     project: (x, y, z) => (basis ? project(x, y, z) : null),
+    // the canvas pixels [x, y] of take k's joints as drawn at the shown frame (null: not drawn), and its bones
+    drawn: (k = 0) => (basis ? screenPoints(S.takes[k], shownPositions(S.takes[k]), shownIndex(S.takes[k])) : null),
+    bones: (k = 0) => S.takes[k].bones.map(([p, j]) => [S.takes[k].joints[p], S.takes[k].joints[j]]),
   };
 
   main().catch((err) => {
