@@ -253,7 +253,7 @@ def _body(motion: Motion) -> dict[str, Any]:
     skeleton = motion.skeleton
     view = body_view(motion)
     kept = set(view.columns.tolist())
-    above = [] if view.body == "root" else _chain(skeleton, view.body)
+    above = view.still_above
     offsets = [
         (joint, column)
         for joint in skeleton.bone_names
@@ -281,14 +281,6 @@ def _body(motion: Motion) -> dict[str, Any]:
         "offset_channels": len(offsets),
         "offset_joints": len({j for j, _ in offsets}),
     }
-
-
-def _chain(skeleton, joint: str) -> list[str]:
-    chain = []
-    while joint != "root":
-        joint = skeleton.parent(joint)
-        chain.append(joint)
-    return chain[::-1]
 
 
 def _ranges(values: np.ndarray) -> tuple[list[float | None], list[float | None]]:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.motion import Motion
-from ..model.rig import body_view, pose_up, sampled_poses
+from ..model.rig import pose_up, sampled_view
 from .legs import axis_name, parse_up, resolve_legs
 
 
@@ -55,9 +55,10 @@ def take_up(motion: Motion, up: str | None = None) -> Up:
         return Up("y", "ASF/AMC is y-up by Acclaim's convention")
     if not motion.frames:
         return Up(pose_up(motion), "the rest pose spans most along it (the take has no frames)")
-    poses = sampled_poses(motion)
+    view = sampled_view(motion)
+    poses = view.positions()
     try:
-        legs = resolve_legs(body_view(motion).motion.skeleton)
+        legs = resolve_legs(view.skeleton)
     except ValueError:
         legs = None
     if legs is not None:

@@ -54,6 +54,11 @@ class BodyView:
         """Whether the view is the take itself (nothing static above the body, nothing folded)."""
         return self.motion is self.original
 
+    @property
+    def still_above(self) -> list[str]:
+        """The take's joints above the body, root first ("root" for the root): they stand still."""
+        return [] if self.body == "root" else _chain_above(self.original.skeleton, self.body)
+
     def unturned(self) -> Motion:
         """The view with the static joints' turn taken out (their shift kept): the body as it moves
         in the axes the static joints stand it in.  A z-up export whose static root turns a y-up
@@ -199,11 +204,16 @@ def rest_values(skeleton: Skeleton, frames: int = 1) -> np.ndarray:
 POSES = 32  # frames, spread over a take, whose poses tell its up axis: quick on hours of frames
 
 
+def sampled_view(motion: Motion) -> Motion:
+    """Up to :data:`POSES` frames spread over the take, seen from its body (the view of those
+    frames alone, which on an hour of frames is what keeps the up axis and the standing frame
+    quick to find)."""
+    return body_view(motion.replace(values=motion.values[_sampled(motion.frames)])).motion
+
+
 def sampled_poses(motion: Motion) -> np.ndarray:
-    """World positions (poses, points, 3) of up to :data:`POSES` frames spread over the take, as
-    its body view draws them (the static joints' turn folded in)."""
-    view = body_view(motion).motion
-    return view.replace(values=view.values[_sampled(view.frames)]).positions()
+    """World positions (poses, points, 3) of :func:`sampled_view` (the static joints' turn folded in)."""
+    return sampled_view(motion).positions()
 
 
 def _sampled(frames: int) -> np.ndarray:

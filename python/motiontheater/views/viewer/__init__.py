@@ -60,7 +60,7 @@ from ...feet.legs import resolve_legs
 from ...feet.upright import take_up
 from ...model.motion import Motion
 from ...model.registry import Joints, lookup
-from ...model.rig import _chain_above, body_view
+from ...model.rig import body_view
 
 __all__ = ["DEFAULT_MAX_FRAMES", "EDIT_STEPS", "page", "write_page"]
 
@@ -151,7 +151,7 @@ def _take_data(
     values = motion.values[::step]
     shown_plants = _plant_rows(motion, label, step, contacts, legs)
     upright = take_up(motion, up)
-    body = body_view(motion).body
+    seen = body_view(motion)
     return {
         "name": label,
         "frameRate": motion.frame_rate,
@@ -164,8 +164,8 @@ def _take_data(
         "metersPerUnit": skeleton.meters_per_unit,
         "up": upright.axis,
         "turn": upright.turn.ravel().tolist(),
-        "body": index[body],
-        "still": [index[j] for j in _chain_above(skeleton, body)],  # body_view's body: they do not move
+        "body": index[seen.body],
+        "still": [index[j] for j in seen.still_above],
         "joints": list(names),
         "points": list(skeleton.point_names),
         "children": [[index[c] for c in skeleton.children(n)] for n in names],
