@@ -252,6 +252,9 @@ def derived(data: Path) -> dict[str, mt.Motion]:
         "offset channels": with_offset_channels(walk),
         "every joint moves": every_joint_moves(walk),
         "amc-bvh, bones that stretch": mt.to_bvh(stretching_bones(amc)),
+        "amc-bvh, XYZ": mt.to_bvh(amc, "XYZ"),
+        "retargeted": mt.retarget(amc, walk.skeleton, cleanup=False),
+        "in metres": walk.to_meters(),
     }
 
 
@@ -264,6 +267,9 @@ DERIVED = [
     "offset channels",
     "every joint moves",
     "amc-bvh, bones that stretch",
+    "amc-bvh, XYZ",
+    "retargeted",
+    "in metres",
 ]
 
 
