@@ -265,8 +265,8 @@ def _numbers(words: list[str], count: int, number: int, what: str) -> tuple[floa
 def write_bvh(motion: Motion, target: Source) -> None:
     """Write a motion of a BVH skeleton as BVH, to a path (atomically) or a binary file object;
     every number the shortest text that reads back exactly, the frame time as it was read, lines
-    and exponents laid out as the file read was (``motion.style``).  A motion written back
-    unchanged is its file's very bytes."""
+    and exponents laid out as the file read was (``motion.style``), the last line ended with a
+    line break.  A motion written back unchanged is its file's very bytes."""
     skeleton = motion.skeleton
     if skeleton.convention != "bvh":
         raise ValueError("write_bvh needs a motion of a BVH skeleton (read_bvh, or convert an ASF/AMC first)")
@@ -307,6 +307,6 @@ def write_bvh(motion: Motion, target: Source) -> None:
     style = motion.style
     with output(target) as f:
         f.write(style.lines(lines))
+        # every line ended, though the file read may have ended its last without a break:
+        # python-bvh drops such a last line, and with it a frame
         format_table(motion.values[:, columns], f, **style.numbers())
-        if not style.final_newline and f.seekable():  # the file read ended without a line break
-            f.truncate(f.tell() - len(style.newline))
