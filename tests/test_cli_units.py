@@ -133,3 +133,25 @@ def test_the_given_unit_is_the_one_used(files, tmp_path, capsys):
 def test_the_verbs_are_found():
     """The verbs that read takes offer --unit (a parser change that hid them would empty the test)."""
     assert {"info", "filter", "batch", "view", "plot", "render", "retarget", "median"} <= set(unit_verbs())
+
+
+@pytest.mark.parametrize(("verb", "dry_run"), runs(), ids=lambda v: {True: "dry-run", False: ""}.get(v, v))
+def test_every_verb_that_reads_takes_uses_a_given_body(verb, dry_run, files, tmp_path, capsys):
+    """--body comes with --unit (one option function): a joint the take does not have is refused by
+    every verb, naming it, and nothing is written; a dropped flag would run as without it."""
+    if verb == "c3d":
+        pytest.importorskip("c3d")
+    argv = [word.format(**files) for word in arguments(verb, dry_run)]
+    status, _, err, written = produce([*argv, "--body", "Nowhere"], tmp_path / "given", capsys)
+    assert status != 0 and "no joint 'Nowhere' to carry the body" in err, (status, err)
+    assert not {name for name in written if not name.endswith("manifest.json")}, written
+
+
+def test_a_given_body_is_the_body(data_dir, tmp_path, capsys):
+    import json
+
+    take = data_dir / "bvh" / "walk01.bvh"
+    assert main(["info", str(take), "--json", "--body", "Hips"]) == 0
+    assert json.loads(capsys.readouterr().out)["body"]["joint"] == "Hips"
+    assert main(["info", str(take), "--body", "LeftUpLeg"]) == 2  # the hips above it move
+    assert "the body joint 'LeftUpLeg' chosen has joints above it that move (Hips)" in capsys.readouterr().err

@@ -53,6 +53,7 @@ def _batch(args: argparse.Namespace) -> int:
         skeleton=args.asf,
         frame_rate=args.frame_rate,
         unit=args.unit,
+        body=args.body,
         resume=args.resume,
         in_place=args.in_place,
         stream_above=int(args.stream_above * 1e6),

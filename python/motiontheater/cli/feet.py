@@ -10,10 +10,11 @@ from .takes import add_output_options, add_take_options, output, take_of
 from .verb import Verb
 
 
-def add_ground_options(parser: argparse.ArgumentParser) -> None:
-    """The flags of the footskate verbs (skate, contacts, view's contacts): they are the cleanup step's."""
+def add_ground_options(parser: argparse.ArgumentParser, names: tuple[str, ...] = ("floor", "up", "legs")) -> None:
+    """The flags of the footskate verbs (skate, contacts, view's contacts; render's --up): they are
+    the cleanup step's."""
     cleanup = {o.name: o for o in lookup("cleanup").options}
-    for name in ("floor", "up", "legs"):
+    for name in names:
         option = cleanup[name]
         parser.add_argument(
             option.flag,

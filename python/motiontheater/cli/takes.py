@@ -12,11 +12,12 @@ import os
 
 from ..formats.table import read_take
 from ..model.motion import Motion
+from ..model.rig import choose_body
 from ..model.units import UNIT_HELP
 
 
 def add_take_options(parser: argparse.ArgumentParser, *, frames: bool = False) -> None:
-    """How a take is read (``--asf``, ``--frame-rate``, ``--unit``) and, with ``frames``, the
+    """How a take is read (``--asf``, ``--frame-rate``, ``--unit``, ``--body``) and, with ``frames``, the
     ``--frames A:B`` of a verb that works on a range of the take's frames."""
     parser.add_argument("--asf", help="the AMC's skeleton (default: the ASF beside it, by the CMU/HDM05 naming)")
     parser.add_argument("--frame-rate", type=float, metavar="HZ", help="frames per second when the AMC does not say")
@@ -26,13 +27,20 @@ def add_take_options(parser: argparse.ArgumentParser, *, frames: bool = False) -
         help=f"the takes' length unit: {UNIT_HELP} "
         "(default: a BVH's is told from its size, an ASF's is its :units length)",
     )
+    parser.add_argument(
+        "--body",
+        metavar="JOINT",
+        help="the joint that carries the body (default: the first whose position channels move, else the "
+        "hips by name; see info)",
+    )
     if frames:
         parser.add_argument("--frames", type=frame_range, metavar="A:B", help="only frames A to B of the take")
 
 
 def take_of(args: argparse.Namespace, path: str) -> Motion:
     """The take at ``path``, read as the options of :func:`add_take_options` say."""
-    return read_take(path, args.asf, args.frame_rate, args.unit)
+    motion = read_take(path, args.asf, args.frame_rate, args.unit)
+    return motion if args.body is None else choose_body(motion, args.body)
 
 
 def frame_range(text: str) -> tuple[int, int]:

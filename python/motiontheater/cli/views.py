@@ -118,11 +118,7 @@ def _render_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fps", type=float, default=25.0, help="frames per second of the animation (default 25)")
     parser.add_argument("--size", type=_size, default=(480, 360), metavar="WxH", help="pixels (default 480x360)")
     parser.add_argument("--fixed-camera", action="store_true", help="do not follow the body")
-    parser.add_argument(
-        "--up",
-        choices=("x", "y", "z", "-x", "-y", "-z"),
-        help="the take's up axis, drawn up (default: y for ASF, the one a BVH's figure stands along)",
-    )
+    add_ground_options(parser, ("up",))
     add_take_options(parser, frames=True)
 
 

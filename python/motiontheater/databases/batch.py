@@ -52,6 +52,7 @@ from ..formats.table import (
 )
 from ..model.errors import FormatError
 from ..model.motion import Motion
+from ..model.rig import choose_body
 
 STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed (when its pipeline allows)
 MANIFEST = ".motiontheater-batch.jsonl"
@@ -72,6 +73,7 @@ class Job:
     chunk_frames: int = CHUNK_FRAMES
     bytes: int = 0  # the take's size when planned
     unit: str | None = None  # the takes' length unit (--unit), when given
+    body: str | None = None  # the joint that carries the body (--body), when given
     stamps: tuple[Stamp, Stamp | None] | None = None  # the take's and its skeleton's when planned
 
 
@@ -224,6 +226,7 @@ def plan_jobs(
     stream_above: int = STREAM_ABOVE,
     chunk_frames: int = CHUNK_FRAMES,
     unit: str | None = None,
+    body: str | None = None,
 ) -> tuple[list[Job], list[Result]]:
     """The jobs to run, and the takes settled before running (no skeleton, or already done by this
     recipe when resuming).  An output that would replace its own input is refused (ValueError)
@@ -257,6 +260,7 @@ def plan_jobs(
             chunk_frames,
             status.st_size,
             unit,
+            body,
             ((status.st_mtime_ns, status.st_size), skeleton_stamps[asf] if asf else None),
         )
         if resume and manifest.done(job):
@@ -302,7 +306,8 @@ def _read(job: Job) -> Motion:
     reader = format_of(job.input).read
     assert reader is not None
     skeleton = read_skeleton(job.skeleton, job.unit) if job.skeleton else None
-    return reader(job.input, skeleton, job.frame_rate, job.unit, 1)
+    motion = reader(job.input, skeleton, job.frame_rate, job.unit, 1)
+    return motion if job.body is None else choose_body(motion, job.body)
 
 
 def _write(job: Job, result: Motion, motion: Motion) -> str:

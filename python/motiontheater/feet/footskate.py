@@ -227,7 +227,8 @@ def cleanup(
     contacts: Annotated[Path | None, "footplants CSV (foot,point,first,last; default: detected)"] = None,
     floor: Annotated[float | None, "the floor's level along the up axis, file units (default: fitted)"] = None,
     up: Annotated[
-        Literal["x", "y", "z", "-x", "-y", "-z"] | None, "the up axis (default: y for ASF, found for BVH)"
+        Literal["x", "y", "z", "-x", "-y", "-z"] | None,
+        "the up axis (default: y for ASF/AMC; for BVH found from the frames, as info says)",
     ] = None,
     legs: Annotated[Joints, "hip,knee,ankle[,toe] of the left then the right leg (default: found by name)"] = None,
     blend: Annotated[float, "seconds over which adjustments fade in and out around plants"] = 0.2,

@@ -8,7 +8,7 @@ the viewer's camera) work on a :class:`BodyView` of such a take: the body joint 
 only an offset folded into the offsets.  ``BodyView.restore`` puts a result back into the
 take's own layout, every channel the step did not change exactly as found.
 
-- The **body** is the first joint (in the file's order) whose position channels move; where
+- The **body** is the joint the caller chose (:func:`choose_body`, ``--body``); else the first joint (in the file's order) whose position channels move; where
   none does, the hips by name (the root's name first, else the one nearest the root: SMPL-named
   rigs hold a ``Pelvis_L_Hip`` below their ``Pelvis``); else the root.
 - A position channel **holds an offset** where it is constant over the take to a millionth of
@@ -24,6 +24,7 @@ import numpy as np
 
 from mtcore.rotations import euler_to_matrices, matrices_to_euler, unroll_euler
 
+from .errors import UnknownNameError
 from .motion import Motion
 from .skeleton import ROTATIONS, TRANSLATIONS, Bone, Root, Skeleton, canonical_hierarchy
 from .units import size_up_poses
@@ -99,6 +100,8 @@ def body_joint(motion: Motion, still: set[int] | None = None) -> str:
     """The joint that carries the body: the first whose position channels move, else the hips by
     name (the root's, else the one nearest the root), else the root (``"root"``).  ``still``: the take's still columns, where known."""
     skeleton = motion.skeleton
+    if skeleton.body is not None:
+        return "root" if skeleton.is_root(skeleton.body) else skeleton.body
     still = _still_columns(motion) if still is None else still
     for joint in skeleton.joint_names:
         columns = [c for c, d in zip(motion.columns(joint), skeleton.dofs(joint)) if d in TRANSLATIONS]
@@ -121,7 +124,13 @@ def body_view(motion: Motion) -> BodyView:
     still = _still_columns(motion)
     body = body_joint(motion, still)  # one pass over the values for both
     chain = _chain_above(skeleton, body)
-    if any(c not in still for joint in chain for c in motion.columns(joint)):
+    if moving := [joint for joint in chain if any(c not in still for c in motion.columns(joint))]:
+        if skeleton.body is not None:
+            names = ", ".join(skeleton.root.name if j == "root" else j for j in moving)
+            raise ValueError(
+                f"the body joint '{skeleton.body}' chosen has joints above it that move ({names}): choose "
+                "one of them or a joint above them, or let the body be found"
+            )
         body, chain = "root", []  # a moving joint above the body: the take is seen from its root
     folded = {
         j
@@ -179,6 +188,17 @@ def body_view(motion: Motion) -> BodyView:
     )
     view = Motion(view_skeleton, values, frame_rate=motion.frame_rate, first_frame=motion.first_frame)
     return BodyView(view, motion, body, np.array(columns, dtype=np.intp), above)
+
+
+def choose_body(motion: Motion, joint: str) -> Motion:
+    """The take with ``joint`` (a joint's name, the root's included) as the joint that carries its
+    body, in place of the one :func:`body_joint` finds; UnknownNameError naming the joints there are."""
+    skeleton = motion.skeleton
+    names = {skeleton.root.name: "root", "root": "root", **{b.name: b.name for b in skeleton.bones if not b.end_site}}
+    if joint not in names:
+        shown = ", ".join(n for n in names if n != "root" or skeleton.root.name == "root")
+        raise UnknownNameError(f"no joint '{joint}' to carry the body; the take's joints are {shown}")
+    return motion.replace(skeleton=replace(skeleton, body=joint))
 
 
 def rest_view(skeleton: Skeleton) -> BodyView:

@@ -128,6 +128,8 @@ class Skeleton:
     posed: length_units.Sizing | None = field(default=None, compare=False, repr=False)
     # a frame's channels in which the figure stands, where the rest pose does not (formats.bvh)
     standing: tuple[float, ...] | None = field(default=None, compare=False, repr=False)
+    # the joint that carries the body where the caller chose it (model.rig.choose_body, --body)
+    body: str | None = field(default=None, compare=False, repr=False)
     style: TextStyle = field(default=PLAIN, compare=False, repr=False)  # how its ASF file was laid out
     origin: Origin | None = field(default=None, compare=False, repr=False)  # the ASF file it was read from
     _index: dict[str, int] = field(init=False, repr=False, compare=False)
