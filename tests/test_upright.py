@@ -6,7 +6,7 @@ import pytest
 
 import motiontheater as mt
 from corpus import ids, real_files
-from motiontheater.feet.upright import take_up
+from motiontheater.feet.upright import take_forward, take_up
 from variants import with_static_root
 
 BVHS = real_files("*/*.bvh")
@@ -49,3 +49,14 @@ def test_the_turn_stands_the_up_axis_along_y(data_dir, axis):
     up = take_up(mt.read_bvh(data_dir / "bvh" / "walk01.bvh"), axis)
     np.testing.assert_array_equal(up.turn @ up.vector, [0.0, 1.0, 0.0])
     assert np.linalg.det(up.turn) == 1.0
+
+
+def test_a_take_faces_the_way_it_travels_else_its_feet(data_dir):
+    walk = mt.read_bvh(data_dir / "bvh" / "walk01.bvh")
+    facing = take_forward(walk)
+    assert facing.axis == "z" and "travels 5.54 m" in facing.reason
+    assert take_forward(with_static_root(walk, turn=(90.0, 0.0, 0.0), keep_world=False)).axis == "-y"
+    still = walk.replace(values=np.repeat(walk.values[:1], 30, axis=0))
+    standing = take_forward(still)
+    assert standing.axis == "z" and "feet point along it" in standing.reason
+    assert take_forward(mt.read_bvh(data_dir / "bvh" / "sinusoidal.bvh")).axis is None

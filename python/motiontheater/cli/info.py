@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..feet.upright import take_up
+from ..feet.upright import take_forward, take_up
 from ..formats.bvh import NAMES as BVH_CHANNEL_NAMES
 from ..formats.table import format_for, format_of, skeleton_for, states_unit
 from ..model import units
@@ -103,6 +103,8 @@ def describe(
         },
         "up_axis": up.axis,
         "up_reason": up.reason,
+        "forward": (facing := take_forward(motion, up)).axis,
+        "forward_reason": facing.reason,
         "body": _body(motion),
         "rest_pose": {
             "extents": list(sizing.extents),
@@ -136,6 +138,7 @@ def as_text(facts: dict[str, Any]) -> str:
     unit_name = label if label == "m" else f"{label} = {_g(meters)} m"
     field(lines, "length unit", f"{unit_name}, {unit['source']}: {unit['why']}. {SET_UNIT[0].upper()}{SET_UNIT[1:]}")
     field(lines, "up axis", f"{facts['up_axis']}: {facts['up_reason']}. Set another with --up AXIS where a verb has it")
+    field(lines, "facing", f"{facts['forward'] or 'not told'}: {facts['forward_reason']}")
     body = facts["body"]
     field(lines, "body", f"{body['joint']}: {body['why']}")
     if body["offset_channels"]:

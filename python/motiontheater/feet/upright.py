@@ -69,5 +69,46 @@ def take_up(motion: Motion, up: str | None = None) -> Up:
     return Up(pose_up(motion), f"no legs found by name; {_frames(len(poses))} span most along it")
 
 
+@dataclass(frozen=True)
+class Facing:
+    """Where a take faces: ``axis`` ("z", "-x", ...; None where nothing tells), and why (``reason``)."""
+
+    axis: str | None
+    reason: str
+
+
+TRAVEL = 0.5  # metres from the first frame to the last: a take that goes somewhere faces its way
+
+
+def take_forward(motion: Motion, up: Up | None = None) -> Facing:
+    """The horizontal axis a take faces: the way its body travels from the first frame to the last
+    where it goes :data:`TRAVEL` or more, else the way its feet point (ankles to balls, legs found
+    by name), else None.  ``up``: the take's (default :func:`take_up`'s)."""
+    up = take_up(motion) if up is None else up
+    if not motion.frames:
+        return Facing(None, "the take has no frames")
+    view = sampled_view(motion)
+    poses = view.positions()
+    vertical = up.vector
+
+    def level(v: np.ndarray) -> np.ndarray:
+        return v - np.outer(v @ vertical, vertical) if v.ndim > 1 else v - (v @ vertical) * vertical
+
+    travel = level(poses[-1, 0] - poses[0, 0])
+    metres = float(np.linalg.norm(travel)) * motion.skeleton.meters_per_unit
+    if np.isfinite(metres) and metres >= TRAVEL:
+        return Facing(axis_name(travel), f"the body travels {metres:.3g} m along it from the first frame to the last")
+    try:
+        legs = resolve_legs(view.skeleton)
+    except ValueError:
+        legs = None
+    if legs is not None:
+        toes = level((poses[:, legs.points[:, 3]] - poses[:, legs.points[:, 2]]).reshape(-1, 3))
+        toes = toes[np.isfinite(toes).all(axis=1)]
+        if len(toes) and np.any(mean := toes.mean(axis=0)):
+            return Facing(axis_name(mean), f"the feet point along it (it travels {metres:.2g} m)")
+    return Facing(None, f"it travels {metres:.2g} m and no feet are found by name")
+
+
 def _frames(count: int) -> str:
     return f"{count} frame" if count == 1 else f"{count} frames"
