@@ -8,7 +8,7 @@ import sys
 from ..editing.filtering import FILTERS
 from ..editing.pipeline import Pipeline
 from .steps import RECIPE_HELP, add_filter_options, filter_pipeline
-from .takes import add_take_options
+from .takes import add_nan_option, add_take_options
 from .verb import Verb, prose
 
 
@@ -25,6 +25,7 @@ def _arguments(parser: argparse.ArgumentParser) -> None:
         help="skip takes already done by this recipe from inputs unchanged since (the output folder's manifest says)",
     )
     parser.add_argument("--in-place", action="store_true", help="allow outputs to replace their inputs")
+    add_nan_option(parser)
     parser.add_argument("--quiet", action="store_true", help="no progress bar or summary (failures still reported)")
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
     parser.add_argument("--dask", action="store_true", help="run on a local Dask cluster of --jobs workers")
@@ -54,6 +55,7 @@ def _batch(args: argparse.Namespace) -> int:
         frame_rate=args.frame_rate,
         unit=args.unit,
         body=args.body,
+        allow_nan=args.allow_nan,
         resume=args.resume,
         in_place=args.in_place,
         stream_above=int(args.stream_above * 1e6),

@@ -7,6 +7,7 @@ import argparse
 from ..editing.scene import RECIPE_HELP as SCENE_HELP
 from ..editing.scene import read_recipe
 from ..formats.table import write_take
+from .takes import add_nan_option
 from .verb import Verb, prose
 
 
@@ -14,6 +15,7 @@ def _arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("recipe", help="the TOML recipe")
     parser.add_argument("-o", "--output", help="the take to write (.amc or .bvh, as the motions)")
     parser.add_argument("--dry-run", action="store_true", help="print the frame maps and borders, write nothing")
+    add_nan_option(parser)
 
 
 def _combine(args: argparse.Namespace) -> int:
@@ -26,7 +28,7 @@ def _combine(args: argparse.Namespace) -> int:
     if not args.output:
         raise ValueError("give -o OUT.amc (or --dry-run)")
     result = scene.render()
-    write_take(result, args.output)
+    write_take(result, args.output, allow_non_finite=args.allow_nan)
     print(
         f"{len(scene.tracks)} track(s) over {scene.base.frames} frames: wrote {result.frames} frames "
         f"({result.first_frame}..{result.last_frame}) to {args.output}"

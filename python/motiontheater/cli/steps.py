@@ -15,7 +15,7 @@ from ..formats.table import companion_path, take_suffix, write_skeleton, write_t
 from ..model.motion import Motion
 from ..model.registry import Option, Step, lookup, steps
 from .info import unit_notes
-from .takes import add_output_options, add_take_options, output, settle_input, take_of
+from .takes import add_nan_option, add_output_options, add_take_options, output, settle_input, take_of
 from .verb import Verb, prose
 
 RECIPE_HELP = """\
@@ -59,6 +59,7 @@ def _step_arguments(step: Step, parser: argparse.ArgumentParser) -> None:
     what = "the file to write (" + (", ".join(step.suffixes) if step.is_exporter else ".amc or .bvh") + ")"
     parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
     add_output_options(parser, what)
+    add_nan_option(parser)
     add_take_options(parser)
     if step.dry_run is not None:
         parser.add_argument("--dry-run", action="store_true", help="print what the step would do; write nothing")
@@ -107,15 +108,15 @@ def _run_step(args: argparse.Namespace) -> int:
             print(note, file=sys.stderr)
         return 0
     result = step(motion, **options)
-    written = _write_result(motion, result, target)
+    written = _write_result(motion, result, target, args.allow_nan)
     print(f"{step.name}: {motion.frames} frames of {source} -> {result.frames} frames in {written}")
     return 0
 
 
-def _write_result(motion: Motion, result: Motion, target: str) -> str:
+def _write_result(motion: Motion, result: Motion, target: str, allow_nan: bool) -> str:
     """Write a step's result as its suffix says; an AMC of a new skeleton gets its ASF beside it.
     Returns what was written, in words."""
-    write_take(result, target)
+    write_take(result, target, allow_non_finite=allow_nan)
     for note in unit_notes(motion, result, target):
         print(note, file=sys.stderr)
     skeleton = companion_path(result, target)
@@ -169,6 +170,7 @@ def _filter_arguments(parser: argparse.ArgumentParser) -> None:
     add_filter_options(parser)
     parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
     add_output_options(parser, "the file to write (the input's format)")
+    add_nan_option(parser)
     add_take_options(parser)
 
 
@@ -178,7 +180,7 @@ def _filter(args: argparse.Namespace) -> int:
     target = output(args, source)
     take_suffix(target)
     motion = take_of(args, source)
-    written = _write_result(motion, pipeline.apply(motion), target)
+    written = _write_result(motion, pipeline.apply(motion), target, args.allow_nan)
     entry = pipeline.entries[0]
     which = ", ".join(args.joints) if args.joints else "all joints"
     print(f"{entry.name} {dict(entry.options)['size']} over {motion.frames} frames of {which}: wrote {written}")
@@ -202,6 +204,7 @@ FILTER = Verb(
 def _apply_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
     add_output_options(parser, "the file to write")
+    add_nan_option(parser)
     parser.add_argument("--recipe", required=True, metavar="FILE", help="the TOML recipe of steps")
     add_take_options(parser)
 
@@ -218,7 +221,7 @@ def _apply(args: argparse.Namespace) -> int:
         pipeline.write(result, target)
         written = target
     else:
-        written = _write_result(motion, result, target)
+        written = _write_result(motion, result, target, args.allow_nan)
     names = ", ".join(entry.name for entry in pipeline.entries) or "no steps"
     print(f"{args.recipe} ({names}) on {motion.frames} frames of {source}: wrote {written}")
     return 0

@@ -59,6 +59,16 @@ def add_output_options(parser: argparse.ArgumentParser, what: str) -> None:
     parser.add_argument("--in-place", action="store_true", help="allow the output to replace the input")
 
 
+def add_nan_option(parser: argparse.ArgumentParser) -> None:
+    """``--allow-nan`` of a verb that writes takes: without it a result holding NaN or inf is
+    refused, naming where (:func:`motiontheater.formats.table.write_take`)."""
+    parser.add_argument(
+        "--allow-nan",
+        action="store_true",
+        help="write values that are not numbers (NaN, inf) as they are; most readers refuse such a file",
+    )
+
+
 def settle_input(args: argparse.Namespace) -> str:
     """The take's path.  The older form ``verb SKELETON.asf TAKE.amc`` is read as ``verb
     TAKE.amc --asf SKELETON.asf`` (``args`` is set so)."""

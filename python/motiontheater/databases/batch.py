@@ -74,6 +74,7 @@ class Job:
     bytes: int = 0  # the take's size when planned
     unit: str | None = None  # the takes' length unit (--unit), when given
     body: str | None = None  # the joint that carries the body (--body), when given
+    allow_nan: bool = False  # results holding NaN or inf are written (--allow-nan), not refused
     stamps: tuple[Stamp, Stamp | None] | None = None  # the take's and its skeleton's when planned
 
 
@@ -227,6 +228,7 @@ def plan_jobs(
     chunk_frames: int = CHUNK_FRAMES,
     unit: str | None = None,
     body: str | None = None,
+    allow_nan: bool = False,
 ) -> tuple[list[Job], list[Result]]:
     """The jobs to run, and the takes settled before running (no skeleton, or already done by this
     recipe when resuming).  An output that would replace its own input is refused (ValueError)
@@ -261,6 +263,7 @@ def plan_jobs(
             status.st_size,
             unit,
             body,
+            allow_nan,
             ((status.st_mtime_ns, status.st_size), skeleton_stamps[asf] if asf else None),
         )
         if resume and manifest.done(job):
@@ -326,7 +329,7 @@ def _write(job: Job, result: Motion, motion: Motion) -> str:
             _copy_skeleton(job.skeleton, os.path.dirname(target))
         else:
             write_skeleton(result.skeleton, companion)
-    write_take(result, target)
+    write_take(result, target, allow_non_finite=job.allow_nan)
     return target
 
 

@@ -115,8 +115,30 @@ def prepare(
     found = legs if isinstance(legs, Legs) else resolve_legs(motion.skeleton, legs)
     if found.skeleton.joint_names != motion.skeleton.joint_names:
         raise ValueError("the legs given are of another skeleton than the motion's")
+    _require_finite_legs(motion, found)
     arrays = leg_arrays(motion, found, up=up, meters_per_unit=mpu)
     return arrays, fit_ground(arrays, motion.frame_rate, mpu, up=up, floor=floor), mpu
+
+
+def _require_finite_legs(motion: Motion, legs: Legs) -> None:
+    """ValueError unless some frame holds every channel that places the legs (the root's, the
+    legs' and the joints' between them) as a number: a take of NaN has no feet to plant."""
+    skeleton, joints = motion.skeleton, set()
+    for index in legs.rotators.ravel():
+        if index < 0:
+            continue
+        joint = skeleton.joint_names[index]
+        while joint not in joints:
+            joints.add(joint)
+            if joint == "root":
+                break
+            joint = skeleton.parent(joint)
+    columns = [c for joint in joints for c in motion.columns(joint)]
+    if motion.frames and not np.isfinite(motion.values[:, columns]).all(axis=1).any():
+        raise ValueError(
+            "no frame holds the legs as numbers (their channels are NaN or inf in every frame): there are "
+            "no feet to measure or plant; fill the gaps first (the fill_gaps step)"
+        )
 
 
 def contacts_of(

@@ -16,6 +16,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from ..model.motion import Motion
 from ..model.skeleton import Skeleton, settle_length_unit
 from .amc import read_amc, skeleton_path_for, write_amc
@@ -200,9 +202,13 @@ def write_skeleton(skeleton: Skeleton, path: str | os.PathLike) -> None:
     row.write_skeleton(skeleton, path)
 
 
-def write_take(motion: Motion, path: str | os.PathLike) -> None:
+def write_take(motion: Motion, path: str | os.PathLike, *, allow_non_finite: bool = False) -> None:
     """Write a motion in the format its suffix names; a motion of another convention is refused
-    (``motiontheater convert`` turns one into the other)."""
+    (``motiontheater convert`` turns one into the other), and so is one holding NaN or inf, unless
+    ``allow_non_finite`` (ValueError naming the frames and channels: a file of ``nan`` tokens is one
+    that most readers refuse)."""
+    if not allow_non_finite and not np.isfinite(motion.values).all():
+        raise ValueError(f"{os.fspath(path)}: {non_finite_text(motion)}")
     row = format_of(path)
     if row.write is None or motion.skeleton.convention != row.convention:
         other = suffix_for(motion.skeleton.convention)
@@ -212,3 +218,22 @@ def write_take(motion: Motion, path: str | os.PathLike) -> None:
             f"name the output {other}, or convert it first (motiontheater convert)"
         )
     row.write(motion, path)
+
+
+def non_finite_text(motion: Motion) -> str:
+    """Where a motion holds values that are not numbers, in words, and what to do about it."""
+    bad = ~np.isfinite(motion.values)
+    frames = np.flatnonzero(bad.any(axis=1)) + motion.first_frame
+    runs = np.split(frames, np.flatnonzero(np.diff(frames) > 1) + 1) if len(frames) else []
+    spans = [f"{r[0]}" if len(r) == 1 else f"{r[0]}-{r[-1]}" for r in runs[:4]] + (["..."] if len(runs) > 4 else [])
+    columns = np.flatnonzero(bad.any(axis=0))
+    names = [
+        f"{motion.skeleton.root.name if j == 'root' else j} {d}" for j, d in (motion.channels[c] for c in columns[:4])
+    ]
+    kinds = " and ".join(k for k, f in (("NaN", np.isnan), ("inf", np.isinf)) if f(motion.values).any())
+    return (
+        f"{int(bad.sum())} values are {kinds} (frames {', '.join(spans)}; channels {', '.join(names)}"
+        f"{', ...' if len(columns) > 4 else ''}), which most readers refuse: fill the gaps (the fill_gaps "
+        "step; --max-gap SECONDS for longer ones), or write them as they are with --allow-nan "
+        "(Python: write_take(..., allow_non_finite=True))"
+    )
