@@ -155,3 +155,16 @@ def test_a_given_body_is_the_body(data_dir, tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["body"]["joint"] == "Hips"
     assert main(["info", str(take), "--body", "LeftUpLeg"]) == 2  # the hips above it move
     assert "the body joint 'LeftUpLeg' chosen has joints above it that move (Hips)" in capsys.readouterr().err
+
+
+def test_feet_measures_at_an_assumed_unit_say_so(files):
+    """skate, contacts, cleanup and view's contacts measure in metres: at an assumed unit, a warning."""
+    take = mt.read_bvh(files["take"])
+    with pytest.warns(UserWarning, match=r"length unit is assumed \(cm\).*--unit UNIT"):
+        mt.skate_metrics(take)
+    given = mt.read_bvh(files["take"], unit=UNIT)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mt.skate_metrics(given)

@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Literal
@@ -59,6 +60,7 @@ import numpy as np
 
 from mtcore import footskate as kernels
 
+from ..model import units
 from ..model.motion import Motion
 from ..model.registry import Joints, step
 from ..model.rig import body_view
@@ -109,6 +111,14 @@ def prepare(
     The motion is seen from its body (:func:`~motiontheater.model.rig.body_view`): a static joint
     above the hips and position channels that only hold offsets are not the legs' concern."""
     motion = body_view(motion).motion
+    if meters_per_unit is None and motion.skeleton.length_source == "assumed":
+        warnings.warn(
+            f"the take's length unit is assumed ({units.label(motion.skeleton.length_unit)}): its size tells "
+            f"none, so the footplants' thresholds in metres may not fit; give it with --unit UNIT (Python: "
+            f"read it with unit=UNIT), UNIT: {units.UNIT_HELP}",
+            UserWarning,
+            stacklevel=3,
+        )
     mpu = motion.skeleton.meters_per_unit if meters_per_unit is None else float(meters_per_unit)
     if not (mpu > 0 and math.isfinite(mpu)):
         raise ValueError(f"meters_per_unit must be a positive number, got {meters_per_unit!r}")
