@@ -15,7 +15,8 @@ import pytest
 
 import motiontheater as mt
 from conftest import DATA
-from motiontheater.characters.retarget import _cached_plan, _rest_channels, _root_positions, _unroll
+from motiontheater.characters.retarget import _cached_plan, _root_positions, _unroll
+from motiontheater.model.rig import rest_values
 from twins import retarget as retarget_twin
 
 FAST = dict(rounds=30, iterations=1, warmup_rounds=2)
@@ -42,8 +43,7 @@ def joint_frames(take) -> int:
 def numpy_retarget(motion: mt.Motion, plan) -> mt.Motion:
     """retarget() with the numpy twin in place of the kernel."""
     target = plan.target
-    values = np.zeros((motion.frames, len(target.channels)))
-    _rest_channels(target, values)
+    values = rest_values(target, motion.frames)
     rotations = retarget_twin.retarget_rotations(
         motion.values, plan.source_tree, target.tree, len(target.channels), plan.kernel
     )
