@@ -48,3 +48,21 @@ def test_bench_command_markdown(capsys, monkeypatch):
     assert "## The thesis scene: 267 frames x 90 rotation channels = 24,030 values" in out
     assert "| median | 3 | 2.08 s | 0.59 s | 4x |" in out
     assert "## One hour at 120 Hz: 100 frames x 62 channels" in out
+
+
+def test_every_benchmark_module_is_collected():
+    """The benchmarks are not run by the suite: that they still import (a renamed helper breaks
+    one silently until someone measures) is checked here, by collecting them."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    run = subprocess.run(
+        [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", "benchmarks"],
+        cwd=root,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
