@@ -497,3 +497,10 @@ def test_bad_input_is_refused_and_nothing_is_written(argv, message, tmp_path, ca
     assert main(["cleanup", *args]) == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_the_report_prints_no_negative_zero(data_dir):
+    report = mt.skate_metrics(mt.read_take(data_dir / "cmu" / "01_01.amc"))
+    foot = report.feet[0]
+    tiny = dataclasses.replace(report, feet=(dataclasses.replace(foot, penetration_mm=-0.001, float_mm=-0.0),))
+    assert "-0.00" not in tiny.text() and "| 0.00 | 0.00 |" in tiny.text()

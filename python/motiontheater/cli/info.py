@@ -57,7 +57,7 @@ def describe(
     axis = up.axis.lstrip("-")
     first = motion.positions()[0] if motion.frames else None
     lows, highs = _ranges(motion.values)
-    joints = []
+    joints, depths = [], _depths(skeleton)
     for name in ("root", *skeleton.bone_names):
         bone = None if name == "root" else skeleton.bone(name)
         start = skeleton.first_column(name)
@@ -77,7 +77,7 @@ def describe(
                 "name": skeleton.root.name if name == "root" else name,
                 "parent": None if name == "root" else _point_name(skeleton, skeleton.parent(name)),
                 "kind": "root" if bone is None else "end site" if bone.end_site else "joint" if bvh else "bone",
-                "depth": _depth(skeleton, name),
+                "depth": depths[name],
                 "channels": channels,
             }
         )
@@ -160,9 +160,9 @@ def as_text(facts: dict[str, Any]) -> str:
     angle = "degrees" if facts["angle_unit"] == "deg" else "radians"
     field(lines, "joints", f"{counted} (the root included){sites}; {facts['channels']} channels, angles in {angle}")
     lines += ["", f"Joint tree, each channel with its range over the take (min .. max; lengths in {label}):"]
-    width = max((2 * j["depth"] + 2 + len(c["name"]) for j in joints for c in j["channels"]), default=0)
+    width = max((len(_indent(j["depth"])) + 2 + len(c["name"]) for j in joints for c in j["channels"]), default=0)
     for joint in joints:
-        pad = "  " * joint["depth"]
+        pad = _indent(joint["depth"])
         kind = (
             " (end site)"
             if joint["kind"] == "end site"
@@ -177,6 +177,13 @@ def as_text(facts: dict[str, Any]) -> str:
             low, high = _span(c["min"], c["max"])
             lines.append(f"  {name:<{width}}  {low:>11} .. {high:<11} {c['unit']}")
     return "\n".join(lines)
+
+
+DEEPEST = 24  # levels indented; deeper joints say their depth (a long chain would be all spaces)
+
+
+def _indent(depth: int) -> str:
+    return "  " * depth if depth <= DEEPEST else "  " * DEEPEST + f"[{depth}] "
 
 
 def field(lines: list[str], name: str, text: str) -> None:
@@ -311,12 +318,18 @@ def _point_name(skeleton, joint: str) -> str:
     return skeleton.root.name if joint == "root" else joint
 
 
-def _depth(skeleton, joint: str) -> int:
-    depth = 0
-    while joint != "root":
-        joint = skeleton.parent(joint)
-        depth += 1
-    return depth
+def _depths(skeleton) -> dict[str, int]:
+    """Each joint's depth below the root, in one walk (a 10,000-level chain is read in a blink)."""
+    depths = {"root": 0}
+    for name in skeleton.bone_names:
+        path = []
+        while name not in depths:
+            path.append(name)
+            name = skeleton.parent(name)
+        for joint in reversed(path):
+            depths[joint] = depths[name] + 1
+            name = joint
+    return depths
 
 
 def _g(value: float | None) -> str:

@@ -89,11 +89,17 @@ class SkateReport:
             "|---|---|---:|---:|---:|---:|---:|---:|",
         ]
         for f in self.feet:
-            lines.append(
-                f"| {f.foot} | {f.plants['heel']}, {f.plants['ball']} | {f.sliding_mean_mm:.2f} | "
-                f"{f.sliding_max_mm:.2f} | {100 * f.skating_ratio:.2f} | {100 * f.planted_skating_ratio:.2f} | "
-                f"{f.penetration_mm:.2f} | {f.float_mm:.2f} |"
+            numbers = (
+                f.sliding_mean_mm,
+                f.sliding_max_mm,
+                100 * f.skating_ratio,
+                100 * f.planted_skating_ratio,
+                f.penetration_mm,
+                f.float_mm,
             )
+            # rounded first, then + 0.0: a value that rounds to nothing prints as 0.00, not -0.00
+            shown = " | ".join(f"{round(v, 2) + 0.0:.2f}" for v in numbers)
+            lines.append(f"| {f.foot} | {f.plants['heel']}, {f.plants['ball']} | {shown} |")
         return "\n".join(lines)
 
 

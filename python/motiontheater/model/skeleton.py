@@ -434,15 +434,17 @@ def _parents_of(hierarchy, index: dict[str, int]) -> dict[str, str]:
             if child in parents:
                 raise HierarchyError(f"bone '{child}' has two parents, '{parents[child]}' and '{parent}'")
             parents[child] = parent
+    reaches = {"root"}  # the bones known to reach the root: each bone is walked once, not once per bone below it
     for name in index:
         if name not in parents:
             raise HierarchyError(f"bone '{name}' has no parent in the hierarchy")
-        seen, node = set(), name
-        while node != "root":
-            if node in seen:
+        path, node = set(), name
+        while node not in reaches:
+            if node in path:
                 raise HierarchyError(f"bone '{name}' is in a cycle that does not reach the root")
-            seen.add(node)
+            path.add(node)
             node = parents[node]
+        reaches |= path
     return parents
 
 
