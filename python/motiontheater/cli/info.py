@@ -111,6 +111,7 @@ def describe(
             "extents_m": [e * meters for e in sizing.extents],
             "height": sizing.extents["xyz".index(axis)],
             "height_m": sizing.extents["xyz".index(axis)] * meters,
+            "from_poses": skeleton.posed is not None,  # the rest pose stands no figure: the frames' median
         },
         "first_frame_height": None if first is None else _clean(_extent(first, axis)),
         "first_frame_height_m": None if first is None else _clean(_extent(first, axis) * meters),
@@ -148,12 +149,16 @@ def as_text(facts: dict[str, Any]) -> str:
             f"{body['offset_channels']} position channels of {body['offset_joints']} joints below it only hold "
             "their OFFSET (constant over the take): steps treat them as offsets and write them back as found",
         )
-    height = f"{_g(rest['height_m'])} m = {_g(rest['height'])} {label} in the rest pose"
+    pose = "the frames' poses (median)" if rest["from_poses"] else "the rest pose"
+    height = f"{_g(rest['height_m'])} m = {_g(rest['height'])} {label} in {pose}"
     if facts["first_frame_height"] is not None:
         height += f", {_g(facts['first_frame_height_m'])} m = {_g(facts['first_frame_height'])} {label} in frame 1"
     field(lines, "height", f"{height} (the extent along {facts['up_axis'].lstrip('-')})")
     extents = " x ".join(_g(e) for e in rest["extents"])
-    field(lines, "rest pose", f"{extents} {label} along x, y, z")
+    if rest["from_poses"]:
+        field(lines, "poses", f"{extents} {label} along x, y, z (median; the rest pose stands no figure)")
+    else:
+        field(lines, "rest pose", f"{extents} {label} along x, y, z")
     joints = facts["joints"]
     counted = sum(1 for j in joints if j["kind"] != "end site")
     sites = f", {len(joints) - counted} end sites" if len(joints) > counted else ""
