@@ -69,7 +69,10 @@ def test_fill_gaps_and_residuals_verbs(cmu, tmp_path, capsys):
     assert main(["fill_gaps", str(cmu / "07_05-walk.amc"), "--asf", asf, "--drop", "100:110", "-o", str(out)]) == 0
     filled = read(out, asf)
     assert not np.isnan(filled.values).any()
-    assert main(["fill_gaps", str(cmu / "07_05-walk.amc"), "--asf", asf, "--drop", "100:200", "-o", str(out)]) == 0
+    long_gap = ["fill_gaps", str(cmu / "07_05-walk.amc"), "--asf", asf, "--drop", "100:200", "-o", str(out)]
+    assert main(long_gap) == 2  # left missing, and NaN is not written unless asked
+    assert "values are NaN (frames 100-200" in capsys.readouterr().err
+    assert main([*long_gap, "--allow-nan"]) == 0
     assert "left missing: root tx frames 100-200" in capsys.readouterr().err
     csv = tmp_path / "residuals.csv"
     assert main(["residuals", str(cmu / "07_05-walk.amc"), "--asf", asf, "--joints", "lfemur", "-o", str(csv)]) == 0
