@@ -229,3 +229,11 @@ def test_a_take_at_a_rounded_frame_time_resamples_to_its_own_rate(data_dir):
     np.testing.assert_allclose(same.values, take.values, atol=1e-9)
     half = take.resample(rate=60)
     assert half.frame_rate == 60.0 and abs(half.frames - take.frames / 2) <= 1
+
+
+def test_a_joint_named_as_the_root_is_refused_with_its_line(data_dir, tmp_path):
+    text = (data_dir / "bvh" / "walk01.bvh").read_text()
+    path = tmp_path / "twice.bvh"
+    path.write_text(text.replace("JOINT RightUpLeg", "JOINT Hips", 1))
+    with pytest.raises(mt.FormatError, match=r"twice.bvh, line 6: joint 'Hips' has the name of the ROOT \(line 2\)"):
+        mt.read_bvh(path)

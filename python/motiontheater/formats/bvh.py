@@ -175,6 +175,11 @@ def _hierarchy(lines: list[tuple[int, str]]) -> Skeleton:
                 raise FormatError(f"{key} needs a name", number)
             if key == "JOINT" and (problem := name_problem(joint.name, "bvh")):
                 raise FormatError(problem, number)
+            if key == "JOINT" and joint.name == stack[0].name:
+                raise FormatError(
+                    f"joint '{joint.name}' has the name of the ROOT (line {stack[0].line}): each joint needs its own",
+                    number,
+                )
             pos = _expect_brace(lines, pos, number)
             if stack:
                 pairs.append((stack[-1].name if len(stack) > 1 else "root", (joint.name,)))
