@@ -748,3 +748,21 @@ def test_edits_on_a_game_rig_name_its_own_joints(browser, data_dir, tmp_path):
     got = previewed(browser, motion.values.shape)
     assert np.abs(got - expected).max() <= 1e-6 and not np.array_equal(expected, motion.values)
     assert console_errors(browser) == []
+
+
+def test_long_take_names_leave_the_joint_values_in_view(browser, tmp_path, data_dir):
+    """HDM05's take names are long: the selected joint's table cuts them short (whole on hover) and
+    its values stay inside the side panel, with no sideways scrolling."""
+    folder = data_dir / "hdm05"
+    names = ["HDM_bd_elbowToKnee1RepsLelbowStart_005_120.amc", "HDM_bd_jogLeftCircle4StepsRstart_001_120.amc"]
+    skeleton = mt.read_asf(folder / "HDM_bd.asf")
+    takes = [mt.read_amc(folder / name, skeleton) for name in names]
+    open_page(browser, tmp_path, takes, names=names)
+    side, right, scroll, client, titles = browser.execute_script(
+        """const side = document.getElementById('side');
+        const cells = [...document.querySelectorAll('#channels td.v')].map(c => c.getBoundingClientRect().right);
+        const heads = [...document.querySelectorAll('#channels td.take')].map(c => c.title);
+        return [side.getBoundingClientRect().right, Math.max(...cells), side.scrollWidth, side.clientWidth, heads];"""
+    )
+    assert right <= side and scroll <= client, (right, side, scroll, client)
+    assert titles == names

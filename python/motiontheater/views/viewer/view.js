@@ -813,6 +813,8 @@
     for (const take of S.takes) {
       const cell = head.insertCell();
       cell.textContent = take.name;
+      cell.title = take.name; // cut short by the style (HDM05's names are long): the whole name on hover
+      cell.className = "take";
       cell.style.color = take.colour;
     }
     const dofs = t.dofs[j];
