@@ -322,9 +322,14 @@ def test_inputs_files_folders_and_globs(data_dir, tmp_path):
     )
     assert len(found) == 11 + 1 + 1
     assert len(batch.find_takes([str(data_dir / "bvh")])) == 8
-    assert found[data_dir / "edge" / "test.amc"] == Path("test.amc")
-    assert found[data_dir / "cmu" / "02_01.amc"] == Path("02_01.amc")
-    assert found[data_dir / "hdm05" / "HDM_bd_squat1Reps_003_120.amc"] == Path("HDM_bd_squat1Reps_003_120.amc")
+    # several input folders: a subfolder of the output each, named as the folder
+    assert found[data_dir / "edge" / "test.amc"] == Path("edge/test.amc")
+    assert found[data_dir / "cmu" / "02_01.amc"] == Path("cmu/02_01.amc")
+    assert found[data_dir / "hdm05" / "HDM_bd_squat1Reps_003_120.amc"] == Path("hdm05/HDM_bd_squat1Reps_003_120.amc")
+    # one folder, or files of one folder: the output folder itself
+    assert dict(batch.find_takes([str(data_dir / "edge")]))[data_dir / "edge" / "test.amc"] == Path("test.amc")
+    alone = batch.find_takes([str(data_dir / "cmu" / "02_01.amc"), str(data_dir / "cmu" / "02_02.amc")])
+    assert [relative for _, relative in alone] == [Path("02_01.amc"), Path("02_02.amc")]
     with pytest.raises(FileNotFoundError, match="no file, folder or glob match"):
         batch.find_takes([str(tmp_path / "nothing.amc")])
 

@@ -10,6 +10,7 @@ import os
 import re
 import secrets
 import shutil
+import stat
 import typing
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -27,7 +28,7 @@ PARTIAL_PREFIX = ".mt-partial-"  # files being written; a killed run may leave t
 def read_source(source: Source) -> tuple[bytes, str | None]:
     """The bytes of a path or file object, and a name for messages."""
     if isinstance(source, (str, os.PathLike)):
-        with open(source, "rb") as f:
+        with open_regular(source) as f:
             return f.read(), os.fspath(source)
     data = source.read()
     if isinstance(data, str):
@@ -39,11 +40,79 @@ def read_source(source: Source) -> tuple[bytes, str | None]:
 def mapped_source(source: Source) -> Iterator[tuple[bytes | mmap.mmap, str | None]]:
     """Like :func:`read_source`, but a file named by path is memory-mapped, not
     copied: large takes are scanned straight from the page cache."""
-    if not isinstance(source, (str, os.PathLike)) or os.path.getsize(source) == 0:
+    if not isinstance(source, (str, os.PathLike)):
         yield read_source(source)
         return
-    with open(source, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
-        yield mapped, os.fspath(source)
+    with open_regular(source) as f:
+        if os.fstat(f.fileno()).st_size == 0:
+            yield b"", os.fspath(source)
+            return
+        with mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
+            yield mapped, os.fspath(source)
+
+
+class InputError(OSError):
+    """A path to read that is not a regular file (a device, a FIFO, a socket, a folder) or cannot
+    be reached (a symlink loop): the message names the file and says what it is."""
+
+    def __str__(self) -> str:
+        return str(self.strerror)
+
+
+def open_regular(path: str | os.PathLike) -> IO[bytes]:
+    """The file at ``path`` opened to read, refused unless it is a regular file: reading a device
+    such as /dev/zero never ends, and opening a FIFO waits for a writer (it is opened without
+    waiting, then looked at).  FileNotFoundError or :class:`InputError` naming the file."""
+    name = os.fspath(path)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0) | getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(name, flags)
+    except OSError as e:
+        raise _input_error(name, e) from None
+    status = os.fstat(fd)
+    if not stat.S_ISREG(status.st_mode):
+        os.close(fd)
+        raise _not_regular(name, status.st_mode)
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, "rb")
+
+
+def regular_file(path: str | os.PathLike) -> os.stat_result:
+    """The status of the regular file at ``path``, refused (as :func:`open_regular`) when it is
+    anything else; for a caller that reads it later, or elsewhere."""
+    name = os.fspath(path)
+    try:
+        status = os.stat(name)
+    except OSError as e:
+        raise _input_error(name, e) from None
+    if not stat.S_ISREG(status.st_mode):
+        raise _not_regular(name, status.st_mode)
+    return status
+
+
+def _not_regular(name: str, mode: int) -> InputError:
+    kinds = (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISFIFO, "a named pipe (FIFO)"),
+        (stat.S_ISSOCK, "a socket"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+    )
+    kind = next((text for test, text in kinds if test(mode)), "not a file")
+    return InputError(errno.EINVAL, f"{name}: {kind}, not a regular file; give a file to read")
+
+
+def _input_error(name: str, error: OSError) -> OSError:
+    """The error of a path that could not be opened or looked at, naming it as the user did."""
+    if error.errno == errno.ENOENT:
+        broken = os.path.islink(name)
+        return FileNotFoundError(f"{name}: {'a symlink to a missing file' if broken else 'no such file'}")
+    if error.errno == errno.ELOOP:
+        return InputError(error.errno, f"{name}: symlink loop (the links lead back to themselves)")
+    if error.errno == errno.ENXIO:  # what opening a socket gives
+        with contextlib.suppress(OSError):
+            return _not_regular(name, os.stat(name).st_mode)
+    return error
 
 
 @dataclass(frozen=True)
@@ -127,7 +196,7 @@ def encode(text: str) -> bytes:
 def output(target: Source) -> Iterator[IO[bytes]]:
     """A binary stream to write to.  For a path, the text goes to a temporary file
     beside it that replaces the path only when complete, so that a failure
-    leaves no partial file; the file gets the permissions any new file gets
+    leaves no partial file, and a missing folder is made first; the file gets the permissions any new file gets
     (the umask's).  An OSError names the target, never the temporary file."""
     if not isinstance(target, (str, os.PathLike)):
         yield typing.cast(IO[bytes], target.buffer if isinstance(target, io.TextIOWrapper) else target)
@@ -136,6 +205,7 @@ def output(target: Source) -> Iterator[IO[bytes]]:
     directory = os.path.dirname(os.path.abspath(path))
     remove_stale_partials(directory)
     try:
+        os.makedirs(directory, exist_ok=True)  # the folder of a path named for the first time
         fd, tmp = _partial(directory)
     except OSError as e:
         raise OutputError(e.errno, f"cannot write {path}: {e.strerror}") from None

@@ -72,7 +72,7 @@ from mtcore.retarget import RetargetPlan as KernelPlan
 from mtcore.retarget import retarget_rotations
 from mtcore.rotations import unroll_euler
 
-from ..formats.table import read_skeleton, skeleton_suffixes
+from ..formats.table import read_skeleton, skeleton_convention, skeleton_suffixes
 from ..model import units
 from ..model.motion import Motion
 from ..model.registry import is_step, step
@@ -804,6 +804,7 @@ def describe_retarget(
     "put a take on another skeleton (.asf or .bvh): other proportions, another rig",
     frames="none",
     dry_run=describe_retarget,
+    convention=lambda convention, options: skeleton_convention(options["to"]),
 )
 def retarget_step(
     motion: Motion,

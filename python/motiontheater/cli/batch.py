@@ -24,7 +24,11 @@ def _arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="skip takes already done by this recipe from inputs unchanged since (the output folder's manifest says)",
     )
-    parser.add_argument("--in-place", action="store_true", help="allow outputs to replace their inputs")
+    parser.add_argument(
+        "--in-place",
+        action="store_true",
+        help="allow outputs to replace their inputs, and skeletons to replace other skeleton files beside them",
+    )
     add_nan_option(parser)
     parser.add_argument("--quiet", action="store_true", help="no progress bar or summary (failures still reported)")
     parser.add_argument("--json", action="store_true", help="print a JSON summary")

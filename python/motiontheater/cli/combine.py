@@ -6,7 +6,7 @@ import argparse
 
 from ..editing.scene import RECIPE_HELP as SCENE_HELP
 from ..editing.scene import read_recipe
-from ..formats.table import write_take
+from ..formats.table import write_take_with_skeleton
 from .takes import add_nan_option
 from .verb import Verb, prose
 
@@ -28,7 +28,7 @@ def _combine(args: argparse.Namespace) -> int:
     if not args.output:
         raise ValueError("give -o OUT.amc (or --dry-run)")
     result = scene.render()
-    write_take(result, args.output, allow_non_finite=args.allow_nan)
+    write_take_with_skeleton(result, args.output, allow_non_finite=args.allow_nan)
     print(
         f"{len(scene.tracks)} track(s) over {scene.base.frames} frames: wrote {result.frames} frames "
         f"({result.first_frame}..{result.last_frame}) to {args.output}"

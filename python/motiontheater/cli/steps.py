@@ -11,7 +11,7 @@ from typing import Any
 
 from ..editing.filtering import FILTERS
 from ..editing.pipeline import Pipeline
-from ..formats.table import companion_path, take_suffix, write_skeleton, write_take
+from ..formats.table import take_suffix, write_take_with_skeleton
 from ..model.motion import Motion
 from ..model.registry import Option, Step, lookup, steps
 from .info import unit_notes
@@ -108,22 +108,18 @@ def _run_step(args: argparse.Namespace) -> int:
             print(note, file=sys.stderr)
         return 0
     result = step(motion, **options)
-    written = _write_result(motion, result, target, args.allow_nan)
+    written = _write_result(motion, result, target, args)
     print(f"{step.name}: {motion.frames} frames of {source} -> {result.frames} frames in {written}")
     return 0
 
 
-def _write_result(motion: Motion, result: Motion, target: str, allow_nan: bool) -> str:
-    """Write a step's result as its suffix says; an AMC of a new skeleton gets its ASF beside it.
-    Returns what was written, in words."""
-    write_take(result, target, allow_non_finite=allow_nan)
+def _write_result(motion: Motion, result: Motion, target: str, args: argparse.Namespace) -> str:
+    """Write a step's result as its suffix says, an AMC with the ASF it is read with when that is
+    not beside it already.  Returns what was written, in words."""
+    skeleton = write_take_with_skeleton(result, target, allow_non_finite=args.allow_nan, replace=args.in_place)
     for note in unit_notes(motion, result, target):
         print(note, file=sys.stderr)
-    skeleton = companion_path(result, target)
-    if skeleton is not None and result.skeleton is not motion.skeleton:
-        write_skeleton(result.skeleton, skeleton)
-        return f"{target} and its skeleton {skeleton}"
-    return target
+    return target if skeleton is None else f"{target} and its skeleton {skeleton}"
 
 
 def _list_steps(args: argparse.Namespace) -> int:
@@ -180,7 +176,7 @@ def _filter(args: argparse.Namespace) -> int:
     target = output(args, source)
     take_suffix(target)
     motion = take_of(args, source)
-    written = _write_result(motion, pipeline.apply(motion), target, args.allow_nan)
+    written = _write_result(motion, pipeline.apply(motion), target, args)
     entry = pipeline.entries[0]
     which = ", ".join(args.joints) if args.joints else "all joints"
     print(f"{entry.name} {dict(entry.options)['size']} over {motion.frames} frames of {which}: wrote {written}")
@@ -221,7 +217,7 @@ def _apply(args: argparse.Namespace) -> int:
         pipeline.write(result, target)
         written = target
     else:
-        written = _write_result(motion, result, target, args.allow_nan)
+        written = _write_result(motion, result, target, args)
     names = ", ".join(entry.name for entry in pipeline.entries) or "no steps"
     print(f"{args.recipe} ({names}) on {motion.frames} frames of {source}: wrote {written}")
     return 0

@@ -56,7 +56,11 @@ def add_output_options(parser: argparse.ArgumentParser, what: str) -> None:
     """The output file, as the second argument or with ``-o``, and ``--in-place``."""
     parser.add_argument("output_file", nargs="?", metavar="OUT", help=f"{what} (or give it with -o)")
     parser.add_argument("-o", "--output", help=f"{what}")
-    parser.add_argument("--in-place", action="store_true", help="allow the output to replace the input")
+    parser.add_argument(
+        "--in-place",
+        action="store_true",
+        help="allow the output to replace the input, and an AMC's to replace the skeleton file beside it",
+    )
 
 
 def add_nan_option(parser: argparse.ArgumentParser) -> None:

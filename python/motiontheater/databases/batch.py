@@ -16,18 +16,19 @@ elsewhere.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import glob
 import hashlib
 import json
 import multiprocessing
 import os
-import shutil
 import signal
 import sys
 import tempfile
 import threading
 import time
+from collections import Counter
 from collections.abc import Generator, Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -35,20 +36,22 @@ from typing import Any
 
 from mtcore import cpu_count, share_cores
 
-from .._io import WRITE_ERRORS, OutputError, output, remove_stale_partials
+from .._io import WRITE_ERRORS, OutputError, output, read_source, regular_file, remove_stale_partials
 from .._signals import terminate_as_interrupt
 from ..editing.pipeline import Pipeline
 from ..editing.streaming import CHUNK_FRAMES, stream, streamable
 from ..formats.table import (
+    companion_needed,
     companion_path,
+    file_bytes,
     format_of,
     read_skeleton,
     require_frames,
     skeleton_for,
     suffix_for,
     take_suffixes,
-    write_skeleton,
     write_take,
+    write_take_with_skeleton,
 )
 from ..model.errors import FormatError
 from ..model.motion import Motion
@@ -62,7 +65,8 @@ Stamp = tuple[int, int]  # a file's modification time (ns) and size: it has not 
 
 @dataclass(frozen=True)
 class Job:
-    """One take to process: where it is, where its result goes (its suffix decided when written)."""
+    """One take to process: where it is, where its result goes (``output`` mirrors the take's path
+    and keys the manifest; ``written`` has the suffix of what the recipe makes)."""
 
     input: str
     output: str
@@ -76,6 +80,8 @@ class Job:
     body: str | None = None  # the joint that carries the body (--body), when given
     allow_nan: bool = False  # results holding NaN or inf are written (--allow-nan), not refused
     stamps: tuple[Stamp, Stamp | None] | None = None  # the take's and its skeleton's when planned
+    written: str = ""  # the file its result goes to, named when planned (default: output)
+    replace: bool = False  # a skeleton file beside the output holding another skeleton is replaced (--in-place)
 
 
 @dataclass
@@ -96,8 +102,14 @@ class Result:
 
 
 def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
-    """(take, its path relative to the output folder) for every AMC and BVH under the inputs."""
-    found: dict[Path, Path] = {}
+    """(take, its path relative to the output folder) for every AMC and BVH under the inputs.
+
+    One input folder (or files and globs of one folder) mirrors into the output folder itself;
+    several mirror into a subfolder each, named as the folder (or, where two share a name, as its
+    path below the folder they have in common), so that their takes never meet.  A file named as
+    a take that is not one (a FIFO, a device, a symlink loop) is listed, for the plan to report; a
+    take named twice (through a link, or by another path) is listed once."""
+    found: dict[str, tuple[Path, str, Path]] = {}  # a take's key -> (the take, the folder it mirrors from, below it)
     suffixes = take_suffixes()
     for item in inputs:
         wild = next((i for i, c in enumerate(item) if c in "*?["), None)
@@ -106,17 +118,29 @@ def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
             prefix = item[:wild]
             base = Path(prefix) if prefix.endswith(os.sep) else Path(prefix).parent
             for match in sorted(glob.glob(item, recursive=True)):
-                if match.lower().endswith(suffixes):
-                    found.setdefault(Path(match), Path(match).relative_to(base))
+                if match.lower().endswith(suffixes) and not os.path.isdir(match):
+                    found.setdefault(_same(match), (Path(match), os.path.abspath(base), Path(match).relative_to(base)))
         elif os.path.isdir(item):
             for path in sorted(Path(item).rglob("*")):
-                if path.suffix.lower() in suffixes and path.is_file():
-                    found.setdefault(path, path.relative_to(item))
-        elif os.path.isfile(item):
-            found.setdefault(Path(item), Path(Path(item).name))
+                if path.suffix.lower() in suffixes and not path.is_dir():
+                    found.setdefault(_same(path), (path, os.path.abspath(item), path.relative_to(item)))
+        elif os.path.lexists(item):
+            found.setdefault(_same(item), (Path(item), os.path.dirname(os.path.abspath(item)), Path(Path(item).name)))
         else:
             raise FileNotFoundError(f"no file, folder or glob match: {item}")
-    return list(found.items())
+    below = _mirrors({base for _, base, _ in found.values()})
+    return [(take, below[base] / relative) for take, base, relative in found.values()]
+
+
+def _mirrors(folders: set[str]) -> dict[str, Path]:
+    """The subfolder of the output folder that each input folder mirrors into (see find_takes)."""
+    if len(folders) <= 1:
+        return {folder: Path() for folder in folders}
+    names = {folder: Path(os.path.basename(folder)) for folder in folders}
+    if len(set(names.values())) == len(folders) and Path() not in names.values():
+        return names
+    common = os.path.commonpath(list(folders))
+    return {folder: Path(os.path.relpath(folder, common)) for folder in folders}
 
 
 class Manifest:
@@ -143,7 +167,10 @@ class Manifest:
         return _relative(job.output, self.path.parent)
 
     def _stamps(self, job: Job) -> dict[str, Any]:
-        take, skeleton = job.stamps or (_stamp(job.input), _stamp(job.skeleton) if job.skeleton else None)
+        take, skeleton = job.stamps or (
+            _stamp(os.stat(job.input)),
+            _stamp(os.stat(job.skeleton)) if job.skeleton else None,
+        )
         return {
             "recipe": self.recipe,
             "input": os.path.abspath(job.input),
@@ -230,47 +257,129 @@ def plan_jobs(
     body: str | None = None,
     allow_nan: bool = False,
 ) -> tuple[list[Job], list[Result]]:
-    """The jobs to run, and the takes settled before running (no skeleton, or already done by this
-    recipe when resuming).  An output that would replace its own input is refused (ValueError)
-    unless ``in_place``."""
-    jobs, settled = [], []
-    manifest = Manifest(out, pipeline.to_toml())
+    """The jobs to run, and the takes settled before running (not a regular file, no skeleton, or
+    already done by this recipe when resuming).  Every take's output is named before any is
+    written, and the run is refused (ValueError naming both files) where an output would replace
+    an input (its own, unless ``in_place``) or a skeleton the takes are read with, or where two
+    takes would write the same file."""
+    found = find_takes(inputs)
+    candidates, settled = [], []
     folders: dict[Path, list[Path]] = {}  # the ASFs of each folder, listed once
     skeleton_stamps: dict[Path, Stamp] = {}
-    for take, relative in find_takes(inputs):
+    for take, relative in found:
         target = Path(out) / relative
-        if not in_place and target.exists() and os.path.samefile(take, target):
-            raise ValueError(
-                f"{take} would be overwritten by its own output: choose another output folder, "
-                "or pass --in-place to replace the takes"
-            )
         try:
+            status = regular_file(take)
             asf = skeleton_for(take, skeleton, folders)
-            status = take.stat()
             if asf is not None and asf not in skeleton_stamps:
-                skeleton_stamps[asf] = _stamp(str(asf))
-        except FileNotFoundError as e:
+                skeleton_stamps[asf] = _stamp(regular_file(asf))
+        except OSError as e:
             settled.append(Result(str(take), str(target), ok=False, error=str(e)))
             continue
-        job = Job(
-            str(take),
-            str(target),
-            str(asf) if asf else "",
-            pipeline,
-            frame_rate,
-            stream_above,
-            chunk_frames,
-            status.st_size,
-            unit,
-            body,
-            allow_nan,
-            ((status.st_mtime_ns, status.st_size), skeleton_stamps[asf] if asf else None),
+        candidates.append(
+            Job(
+                str(take),
+                str(target),
+                str(asf) if asf else "",
+                pipeline,
+                frame_rate,
+                stream_above,
+                chunk_frames,
+                status.st_size,
+                unit,
+                body,
+                allow_nan,
+                (_stamp(status), skeleton_stamps[asf] if asf else None),
+                replace=in_place,
+            )
         )
+    candidates = _name_outputs(candidates)
+    _refuse_clashes(candidates, [take for take, _ in found] + list(skeleton_stamps), in_place)
+    manifest = Manifest(out, pipeline.to_toml())
+    jobs = []
+    for job in candidates:
         if resume and manifest.done(job):
-            settled.append(Result(str(take), str(target), skipped=True, bytes=status.st_size))
+            settled.append(Result(job.input, job.output, skipped=True, bytes=job.bytes))
         else:
             jobs.append(job)
     return jobs, settled
+
+
+def _name_outputs(jobs: list[Job]) -> list[Job]:
+    """The jobs with the file each one writes: its take's name, with the suffix of what the recipe
+    makes (an exporter's, or the format of the result's skeleton).  Where takes of one name in
+    different formats would make the same file (``01_01.amc`` and ``01_01.bvh`` -> ``01_01.csv``),
+    each keeps its take's suffix before the new one (``01_01.amc.csv``, ``01_01.bvh.csv``)."""
+
+    def named(job: Job, keep: bool) -> str:
+        stem, suffix = os.path.splitext(job.output)
+        stem += suffix if keep else ""
+        exporter = job.pipeline.exporter
+        if exporter is not None:
+            chosen = dict(exporter.options).get("format")
+            return stem + (f".{chosen}" if chosen else exporter.step.suffixes[0])
+        return stem + suffix_for(job.pipeline.convention(format_of(job.input).convention))
+
+    plain = [_same(named(job, False)) for job in jobs]
+    shared = {path for path, count in Counter(plain).items() if count > 1}
+    return [dataclasses.replace(job, written=named(job, path in shared)) for job, path in zip(jobs, plain)]
+
+
+def _refuse_clashes(jobs: list[Job], reads: list[Path], in_place: bool) -> None:
+    """ValueError naming both files where an output is an input of the run (a take, or a skeleton
+    takes are read with), where two takes write one file, or where a take's skeleton would be
+    copied over another skeleton file beside the outputs."""
+    read = {_same(path): str(path) for path in reads}
+    claimed: dict[str, str] = {}
+    for job in jobs:
+        key = _same(job.written)
+        other = claimed.setdefault(key, job.input)
+        if other != job.input:
+            raise ValueError(
+                f"{other} and {job.input} would both be written to {job.written}: "
+                "process them into separate output folders"
+            )
+        if key == _same(job.input):
+            if not in_place:
+                raise ValueError(
+                    f"{job.input} would be overwritten by its own output: choose another output folder, "
+                    "or pass --in-place to replace the takes"
+                )
+        elif key in read:
+            raise ValueError(
+                f"{job.written}, the output of {job.input}, would replace {read[key]}, which this run reads: "
+                "choose an output folder where no input lies"
+            )
+    copied: dict[str, tuple[str, str]] = {}  # file beside the outputs -> the skeleton copied there (key, path)
+    for job in jobs:
+        if not job.skeleton or job.pipeline.exporter is not None or format_of(job.written).companion is None:
+            continue
+        target = os.path.join(os.path.dirname(job.written), os.path.basename(job.skeleton))
+        key, source = _same(target), _same(job.skeleton)
+        if key == source or copied.get(key, ("",))[0] == source:
+            continue  # a skeleton copied onto itself, or one looked at already
+        data = file_bytes(job.skeleton)
+        assert data is not None  # the plan found it a file
+        if key in copied:
+            if file_bytes(copied[key][0]) != data:
+                raise ValueError(
+                    f"{copied[key][1]} and {job.skeleton} would both be copied to {target}: "
+                    "process their takes into separate output folders"
+                )
+            continue
+        copied[key] = (source, job.skeleton)
+        if key in read and file_bytes(target) != data:
+            raise ValueError(
+                f"{target}, the skeleton of {job.input} copied beside its output, would replace {read[key]}, "
+                "which this run reads: choose an output folder where no input lies"
+            )
+        companion_needed(target, data, replace=in_place)
+
+
+def _same(path: str | os.PathLike) -> str:
+    """A path's key: two paths of one file (through links, or of another case where case does not
+    count) have the same key."""
+    return os.path.normcase(os.path.realpath(path))
 
 
 def run_job(job: Job) -> Result:
@@ -284,9 +393,10 @@ def run_job(job: Job) -> Result:
             raise OutputError(e.errno, f"cannot write {os.path.dirname(job.output)}: {e.strerror}") from None
         if job.skeleton and job.bytes > job.stream_above and streamable(job.pipeline):
             skeleton = read_skeleton(job.skeleton, job.unit)
-            _copy_skeleton(job.skeleton, os.path.dirname(job.output))
+            _copy_skeleton(job.skeleton, os.path.dirname(job.output), job.replace)
+            result.output = job.written or job.output
             result.frames = stream(
-                job.input, job.output, skeleton, job.pipeline, job.frame_rate, chunk_frames=job.chunk_frames
+                job.input, result.output, skeleton, job.pipeline, job.frame_rate, chunk_frames=job.chunk_frames
             )
             result.streamed = True
         else:
@@ -314,36 +424,32 @@ def _read(job: Job) -> Motion:
 
 
 def _write(job: Job, result: Motion, motion: Motion) -> str:
-    """Write a take's result where the job says (an exporter's suffix, or its format's); returns the path."""
-    stem = os.path.splitext(job.output)[0]
-    exporter = job.pipeline.exporter
-    if exporter is not None:
-        chosen = dict(exporter.options).get("format")
-        target = stem + (f".{chosen}" if chosen else exporter.step.suffixes[0])
+    """Write a take's result where the job says, an AMC with its skeleton beside it; returns the path."""
+    target = job.written or job.output
+    if job.pipeline.exporter is not None:
         job.pipeline.write(result, target)
-        return target
-    target = stem + suffix_for(result.skeleton.convention)
-    companion = companion_path(result, target)
-    if companion is not None:
-        if result.skeleton is motion.skeleton and job.skeleton:
-            _copy_skeleton(job.skeleton, os.path.dirname(target))
-        else:
-            write_skeleton(result.skeleton, companion)
-    write_take(result, target, allow_non_finite=job.allow_nan)
+    elif result.skeleton is motion.skeleton and job.skeleton and companion_path(result, target) is not None:
+        _copy_skeleton(job.skeleton, os.path.dirname(target), job.replace)
+        write_take(result, target, allow_non_finite=job.allow_nan)
+    else:
+        write_take_with_skeleton(result, target, allow_non_finite=job.allow_nan, replace=job.replace)
     return target
 
 
-def _stamp(path: str) -> Stamp:
-    status = os.stat(path)
+def _stamp(status: os.stat_result) -> Stamp:
     return status.st_mtime_ns, status.st_size
 
 
-def _copy_skeleton(asf: str, folder: str) -> None:
-    """The skeleton beside the outputs that use it, so that the output folder stands alone."""
+def _copy_skeleton(asf: str, folder: str, replace: bool = False) -> None:
+    """The skeleton beside the outputs that use it, so that the output folder stands alone; a file
+    there holding another skeleton is kept (ValueError) unless ``replace``."""
     target = os.path.join(folder, os.path.basename(asf))
-    if os.path.abspath(target) != os.path.abspath(asf) and not os.path.exists(target):
-        with open(asf, "rb") as src, output(target) as dst:
-            shutil.copyfileobj(src, dst)
+    if os.path.abspath(target) == os.path.abspath(asf):
+        return
+    data = read_source(asf)[0]
+    if companion_needed(target, data, replace=replace):
+        with output(target) as dst:
+            dst.write(data)
 
 
 class Progress:

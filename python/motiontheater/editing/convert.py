@@ -299,7 +299,10 @@ def _notes(skeleton: Skeleton) -> tuple[str, frozenset[str], frozenset[str]]:
 
 
 @step(
-    "convert", "turn an ASF/AMC motion into a BVH one or back (forward kinematics gives the same points)", frames="none"
+    "convert",
+    "turn an ASF/AMC motion into a BVH one or back (forward kinematics gives the same points)",
+    frames="none",
+    convention=lambda convention, options: options["to"] or ("asf" if convention == "bvh" else "bvh"),
 )
 def convert(
     motion: Motion,

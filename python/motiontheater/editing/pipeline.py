@@ -92,6 +92,12 @@ class Pipeline:
             motion = entry.apply(motion)
         return motion
 
+    def convention(self, convention: str) -> str:
+        """The skeleton convention of the result on a motion of ``convention`` (``"asf"``, ``"bvh"``)."""
+        for entry in self.steps:
+            convention = entry.step.result_convention(convention, dict(entry.options))
+        return convention
+
     def write(self, motion: Motion, target: str | os.PathLike) -> None:
         """Run the pipeline's exporter on ``motion`` (already through :meth:`apply`) into ``target``."""
         if self.exporter is None:

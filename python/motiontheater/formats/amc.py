@@ -15,7 +15,7 @@ from mtcore import format_frames, format_number, scan_frames
 from mtcore.errors import ChangedFileError
 from mtcore.text import copy_text, frame_line, line_breaks
 
-from .._io import LINE_BREAK, Source, Text, TextStyle, decode, encode, mapped_source, output
+from .._io import LINE_BREAK, Source, Text, TextStyle, decode, encode, mapped_source, open_regular, output
 from ..model.errors import FormatError, SequenceError
 from ..model.motion import DEFAULT_FRAME_RATE, Motion
 from ..model.skeleton import Skeleton
@@ -263,7 +263,7 @@ class AmcStream:
         skeleton = self.motion.skeleton
         keys, offsets, counts = _layout(skeleton, skeleton.joint_names)
         pending, lines_done, expected = b"", self.header_lines, None
-        with open(self.path, "rb") as f:
+        with open_regular(self.path) as f:
             f.seek(self.body)
             while True:
                 more = f.read(self.read_bytes)
@@ -297,13 +297,13 @@ def open_amc(
 ) -> AmcStream:
     """An AMC take to read a piece at a time (:class:`AmcStream`); the header is read and checked
     now, as :func:`read_amc` does, and the first frame's number and bone order from the first piece."""
-    with open(path, "rb") as f:
+    with open_regular(path) as f:
         head = f.read(read_bytes)
     name = os.fspath(path)
     header, body, header_lines, rate = _read_header(head, name, skeleton, frame_rate)
     start = frame_line(head, body)
     first = int(LINE_BREAK.split(decode(head[start:]), 1)[0]) if start != -1 else 1
-    with open(path, "rb") as f:
+    with open_regular(path) as f:
         f.seek(max(0, os.fstat(f.fileno()).st_size - 1))
         ends_in_a_break = f.read(1) in (b"", b"\n", b"\r")
     motion = Motion(

@@ -11,13 +11,16 @@ the exporters) asks this module; adding a format is its codec module and one row
 from __future__ import annotations
 
 import hashlib
+import io
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 
+from .._io import output, read_source, regular_file
 from ..model.motion import Motion
 from ..model.skeleton import Skeleton, settle_length_unit
 from .amc import read_amc, skeleton_path_for, write_amc
@@ -45,7 +48,7 @@ class Format:
     read: ReadTake | None = None
     write: Callable[[Motion, str | os.PathLike], None] | None = None
     read_skeleton: Callable[[str | os.PathLike], Skeleton] | None = None
-    write_skeleton: Callable[[Skeleton, str | os.PathLike], None] | None = None
+    write_skeleton: Callable[[Skeleton, str | os.PathLike | IO[bytes]], None] | None = None
     companion: str | None = None
     states_unit: bool = True
 
@@ -128,19 +131,28 @@ def skeleton_for(
     return skeleton_path_for(path, folders)
 
 
+def _skeleton_format(path: str | os.PathLike) -> Format:
+    """The format a skeleton file is read in, by its suffix; ValueError naming the file otherwise."""
+    row = FORMATS.get(Path(path).suffix.lower())
+    if row is None or row.read_skeleton is None:
+        raise ValueError(f"{os.fspath(path)}: a skeleton's file name must end in {_listing(skeleton_suffixes())}")
+    return row
+
+
+def skeleton_convention(path: str | os.PathLike) -> str:
+    """The convention of the skeleton a skeleton file of this name holds (``.asf``: ``"asf"``)."""
+    return _skeleton_format(path).convention
+
+
 def read_skeleton(path: str | os.PathLike, unit: str | None = None) -> Skeleton:
     """The skeleton of a file (an ``.asf``, or a ``.bvh``'s hierarchy), its length unit settled
     (``unit`` when given).  Files of the same bytes are parsed once (a database has a few
     skeletons and thousands of takes; a subject's ASF is copied into every session's folder);
     a changed file is read again.  FileNotFoundError naming a missing file."""
-    suffix = Path(path).suffix.lower()
-    row = FORMATS.get(suffix)
-    if row is None or row.read_skeleton is None:
-        raise ValueError(f"{os.fspath(path)}: a skeleton's file name must end in {_listing(skeleton_suffixes())}")
-    if not os.path.exists(path):
-        raise FileNotFoundError(f"{os.fspath(path)}: no such file")
-    with open(path, "rb") as f:
-        key = (hashlib.sha256(f.read()).digest(), suffix, unit)
+    row = _skeleton_format(path)
+    assert row.read_skeleton is not None
+    data, _ = read_source(path)
+    key = (hashlib.sha256(data).digest(), row.suffix, unit)
     if key not in _PARSED:
         if len(_PARSED) >= 256:
             _PARSED.pop(next(iter(_PARSED)))  # the oldest
@@ -165,8 +177,7 @@ def read_take(
     (m, cm, mm, in, or a number L for inch / L) when given: a BVH's is detected from its size
     otherwise, an ASF's is its ``:units length``.  The take must hold at least one frame."""
     row = format_of(path)
-    if not os.path.exists(path):
-        raise FileNotFoundError(f"{os.fspath(path)}: no such file")
+    regular_file(path)
     companion = skeleton_for(path, asf)
     skeleton = None if companion is None else read_skeleton(companion, unit)
     assert row.read is not None
@@ -200,6 +211,66 @@ def write_skeleton(skeleton: Skeleton, path: str | os.PathLike) -> None:
     if row is None or row.write_skeleton is None:
         raise ValueError(f"{os.fspath(path)}: no format writes skeletons as {Path(path).suffix or 'this'}")
     row.write_skeleton(skeleton, path)
+
+
+def write_take_with_skeleton(
+    motion: Motion, path: str | os.PathLike, *, allow_non_finite: bool = False, replace: bool = False
+) -> Path | None:
+    """Write a take (as :func:`write_take`) and, for a format that keeps its skeleton beside the
+    take (an AMC's ASF), the skeleton file it is then read with, unless the one its name finds
+    there (:func:`skeleton_for`) holds that skeleton already, byte for byte.  The file written is
+    named after the take (``out/y.amc`` -> ``out/y.asf``); one of that name holding another
+    skeleton is what other takes there are read with, and is kept: ValueError before anything is
+    written, unless ``replace``.  Returns the skeleton file written, or None."""
+    target = companion_path(motion, path)
+    data = None if target is None else skeleton_text(motion.skeleton, target)
+    if target is not None and data is not None:
+        try:
+            found: Path | None = skeleton_for(path)
+        except (FileNotFoundError, NotADirectoryError):
+            found = None
+        if (found is not None and file_bytes(found) == data) or not companion_needed(target, data, replace=replace):
+            data = None
+    write_take(motion, path, allow_non_finite=allow_non_finite)
+    if target is None or data is None:
+        return None
+    with output(target) as f:
+        f.write(data)
+    return target
+
+
+def skeleton_text(skeleton: Skeleton, path: str | os.PathLike) -> bytes:
+    """The bytes of the skeleton file ``path`` that holds ``skeleton`` (in the format of its suffix)."""
+    row = _skeleton_format(path)
+    if row.write_skeleton is None:
+        raise ValueError(f"{os.fspath(path)}: no format writes skeletons as {Path(path).suffix or 'this'}")
+    buffer = io.BytesIO()
+    row.write_skeleton(skeleton, buffer)
+    return buffer.getvalue()
+
+
+def file_bytes(path: str | os.PathLike) -> bytes | None:
+    """The bytes of a file, or None where there is none (nor, perhaps, its folder)."""
+    try:
+        return read_source(path)[0]
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+
+
+def companion_needed(path: str | os.PathLike, data: bytes, *, replace: bool = False) -> bool:
+    """Whether the skeleton file ``path`` is to be written to hold ``data``: when it is absent (or,
+    with ``replace``, holds other bytes), not when it holds them already.  ValueError when it holds
+    another skeleton: takes beside it are read with that one."""
+    existing = file_bytes(path)
+    if existing is None or (replace and existing != data):
+        return True
+    if existing != data:
+        raise ValueError(
+            f"{os.fspath(path)} exists and holds another skeleton, which the takes beside it are read with: "
+            "write the take elsewhere or under another name, or pass --in-place to replace that file "
+            "(Python: replace=True)"
+        )
+    return False
 
 
 def write_take(motion: Motion, path: str | os.PathLike, *, allow_non_finite: bool = False) -> None:

@@ -226,6 +226,9 @@ class Step:
     ``dry_run``, where set, is ``f(motion, **options) -> str``: what the step
     would do to the motion, in words, with nothing done (its verb's --dry-run);
     it takes the step's options, and ``frames`` where the registry splices.
+    ``convention``, where set, is ``f(convention, options) -> convention``: the skeleton
+    convention of the step's result from its input's and its bound options (unset: the input's),
+    so that batch knows every output's name before it writes any.
     """
 
     name: str
@@ -238,6 +241,11 @@ class Step:
     suffixes: tuple[str, ...] = ()  # an exporter's file suffixes; empty for a step
     aliases: tuple[str, ...] = ()  # other names of the step (command-line verbs, recipes)
     dry_run: Callable[..., str] | None = None
+    convention: Callable[[str, dict[str, Any]], str] | None = None
+
+    def result_convention(self, convention: str, options: Mapping[str, Any]) -> str:
+        """The skeleton convention of the step's result on a motion of ``convention``."""
+        return convention if self.convention is None else self.convention(convention, self.bind(options))
 
     @property
     def is_exporter(self) -> bool:
@@ -317,12 +325,22 @@ def step(
     streamer: Callable[..., Any] | None = None,
     aliases: tuple[str, ...] = (),
     dry_run: Callable[..., str] | None = None,
+    convention: Callable[[str, dict[str, Any]], str] | None = None,
 ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """Register the decorated function as the step ``name`` (see the module docstring and
-    :class:`Step` for ``frames``, ``streamer`` and ``dry_run``)."""
+    :class:`Step` for ``frames``, ``streamer``, ``dry_run`` and ``convention``)."""
 
     def decorate(function: Callable[..., Any]) -> Callable[..., Any]:
-        register(name, function, summary, frames=frames, streamer=streamer, aliases=aliases, dry_run=dry_run)
+        register(
+            name,
+            function,
+            summary,
+            frames=frames,
+            streamer=streamer,
+            aliases=aliases,
+            dry_run=dry_run,
+            convention=convention,
+        )
         return function
 
     return decorate
@@ -353,6 +371,7 @@ def register(
     fixed: Mapping[str, Any] | None = None,
     aliases: tuple[str, ...] = (),
     dry_run: Callable[..., str] | None = None,
+    convention: Callable[[str, dict[str, Any]], str] | None = None,
 ) -> Step:
     """Register ``function`` as ``name``; ``fixed`` options are bound and hidden (one function serving
     several steps, e.g. each filter kind).  Returns the step; a name registered twice is an error."""
@@ -381,6 +400,7 @@ def register(
         suffixes=suffixes,
         aliases=aliases,
         dry_run=dry_run,
+        convention=convention,
     )
     _REGISTRY[name] = registered
     _ALIASES.update((alias, name) for alias in aliases)
