@@ -29,7 +29,7 @@ import tempfile
 import threading
 import time
 from collections import Counter
-from collections.abc import Generator, Iterable
+from collections.abc import Callable, Generator, Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -41,6 +41,7 @@ from .._signals import terminate_as_interrupt
 from ..editing.pipeline import Pipeline
 from ..editing.streaming import CHUNK_FRAMES, stream, streamable
 from ..formats.table import (
+    FORMATS,
     companion_needed,
     companion_path,
     file_bytes,
@@ -111,6 +112,7 @@ def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
     take named twice (through a link, or by another path) is listed once."""
     found: dict[str, tuple[Path, str, Path]] = {}  # a take's key -> (the take, the folder it mirrors from, below it)
     suffixes = take_suffixes()
+    _same = _path_keys()
     for item in inputs:
         wild = next((i for i, c in enumerate(item) if c in "*?["), None)
         if wild is not None:
@@ -266,14 +268,20 @@ def plan_jobs(
     candidates, settled = [], []
     folders: dict[Path, list[Path]] = {}  # the ASFs of each folder, listed once
     skeleton_stamps: dict[Path, Stamp] = {}
+    reads: dict[Identity, str] = {}  # every file the run reads
     for take, relative in found:
         target = Path(out) / relative
         try:
             status = regular_file(take)
+            reads.setdefault(_identity(status), str(take))
             asf = skeleton_for(take, skeleton, folders)
             if asf is not None and asf not in skeleton_stamps:
-                skeleton_stamps[asf] = _stamp(regular_file(asf))
+                asf_status = regular_file(asf)
+                skeleton_stamps[asf] = _stamp(asf_status)
+                reads.setdefault(_identity(asf_status), str(asf))
         except OSError as e:
+            with contextlib.suppress(OSError):
+                reads.setdefault(_identity(os.lstat(take)), str(take))
             settled.append(Result(str(take), str(target), ok=False, error=str(e)))
             continue
         candidates.append(
@@ -293,8 +301,9 @@ def plan_jobs(
                 replace=in_place,
             )
         )
-    candidates = _name_outputs(candidates)
-    _refuse_clashes(candidates, [take for take, _ in found] + list(skeleton_stamps), in_place)
+    keys = _path_keys()
+    candidates = _name_outputs(candidates, keys)
+    _refuse_clashes(candidates, reads, in_place, keys)
     manifest = Manifest(out, pipeline.to_toml())
     jobs = []
     for job in candidates:
@@ -305,81 +314,110 @@ def plan_jobs(
     return jobs, settled
 
 
-def _name_outputs(jobs: list[Job]) -> list[Job]:
+def _name_outputs(jobs: list[Job], key: Callable[[str], str]) -> list[Job]:
     """The jobs with the file each one writes: its take's name, with the suffix of what the recipe
     makes (an exporter's, or the format of the result's skeleton).  Where takes of one name in
     different formats would make the same file (``01_01.amc`` and ``01_01.bvh`` -> ``01_01.csv``),
     each keeps its take's suffix before the new one (``01_01.amc.csv``, ``01_01.bvh.csv``)."""
 
-    def named(job: Job, keep: bool) -> str:
-        stem, suffix = os.path.splitext(job.output)
-        stem += suffix if keep else ""
-        exporter = job.pipeline.exporter
+    @functools.cache
+    def made(pipeline: Pipeline, take: str) -> str:
+        """The suffix of what the pipeline makes of a take of this suffix."""
+        exporter = pipeline.exporter
         if exporter is not None:
             chosen = dict(exporter.options).get("format")
-            return stem + (f".{chosen}" if chosen else exporter.step.suffixes[0])
-        return stem + suffix_for(job.pipeline.convention(format_of(job.input).convention))
+            return f".{chosen}" if chosen else exporter.step.suffixes[0]
+        return suffix_for(pipeline.convention(FORMATS[take].convention))
 
-    plain = [_same(named(job, False)) for job in jobs]
-    shared = {path for path, count in Counter(plain).items() if count > 1}
-    return [dataclasses.replace(job, written=named(job, path in shared)) for job, path in zip(jobs, plain)]
+    def named(job: Job, keep: bool) -> str:
+        stem, suffix = os.path.splitext(job.output)
+        return stem + (suffix if keep else "") + made(job.pipeline, suffix.lower())
+
+    plain = [named(job, False) for job in jobs]
+    keys = [key(path) for path in plain]
+    shared = {k for k, count in Counter(keys).items() if count > 1}
+    return [
+        dataclasses.replace(job, written=named(job, True) if k in shared else path)
+        for job, path, k in zip(jobs, plain, keys)
+    ]
 
 
-def _refuse_clashes(jobs: list[Job], reads: list[Path], in_place: bool) -> None:
-    """ValueError naming both files where an output is an input of the run (a take, or a skeleton
+def _refuse_clashes(jobs: list[Job], reads: dict[Identity, str], in_place: bool, key: Callable[[str], str]) -> None:
+    """ValueError naming both files where an output is a file the run reads (a take, or a skeleton
     takes are read with), where two takes write one file, or where a take's skeleton would be
     copied over another skeleton file beside the outputs."""
-    read = {_same(path): str(path) for path in reads}
     claimed: dict[str, str] = {}
     for job in jobs:
-        key = _same(job.written)
-        other = claimed.setdefault(key, job.input)
+        other = claimed.setdefault(key(job.written), job.input)
         if other != job.input:
             raise ValueError(
                 f"{other} and {job.input} would both be written to {job.written}: "
                 "process them into separate output folders"
             )
-        if key == _same(job.input):
-            if not in_place:
-                raise ValueError(
-                    f"{job.input} would be overwritten by its own output: choose another output folder, "
-                    "or pass --in-place to replace the takes"
-                )
-        elif key in read:
+        source = _read_at(job.written, reads)
+        if source == job.input and not in_place:
             raise ValueError(
-                f"{job.written}, the output of {job.input}, would replace {read[key]}, which this run reads: "
+                f"{job.input} would be overwritten by its own output: choose another output folder, "
+                "or pass --in-place to replace the takes"
+            )
+        if source not in (None, job.input):
+            raise ValueError(
+                f"{job.written}, the output of {job.input}, would replace {source}, which this run reads: "
                 "choose an output folder where no input lies"
             )
-    copied: dict[str, tuple[str, str]] = {}  # file beside the outputs -> the skeleton copied there (key, path)
+    copied: dict[str, str] = {}  # each file beside the outputs a skeleton is copied to -> that skeleton
     for job in jobs:
         if not job.skeleton or job.pipeline.exporter is not None or format_of(job.written).companion is None:
             continue
         target = os.path.join(os.path.dirname(job.written), os.path.basename(job.skeleton))
-        key, source = _same(target), _same(job.skeleton)
-        if key == source or copied.get(key, ("",))[0] == source:
-            continue  # a skeleton copied onto itself, or one looked at already
-        data = file_bytes(job.skeleton)
-        assert data is not None  # the plan found it a file
-        if key in copied:
-            if file_bytes(copied[key][0]) != data:
+        earlier = copied.get(place := key(target))
+        if earlier is not None:  # looked at already, for a take before
+            if earlier != job.skeleton and file_bytes(earlier) != file_bytes(job.skeleton):
                 raise ValueError(
-                    f"{copied[key][1]} and {job.skeleton} would both be copied to {target}: "
+                    f"{earlier} and {job.skeleton} would both be copied to {target}: "
                     "process their takes into separate output folders"
                 )
             continue
-        copied[key] = (source, job.skeleton)
-        if key in read and file_bytes(target) != data:
+        copied[place] = job.skeleton
+        source = _read_at(target, reads)
+        if source == job.skeleton:
+            continue  # the skeleton itself: nothing is copied
+        data = file_bytes(job.skeleton)
+        assert data is not None  # the plan found it a file
+        if source is not None and file_bytes(target) != data:
             raise ValueError(
-                f"{target}, the skeleton of {job.input} copied beside its output, would replace {read[key]}, "
+                f"{target}, the skeleton of {job.input} copied beside its output, would replace {source}, "
                 "which this run reads: choose an output folder where no input lies"
             )
         companion_needed(target, data, replace=in_place)
 
 
-def _same(path: str | os.PathLike) -> str:
-    """A path's key: two paths of one file (through links, or of another case where case does not
-    count) have the same key."""
-    return os.path.normcase(os.path.realpath(path))
+Identity = tuple[int, int]  # a file's device and inode: the same for every path that reaches it
+
+
+def _identity(status: os.stat_result) -> Identity:
+    return status.st_dev, status.st_ino
+
+
+def _read_at(path: str, reads: dict[Identity, str]) -> str | None:
+    """The input of the run that is the file at ``path`` (through any link), or None."""
+    try:
+        return reads.get(_identity(os.stat(path)))
+    except OSError:
+        return None
+
+
+def _path_keys() -> Callable[[str | os.PathLike], str]:
+    """A function giving the key of a path that may not exist yet: two paths of one place (through
+    linked folders, or of another case where case does not count) have one key.  Each folder's
+    real path is looked up once (thousands of takes share a few folders)."""
+    real = functools.lru_cache(maxsize=None)(os.path.realpath)
+
+    def key(path: str | os.PathLike) -> str:
+        folder, name = os.path.split(os.fspath(path))
+        return os.path.normcase(os.path.join(real(folder or os.curdir), name))
+
+    return key
 
 
 def run_job(job: Job) -> Result:

@@ -93,8 +93,7 @@ def _listing(suffixes: tuple[str, ...]) -> str:
 
 def format_of(path: str | os.PathLike) -> Format:
     """The format of a take file by its suffix (any case); ValueError naming the file otherwise."""
-    suffix = Path(path).suffix.lower()
-    found = FORMATS.get(suffix)
+    found = FORMATS.get(os.path.splitext(os.fspath(path))[1].lower())  # not Path: batch asks for every take
     if found is None or not found.holds_takes:
         raise ValueError(f"{os.fspath(path)}: a take's file name must end in {_listing(take_suffixes())}")
     return found
