@@ -138,7 +138,10 @@ def test_filter_command(data_dir, tmp_path, capsys):
         )
         == 0
     )
-    assert capsys.readouterr().out.strip() == f"median 5 over 2751 frames of lhumerus, rhumerus: wrote {out}"
+    assert capsys.readouterr().out.strip() == (  # with the skeleton it is read with, beside it
+        f"median 5 over 2751 frames of lhumerus, rhumerus: wrote {out} and its skeleton {tmp_path / 'smooth.asf'}"
+    )
+    assert (tmp_path / "smooth.asf").read_bytes() == (data_dir / "cmu" / "01.asf").read_bytes()
     skeleton = mt.read_asf(data_dir / "cmu" / "01.asf")
     expected = mt.read_amc(data_dir / "cmu" / "01_01.amc", skeleton).median(size=5, joints=["lhumerus", "rhumerus"])
     assert mt.read_amc(out, skeleton).values.tobytes() == expected.values.tobytes()
@@ -158,7 +161,7 @@ def test_filter_command_finds_the_skeleton_and_writes_nothing_on_failure(data_di
     assert "no bone 'nosuchbone'" in capsys.readouterr().err
     assert main(["filter", "--mean", "3", "--median", "5", str(data_dir / "cmu" / "01_01.amc"), "-o", str(bad)]) == 2
     assert "give exactly one of --median N, --mean N, --binomial N" in capsys.readouterr().err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["smooth.amc"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["smooth.amc", "smooth.asf"]
 
 
 def test_filter_command_on_bvh(data_dir, tmp_path, capsys):

@@ -389,7 +389,7 @@ def _refuse_clashes(jobs: list[Job], reads: dict[Identity, str], in_place: bool,
                 f"{target}, the skeleton of {job.input} copied beside its output, would replace {source}, "
                 "which this run reads: choose an output folder where no input lies"
             )
-        companion_needed(target, data, replace=in_place)
+        companion_needed(target, data, replace=in_place)  # another skeleton there: refused now, not per take
 
 
 Identity = tuple[int, int]  # a file's device and inode: the same for every path that reaches it
