@@ -22,7 +22,7 @@ from .demo import DEMO
 from .info import INFO
 from .steps import APPLY, FILTER, LISTING, step_verbs
 from .timing import BENCH
-from .verb import Verb
+from .verb import Verb, VerbParser
 
 
 def verbs() -> list[Verb]:
@@ -41,7 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     parser.add_argument("--version", action="version", version=f"motiontheater {__version__}")
-    subparsers = parser.add_subparsers(dest="verb", metavar="<verb>")
+    subparsers = parser.add_subparsers(dest="verb", metavar="<verb>", parser_class=VerbParser)
     for verb in verbs():
         verb.add_to(subparsers)
     return parser

@@ -11,7 +11,7 @@ from typing import Any
 
 from ..editing.filtering import FILTERS
 from ..editing.pipeline import Pipeline
-from ..formats.table import companion_path, take_suffix, write_skeleton, write_take
+from ..formats.table import companion_path, format_of, take_suffix, write_skeleton, write_take
 from ..model.motion import Motion
 from ..model.registry import Option, Step, lookup, steps
 from .info import unit_notes
@@ -99,7 +99,7 @@ def _run_step(args: argparse.Namespace) -> int:
         return 0
     target = output(args, source)
     if not step.is_exporter:
-        take_suffix(target)
+        options.update(_direction(step, options, target))
     motion = take_of(args, source)
     if step.is_exporter:
         step(motion, target, **options)
@@ -111,6 +111,15 @@ def _run_step(args: argparse.Namespace) -> int:
     written = _write_result(motion, result, target, args.allow_nan)
     print(f"{step.name}: {motion.frames} frames of {source} -> {result.frames} frames in {written}")
     return 0
+
+
+def _direction(step: Step, options: dict[str, Any], target: str) -> dict[str, Any]:
+    """A ``to`` option naming a convention (convert's), when not given, is the output's: an .amc
+    output means ASF/AMC, a .bvh one BVH.  (ValueError for an output no format holds takes in.)"""
+    convention = format_of(target).convention
+    if "to" in options or not any(o.name == "to" and convention in o.choices for o in step.options):
+        return {}
+    return {"to": convention}
 
 
 def _write_result(motion: Motion, result: Motion, target: str, allow_nan: bool) -> str:
