@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import re
 import shutil
 import textwrap
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -62,7 +63,23 @@ class VerbParser(argparse.ArgumentParser):
         return parsed, extras
 
 
-def prose(*paragraphs: str) -> str:
-    """Paragraphs filled to the terminal's width, for --help texts that also hold examples."""
+def prose(*paragraphs: str, flags: Mapping[str, str] | None = None) -> str:
+    """Paragraphs filled to the terminal's width, as :func:`plain` text (``flags`` as there), for
+    --help texts that also hold examples."""
     width = min(shutil.get_terminal_size().columns, 100) - 2
-    return "".join(textwrap.fill(" ".join(p.split()), width) + "\n\n" for p in paragraphs if p.strip())
+    filled = (textwrap.fill(" ".join(plain(p, flags).split()), width) for p in paragraphs if p.strip())
+    return "".join(f + "\n\n" for f in filled)
+
+
+_ROLE = re.compile(r":[a-z]+:`~?(?:[\w.]*\.)?([^`.]+)`")  # :func:`~motiontheater.x.name` -> name
+_RETURNS = re.compile(r"(^|[.:]\s+)Returns\b[^.]*\.\s*")
+
+
+def plain(text: str, flags: Mapping[str, str] | None = None) -> str:
+    """Docstring text as --help shows it (step summaries, descriptions and options come from
+    docstrings): roles (:func:`name`) and literals (``x``) as their bare words, an option named as
+    a literal as its flag (``max_gap`` -> --max-gap, by ``flags``), and no "Returns ..." sentence,
+    which speaks of the Python function, not of the command."""
+    for name, flag in (flags or {}).items():
+        text = text.replace(f"``{name}``", flag)
+    return _RETURNS.sub(r"\1", _ROLE.sub(r"\1", text).replace("``", ""))
