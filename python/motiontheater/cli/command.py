@@ -11,6 +11,7 @@ import argparse
 import logging
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 
 from .._signals import terminate_as_interrupt
@@ -55,6 +56,11 @@ def _notes() -> logging.Handler:
     return handler
 
 
+def _warning(message: Warning | str, *args: object, **kwargs: object) -> None:
+    """A Python warning as the command line says it: ``warning: <text>``, without its file and line."""
+    print(f"warning: {message}", file=sys.stderr)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status: 0 done, 1 some takes failed (batch), 2 a
     one-line reason on failure, 130 interrupted (Ctrl-C or SIGTERM: nothing partial is left)."""
@@ -68,7 +74,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     level = logger.level
     logger.setLevel(logging.INFO)
     try:
-        with terminate_as_interrupt():
+        with terminate_as_interrupt(), warnings.catch_warnings():
+            warnings.showwarning = _warning
             status = int(args.run(args))
         sys.stdout.flush()  # here, where a closed pipe is caught, not at exit
         return status

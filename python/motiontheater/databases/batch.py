@@ -20,6 +20,7 @@ import functools
 import glob
 import hashlib
 import json
+import logging
 import multiprocessing
 import os
 import shutil
@@ -32,6 +33,8 @@ from collections.abc import Generator, Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
+
+from tqdm import tqdm
 
 from mtcore import cpu_count, share_cores
 
@@ -93,6 +96,7 @@ class Result:
     seconds: float = 0.0
     stop: str = ""  # an output problem that every take would meet: the run stops
     written: int = 0  # the output's size
+    notes: list[str] = field(default_factory=list)  # what the steps logged (a cut-off chosen, gaps left)
 
 
 def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
@@ -277,6 +281,13 @@ def run_job(job: Job) -> Result:
     """Process one take; every failure becomes a Result naming the file, line and reason."""
     start = time.perf_counter()
     result = Result(job.input, job.output, bytes=job.bytes)
+    with _notes_into(result.notes):
+        _run_job(job, result)
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def _run_job(job: Job, result: Result) -> None:
     try:
         try:
             os.makedirs(os.path.dirname(job.output) or ".", exist_ok=True)
@@ -301,8 +312,39 @@ def run_job(job: Job) -> Result:
         result.ok, result.error = False, str(e)
     except MemoryError:
         result.ok, result.error = False, f"{job.input}: not enough memory for this take ({job.bytes / 1e6:.0f} MB)"
-    result.seconds = time.perf_counter() - start
-    return result
+
+
+_taking_notes = threading.local()  # the notes list of the take this thread processes, if any
+
+
+class _TakeNotes(logging.Filter):
+    """On the package's logger: a record logged while a take is processed goes to its notes (for
+    the parent to print, naming the take, above the bar), not to the handlers (a worker's stderr)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        notes = getattr(_taking_notes, "notes", None)
+        if notes is None:
+            return True
+        notes.append(record.getMessage())
+        return False
+
+
+_LOG = logging.getLogger("motiontheater")
+_LOG.addFilter(_TakeNotes())
+
+
+@contextlib.contextmanager
+def _notes_into(notes: list[str]) -> Generator[None]:
+    """Keep what the package logs in this thread (at INFO and above, as the command line prints) in ``notes``."""
+    level = _LOG.level
+    _taking_notes.notes = notes
+    if _LOG.getEffectiveLevel() > logging.INFO:  # a Dask worker's, which the command line did not set
+        _LOG.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        _taking_notes.notes = None
+        _LOG.setLevel(level)
 
 
 def _read(job: Job) -> Motion:
@@ -347,28 +389,34 @@ def _copy_skeleton(asf: str, folder: str) -> None:
 
 
 class Progress:
-    """A progress bar on stderr (takes and MB, rate, time left), fitting the terminal: tqdm's, where
-    it is installed (``pip install "motiontheater[progress]"``); off when stderr is not a terminal."""
+    """A progress bar on stderr (takes and MB, rate, time left), fitting the terminal (tqdm's); off
+    when stderr is not a terminal."""
 
     def __init__(self, files: int, total_bytes: int, enabled: bool | None = None):
         enabled = sys.stderr.isatty() if enabled is None else enabled
         self.bar = None
         if enabled:
-            with contextlib.suppress(ImportError):
-                from tqdm import tqdm
-
-                self.bar = tqdm(
-                    total=total_bytes, unit="B", unit_scale=True, unit_divisor=1000, file=sys.stderr,
-                    desc=f"0/{files} takes", dynamic_ncols=True, smoothing=0.1,
-                )  # fmt: skip
+            self.bar = tqdm(
+                total=total_bytes, unit="B", unit_scale=True, unit_divisor=1000, file=sys.stderr,
+                desc=f"0/{files} takes", dynamic_ncols=True, smoothing=0.1,
+            )  # fmt: skip
         self.files, self.done = files, 0
 
     def advance(self, result: Result) -> None:
-        """Count a finished take."""
+        """Count a finished take, after printing what its steps noted, each line naming it."""
+        for note in result.notes:
+            self.write(f"{result.input}: {note}")
         self.done += 1
         if self.bar is not None:
             self.bar.set_description(f"{self.done}/{self.files} takes", refresh=False)
             self.bar.update(result.bytes)
+
+    def write(self, line: str) -> None:
+        """A line on stderr, above the bar."""
+        if self.bar is not None:
+            self.bar.write(line, file=sys.stderr)
+        else:
+            print(line, file=sys.stderr)
 
     def close(self) -> None:
         """Take the bar off the screen's last line."""
