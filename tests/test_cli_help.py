@@ -96,9 +96,9 @@ def test_example_runs_as_pasted(verb, command, data_dir, tmp_path, shell_env):
     assert "Traceback" not in done.stderr and "Warning:" not in done.stderr, done.stderr
 
 
-@pytest.mark.parametrize("verb", HELPS)
+@pytest.mark.parametrize("verb", [None, *HELPS])
 def test_help_has_no_docstring_markup(verb):
-    text = HELPS[verb]
+    text = build_parser().format_help() if verb is None else HELPS[verb]  # None: the verbs' list
     for markup in (r":[a-z]+:`", r"``", r"\bReturns\b"):
         assert not re.search(markup, text), f"motiontheater {verb} --help shows {markup}: {text}"
 

@@ -3,12 +3,12 @@ each take of a batch named and printed above the progress bar."""
 
 import logging
 import shutil
+import sys
 import warnings
 
 import pytest
 
 from motiontheater.cli import main
-from motiontheater.databases import batch
 from motiontheater.model.registry import register, unregister
 
 
@@ -55,10 +55,12 @@ def test_batch_notes_name_their_take(toy_steps, takes, capfd, jobs):
     assert sorted(lines) == ["01_01.amc: the toy step notes 2751 frames", "01_01.bvh: the toy step notes 2752 frames"]
 
 
-def test_notes_print_above_the_bar(capsys):
-    progress = batch.Progress(2, 2_000_000, enabled=True)
-    progress.advance(batch.Result("a.amc", "out/a.amc", bytes=1_000_000, notes=["gaps left"]))
-    progress.close()
+def test_notes_print_above_the_bar(toy_steps, takes, capsys, monkeypatch):
+    (takes / "recipe.toml").write_text('[[step]]\nrun = "toy_notes"\n')
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)  # as at a terminal: the bar is drawn
+    argv = ["batch", "01_01.amc", "01_01.bvh", "--recipe", "recipe.toml", "-o", "out", "--jobs", "1"]
+    assert main(argv) == 0
     err = capsys.readouterr().err
-    assert "a.amc: gaps left\n" in err and "1/2 takes" in err
-    assert err.index("a.amc: gaps left") < err.rindex("1/2 takes")  # the bar is drawn again below it
+    note = "01_01.amc: the toy step notes 2751 frames\n"
+    assert note in err and "2/2 takes" in err
+    assert err.index(note) > err.index("0/2 takes")  # tqdm.write: the bar drawn, cleared, the note, the bar again

@@ -48,11 +48,19 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Notes(logging.Handler):
+    """Prints what steps note on the package's logger (a cut-off chosen, gaps left) to stderr,
+    above batch's progress bar when one is drawn."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        from tqdm import tqdm  # here: most runs note nothing, and tqdm takes a while to import
+
+        tqdm.write(self.format(record), file=sys.stderr)
+
+
 def _notes() -> logging.Handler:
-    """A handler that prints what steps note on the package's logger (a cut-off chosen, gaps left) to stderr."""
-    handler = logging.StreamHandler(sys.stderr)
+    handler = _Notes(logging.INFO)
     handler.setFormatter(logging.Formatter("%(message)s"))
-    handler.setLevel(logging.INFO)
     return handler
 
 

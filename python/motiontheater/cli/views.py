@@ -178,7 +178,8 @@ VERBS = [
             "take in a colour over it (e.g. before and after a filter, as the thesis's figures 4.26-4.39). "
             "Needs matplotlib: pip install 'motiontheater[plot]'."
         ),
-        epilog="Example: motiontheater median 01_01.amc --size 5 -o smooth.amc && "
+        epilog="Example: motiontheater plot 01_01.amc --joints lfemur,ltibia --frames 100:400 -o fig.png\n"
+        "Example: motiontheater median 01_01.amc --size 5 -o smooth.amc && "
         "motiontheater plot 01_01.amc --joints lfemur,ltibia --compare smooth.amc --asf 01.asf --frames 100:400 -o fig.png",
     ),
     Verb(

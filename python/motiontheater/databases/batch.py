@@ -96,7 +96,7 @@ class Result:
     seconds: float = 0.0
     stop: str = ""  # an output problem that every take would meet: the run stops
     written: int = 0  # the output's size
-    notes: list[str] = field(default_factory=list)  # what the steps logged (a cut-off chosen, gaps left)
+    notes: list[tuple[int, str]] = field(default_factory=list)  # what the steps logged: (level, message)
 
 
 def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
@@ -318,14 +318,15 @@ _taking_notes = threading.local()  # the notes list of the take this thread proc
 
 
 class _TakeNotes(logging.Filter):
-    """On the package's logger: a record logged while a take is processed goes to its notes (for
-    the parent to print, naming the take, above the bar), not to the handlers (a worker's stderr)."""
+    """On the package's logger: a record logged while a take is processed goes to its notes, for
+    the parent to log again naming the take (the command line prints it above the bar), not to the
+    handlers (in a worker: its stderr, over the bar)."""
 
     def filter(self, record: logging.LogRecord) -> bool:
         notes = getattr(_taking_notes, "notes", None)
         if notes is None:
             return True
-        notes.append(record.getMessage())
+        notes.append((record.levelno, record.getMessage()))
         return False
 
 
@@ -334,7 +335,7 @@ _LOG.addFilter(_TakeNotes())
 
 
 @contextlib.contextmanager
-def _notes_into(notes: list[str]) -> Generator[None]:
+def _notes_into(notes: list[tuple[int, str]]) -> Generator[None]:
     """Keep what the package logs in this thread (at INFO and above, as the command line prints) in ``notes``."""
     level = _LOG.level
     _taking_notes.notes = notes
@@ -403,20 +404,11 @@ class Progress:
         self.files, self.done = files, 0
 
     def advance(self, result: Result) -> None:
-        """Count a finished take, after printing what its steps noted, each line naming it."""
-        for note in result.notes:
-            self.write(f"{result.input}: {note}")
+        """Count a finished take."""
         self.done += 1
         if self.bar is not None:
             self.bar.set_description(f"{self.done}/{self.files} takes", refresh=False)
             self.bar.update(result.bytes)
-
-    def write(self, line: str) -> None:
-        """A line on stderr, above the bar."""
-        if self.bar is not None:
-            self.bar.write(line, file=sys.stderr)
-        else:
-            print(line, file=sys.stderr)
 
     def close(self) -> None:
         """Take the bar off the screen's last line."""
@@ -503,6 +495,8 @@ def run(
     try:
         for job, result in results:
             summary.results.append(result)
+            for level, note in result.notes:
+                _LOG.log(level, "%s: %s", result.input, note)
             progress.advance(result)
             if result.ok and manifest is not None:
                 manifest.record(job, result)
