@@ -339,7 +339,6 @@ def test_progress_bar(capsys):
     progress.advance(batch.Result("a", "b", bytes=1_000_000))
     progress.close()
     err = capsys.readouterr().err
-    pytest.importorskip("tqdm")
     assert "1/2 takes" in err and "50%" in err and "1.00M/2.00M" in err
     silent = batch.Progress(2, 10, enabled=False)
     silent.advance(batch.Result("a", "b", bytes=5))

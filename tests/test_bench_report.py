@@ -47,7 +47,15 @@ def test_bench_command_markdown(capsys, monkeypatch):
     out = capsys.readouterr().out
     assert "## The thesis scene: 267 frames x 90 rotation channels = 24,030 values" in out
     assert "| median | 3 | 2.08 s | 0.59 s | 4x |" in out
-    assert "## One hour at 120 Hz: 100 frames x 62 channels" in out
+    assert "## 0.83 seconds at 120 Hz: 100 frames x 62 channels" in out  # what was measured, not an hour
+
+
+@pytest.mark.parametrize(
+    ("frames", "heading"),
+    [(432_000, "One hour"), (21_600, "3 minutes"), (864_000, "2 hours"), (7_200, "One minute"), (120, "One second")],
+)
+def test_the_hour_table_is_headed_by_its_length(frames, heading):
+    assert bench._duration(frames / 120) == heading
 
 
 def test_every_benchmark_module_is_collected():

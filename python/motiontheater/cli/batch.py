@@ -100,6 +100,7 @@ BATCH = Verb(
         "streamed in chunks when the recipe is a single filter."
     )
     + RECIPE_HELP,
-    epilog="Example: motiontheater batch --median 5 --jobs 2 captures/ -o smoothed/",
+    epilog="Example: motiontheater batch --median 5 --jobs 2 captures/ -o smoothed/\n"
+    "Example: motiontheater batch --recipe steps.toml captures/ -o cleaned/",
     laid_out=True,
 )

@@ -166,6 +166,13 @@ def _x(numerator: float | None, denominator: float | None) -> str:
     return "-" if numerator is None or denominator is None else f"{numerator / denominator:,.0f}x"
 
 
+def _duration(seconds: float) -> str:
+    """A capture's length as its table's heading says it: "One hour", "3 minutes", "0.83 seconds"."""
+    unit, length = ("hour", 3600) if seconds >= 3600 else ("minute", 60) if seconds >= 60 else ("second", 1)
+    count = seconds / length
+    return f"One {unit}" if count == 1 else f"{count:.2g} {unit}s"
+
+
 def markdown(report: dict) -> str:
     """The report of :func:`measure` as Markdown tables, the thesis's table first."""
     scene, hour = report["scene"], report["hour"]
@@ -188,7 +195,7 @@ def markdown(report: dict) -> str:
     frames, channels = hour["shape"]
     lines += [
         "",
-        f"## One hour at 120 Hz: {frames:,} frames x {channels} channels "
+        f"## {_duration(frames / 120)} at 120 Hz: {frames:,} frames x {channels} channels "
         f"(numpy.copyto {_t(hour['copyto'])}, ndarray.copy {_t(hour['copy'])})",
         "",
         "| filter | size | mtcore | M values/s | share of copy (output=) | share of copy (fresh) "

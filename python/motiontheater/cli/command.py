@@ -11,6 +11,7 @@ import argparse
 import logging
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 
 from .._signals import terminate_as_interrupt
@@ -22,7 +23,7 @@ from .demo import DEMO
 from .info import INFO
 from .steps import APPLY, FILTER, LISTING, step_verbs
 from .timing import BENCH
-from .verb import Verb
+from .verb import Verb, VerbParser
 
 
 def verbs() -> list[Verb]:
@@ -41,18 +42,31 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     parser.add_argument("--version", action="version", version=f"motiontheater {__version__}")
-    subparsers = parser.add_subparsers(dest="verb", metavar="<verb>")
+    subparsers = parser.add_subparsers(dest="verb", metavar="<verb>", parser_class=VerbParser)
     for verb in verbs():
         verb.add_to(subparsers)
     return parser
 
 
+class _Notes(logging.Handler):
+    """Prints what steps note on the package's logger (a cut-off chosen, gaps left) to stderr,
+    above batch's progress bar when one is drawn."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        from tqdm import tqdm  # here: most runs note nothing, and tqdm takes a while to import
+
+        tqdm.write(self.format(record), file=sys.stderr)
+
+
 def _notes() -> logging.Handler:
-    """A handler that prints what steps note on the package's logger (a cut-off chosen, gaps left) to stderr."""
-    handler = logging.StreamHandler(sys.stderr)
+    handler = _Notes(logging.INFO)
     handler.setFormatter(logging.Formatter("%(message)s"))
-    handler.setLevel(logging.INFO)
     return handler
+
+
+def _warning(message: Warning | str, *args: object, **kwargs: object) -> None:
+    """A Python warning as the command line says it: ``warning: <text>``, without its file and line."""
+    print(f"warning: {message}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -68,7 +82,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     level = logger.level
     logger.setLevel(logging.INFO)
     try:
-        with terminate_as_interrupt():
+        with terminate_as_interrupt(), warnings.catch_warnings():
+            warnings.showwarning = _warning
             status = int(args.run(args))
         sys.stdout.flush()  # here, where a closed pipe is caught, not at exit
         return status

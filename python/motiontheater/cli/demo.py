@@ -59,4 +59,5 @@ DEMO = Verb(
         "jitter and marker-pop spikes, smooth it with each filter and print how close each "
         "result comes to the clean motion."
     ),
+    epilog="Example: motiontheater demo --seconds 2 --size 7",
 )

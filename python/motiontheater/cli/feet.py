@@ -79,9 +79,9 @@ VERBS = [
             "cleaned take finds other plants."
         ),
         epilog=(
-            "Example: motiontheater contacts 07_05-walk.amc -o plants.csv && motiontheater cleanup "
-            "07_05-walk.amc --contacts plants.csv -o clean.amc && motiontheater skate clean.amc --asf "
-            "07-walk.asf --contacts plants.csv"
+            "Example: motiontheater skate 01_01.amc\n"
+            "Example: motiontheater contacts 01_01.amc -o plants.csv && motiontheater cleanup 01_01.amc "
+            "--contacts plants.csv -o clean.amc && motiontheater skate clean.amc --asf 01.asf --contacts plants.csv"
         ),
     ),
     Verb(
@@ -95,6 +95,6 @@ VERBS = [
             "numbers, both included). Edit it (delete a row, add one) and give it back to cleanup "
             "with --contacts."
         ),
-        epilog="Example: motiontheater contacts 07_05-walk.amc -o plants.csv",
+        epilog="Example: motiontheater contacts 01_01.amc -o plants.csv",
     ),
 ]

@@ -379,5 +379,5 @@ INFO = Verb(
         "units and its up axis; and the joint tree with each channel's range over the take. --json "
         "prints the same as JSON for programs."
     ),
-    epilog="Example: motiontheater info walk01.bvh ; motiontheater info 01_01.amc --json",
+    epilog="Example: motiontheater info 01_01.bvh\nExample: motiontheater info 01_01.amc --json",
 )

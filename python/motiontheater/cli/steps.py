@@ -10,18 +10,19 @@ from functools import partial
 from typing import Any
 
 from ..editing.filtering import FILTERS
-from ..editing.pipeline import Pipeline
-from ..formats.table import take_suffix, write_take_with_skeleton
+from ..editing.pipeline import Pipeline, toml_value
+from ..formats.table import format_of, take_suffix, write_take_with_skeleton
 from ..model.motion import Motion
 from ..model.registry import Option, Step, lookup, steps
 from .info import unit_notes
 from .takes import add_nan_option, add_output_options, add_take_options, output, settle_input, take_of
-from .verb import Verb, prose
+from .verb import Verb, plain, prose
 
 RECIPE_HELP = """\
 A recipe is a TOML file of [[step]] tables, applied in order; each names a step
-with run = "..." and gives its options (motiontheater steps lists them);
-frames = [A, B] confines a step to frames A..B:
+with run = "..." and gives its options (motiontheater steps lists them as a
+recipe writes them); frames = [A, B] confines a step to frames A..B. For
+example, steps.toml:
 
   [[step]]
   run = "median"
@@ -39,17 +40,44 @@ def step_verbs() -> list[Verb]:
     return [_step_verb(step) for step in steps().values()]
 
 
+# The value an example gives an option that has no default, by the option's name, else by its kind
+EXAMPLES: dict[str, Any] = {
+    "size": 5, "gains": (1, 1, 1.5, 1, 0.5), "rate": 60.0, "to": "02.asf", "map": "map.toml", "to_unit": "m", "contacts": "plants.csv",
+}  # fmt: skip
+KIND_EXAMPLES: dict[str, Any] = {
+    "int": 3, "float": 1.0, "str": "text", "bool": True, "ints": (1, 2), "floats": (1.0, 2.0),
+    "names": ("lfemur", "rfemur"), "path": "FILE", "frames": (100, 150),
+}  # fmt: skip
+
+
+def example(option: Option) -> Any:
+    """A value of an option for examples: its first choice, its entry in EXAMPLES, or one of its kind."""
+    if option.choices:
+        return option.choices[0]
+    return EXAMPLES.get(option.name, KIND_EXAMPLES[option.kind])
+
+
+def _command_line(option: Option, value: Any) -> str:
+    """A value as the command line writes it: lists comma-separated, frame ranges A:B."""
+    if option.kind == "frames":
+        return f"{value[0]}:{value[1]}"
+    return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
+
+
 def _step_verb(step: Step) -> Verb:
-    required = " ".join(f"{o.flag} {o.metavar or o.name.upper()}" for o in step.all_options if o.required)
-    example = f"Example: motiontheater {step.name} 01_01.amc {required + ' ' if required else ''}-o out"
-    example += step.suffixes[0] if step.is_exporter else ".amc"
+    required = "".join(f" {o.flag} {_command_line(o, example(o))}" for o in step.all_options if o.required)
+    output = "out" + (step.suffixes[0] if step.is_exporter else ".amc")
     return Verb(
         step.name,
-        step.summary,
+        plain(step.summary),
         partial(_step_arguments, step),
         _run_step,
-        description=prose(f"{step.summary[:1].upper()}{step.summary[1:]}.", *step.description.split("\n\n")),
-        epilog=example,
+        description=prose(
+            f"{step.summary[:1].upper()}{step.summary[1:]}.",
+            *step.description.split("\n\n"),
+            flags={o.name: o.flag for o in step.all_options},
+        ),
+        epilog=f"Example: motiontheater {step.name} 01_01.amc{required} -o {output}",
         aliases=step.aliases,
         laid_out=True,
     )
@@ -65,7 +93,7 @@ def _step_arguments(step: Step, parser: argparse.ArgumentParser) -> None:
         parser.add_argument("--dry-run", action="store_true", help="print what the step would do; write nothing")
     for option in step.all_options:
         shown = option.required or option.default is None  # the help says what None means
-        help_text = option.help + ("" if shown else f" (default: {_shown(option.default)})")
+        help_text = plain(option.help) + ("" if shown else f" (default: {_shown(option.default)})")
         if option.kind == "bool":
             parser.add_argument(option.flag, dest=option.name, action=argparse.BooleanOptionalAction, help=help_text)
         elif option.kind == "choice":
@@ -99,7 +127,7 @@ def _run_step(args: argparse.Namespace) -> int:
         return 0
     target = output(args, source)
     if not step.is_exporter:
-        take_suffix(target)
+        options.update(_direction(step, options, target))
     motion = take_of(args, source)
     if step.is_exporter:
         step(motion, target, **options)
@@ -111,6 +139,15 @@ def _run_step(args: argparse.Namespace) -> int:
     written = _write_result(motion, result, target, args)
     print(f"{step.name}: {motion.frames} frames of {source} -> {result.frames} frames in {written}")
     return 0
+
+
+def _direction(step: Step, options: dict[str, Any], target: str) -> dict[str, Any]:
+    """A ``to`` option naming a convention (convert's), when not given, is the output's: an .amc
+    output means ASF/AMC, a .bvh one BVH.  (ValueError for an output no format holds takes in.)"""
+    convention = format_of(target).convention
+    if "to" in options or not any(o.name == "to" and convention in o.choices for o in step.options):
+        return {}
+    return {"to": convention}
 
 
 def _write_result(motion: Motion, result: Motion, target: str, args: argparse.Namespace) -> str:
@@ -125,15 +162,38 @@ def _write_result(motion: Motion, result: Motion, target: str, args: argparse.Na
 def _list_steps(args: argparse.Namespace) -> int:
     for name, step in steps().items():
         kind = f"exporter ({', '.join(step.suffixes)})" if step.is_exporter else "step"
-        print(f"{name}: {step.summary} [{kind}]")
+        print(f"{name}: {plain(step.summary)} [{kind}]")
         for option in step.all_options:
-            default = "required" if option.required else f"default {option.default!r}"
-            choices = f" ({', '.join(map(str, option.choices))})" if option.choices else ""
-            print(f"    {option.name}: {option.help}{choices}; {default}")
+            print(f"    {_recipe_line(option)}")
     return 0
 
 
-LISTING = Verb("steps", "list every step and exporter with its options", lambda parser: None, _list_steps)
+def _recipe_line(option: Option) -> str:
+    """An option as a recipe's [[step]] table writes it, its default's value or an example's, then
+    what it is: ``size = 5  # required: window length ...``."""
+    if option.required:
+        value, which = example(option), "required"
+    elif option.default is None:
+        value, which = example(option), "unset by default; e.g."
+    else:
+        value, which = option.default, "default"
+    choices = f" (one of {', '.join(map(toml_value, option.choices))})" if option.choices else ""
+    return f"{option.name} = {toml_value(value)}  # {which}: {plain(option.help)}{choices}"
+
+
+LISTING = Verb(
+    "steps",
+    "list every step and exporter with its options, as a recipe writes them",
+    lambda parser: None,
+    _list_steps,
+    description=(
+        "List every step and exporter: its name (a verb of its own, and run = NAME in a recipe), what "
+        "it does, and each option as a recipe's [[step]] table writes it (TOML), with its default, or "
+        "an example where it has none. On the command line an option is --NAME VALUE, with lists "
+        "comma-separated (--joints lfemur,rfemur) and frame ranges as FIRST:LAST (--frames 100:150)."
+    ),
+    epilog="Example: motiontheater steps",
+)
 
 
 def add_filter_options(parser: argparse.ArgumentParser) -> None:

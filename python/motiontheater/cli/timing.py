@@ -40,4 +40,5 @@ BENCH = Verb(
         "frames x 3 rotations) beside mtcore, a plain Python loop, scipy.ndimage and bottleneck, "
         "and time a one-hour 120 Hz capture against numpy's copy. Prints Markdown, or JSON."
     ),
+    epilog="Example: motiontheater bench --quick",
 )

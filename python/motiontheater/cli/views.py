@@ -164,8 +164,9 @@ VERBS = [
             "(found from its frames, where the hips are above the ankles; --up gives it for every take), the camera "
             "follows the joint that travels, and a static joint above it (a game rig's root) is not drawn."
         ),
-        epilog="Example: motiontheater view 01_01.amc smooth.amc -o compare.html; "
-        "motiontheater view 07_05.amc cleaned.amc --contacts",
+        epilog="Example: motiontheater view 01_01.amc --contacts\n"
+        "Example: motiontheater median 01_01.amc --size 5 -o smooth.amc && "
+        "motiontheater view 01_01.amc smooth.amc --asf 01.asf -o compare.html",
     ),
     Verb(
         "plot",
@@ -177,8 +178,9 @@ VERBS = [
             "take in a colour over it (e.g. before and after a filter, as the thesis's figures 4.26-4.39). "
             "Needs matplotlib: pip install 'motiontheater[plot]'."
         ),
-        epilog="Example: motiontheater plot 01_01.amc --joints lfemur,ltibia --compare smooth.amc --frames 100:400 "
-        "-o fig.png",
+        epilog="Example: motiontheater plot 01_01.amc --joints lfemur,ltibia --frames 100:400 -o fig.png\n"
+        "Example: motiontheater median 01_01.amc --size 5 -o smooth.amc && "
+        "motiontheater plot 01_01.amc --joints lfemur,ltibia --compare smooth.amc --asf 01.asf --frames 100:400 -o fig.png",
     ),
     Verb(
         "render",
@@ -190,6 +192,6 @@ VERBS = [
             "the root (--fixed-camera: one camera over the whole take); --compare takes are ghosted over it. "
             "GIF needs matplotlib and pillow (pip install 'motiontheater[plot]'); MP4 also ffmpeg on the PATH."
         ),
-        epilog="Example: motiontheater render 01_01.amc --frames 1:600 -o walk.gif",
+        epilog="Example: motiontheater render 01_01.amc --frames 1:600 -o 01_01.gif",
     ),
 ]

@@ -21,6 +21,7 @@ import functools
 import glob
 import hashlib
 import json
+import logging
 import multiprocessing
 import os
 import signal
@@ -33,6 +34,8 @@ from collections.abc import Callable, Generator, Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
+
+from tqdm import tqdm
 
 from mtcore import cpu_count, share_cores
 
@@ -100,6 +103,7 @@ class Result:
     seconds: float = 0.0
     stop: str = ""  # an output problem that every take would meet: the run stops
     written: int = 0  # the output's size
+    notes: list[tuple[int, str]] = field(default_factory=list)  # what the steps logged: (level, message)
 
 
 def find_takes(inputs: Iterable[str]) -> list[tuple[Path, Path]]:
@@ -424,6 +428,13 @@ def run_job(job: Job) -> Result:
     """Process one take; every failure becomes a Result naming the file, line and reason."""
     start = time.perf_counter()
     result = Result(job.input, job.output, bytes=job.bytes)
+    with _notes_into(result.notes):
+        _run_job(job, result)
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def _run_job(job: Job, result: Result) -> None:
     try:
         try:
             os.makedirs(os.path.dirname(job.output) or ".", exist_ok=True)
@@ -449,8 +460,40 @@ def run_job(job: Job) -> Result:
         result.ok, result.error = False, str(e)
     except MemoryError:
         result.ok, result.error = False, f"{job.input}: not enough memory for this take ({job.bytes / 1e6:.0f} MB)"
-    result.seconds = time.perf_counter() - start
-    return result
+
+
+_taking_notes = threading.local()  # the notes list of the take this thread processes, if any
+
+
+class _TakeNotes(logging.Filter):
+    """On the package's logger: a record logged while a take is processed goes to its notes, for
+    the parent to log again naming the take (the command line prints it above the bar), not to the
+    handlers (in a worker: its stderr, over the bar)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        notes = getattr(_taking_notes, "notes", None)
+        if notes is None:
+            return True
+        notes.append((record.levelno, record.getMessage()))
+        return False
+
+
+_LOG = logging.getLogger("motiontheater")
+_LOG.addFilter(_TakeNotes())
+
+
+@contextlib.contextmanager
+def _notes_into(notes: list[tuple[int, str]]) -> Generator[None]:
+    """Keep what the package logs in this thread (at INFO and above, as the command line prints) in ``notes``."""
+    level = _LOG.level
+    _taking_notes.notes = notes
+    if _LOG.getEffectiveLevel() > logging.INFO:  # a Dask worker's, which the command line did not set
+        _LOG.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        _taking_notes.notes = None
+        _LOG.setLevel(level)
 
 
 def _read(job: Job) -> Motion:
@@ -491,20 +534,17 @@ def _copy_skeleton(asf: str, folder: str, replace: bool = False) -> None:
 
 
 class Progress:
-    """A progress bar on stderr (takes and MB, rate, time left), fitting the terminal: tqdm's, where
-    it is installed (``pip install "motiontheater[progress]"``); off when stderr is not a terminal."""
+    """A progress bar on stderr (takes and MB, rate, time left), fitting the terminal (tqdm's); off
+    when stderr is not a terminal."""
 
     def __init__(self, files: int, total_bytes: int, enabled: bool | None = None):
         enabled = sys.stderr.isatty() if enabled is None else enabled
         self.bar = None
         if enabled:
-            with contextlib.suppress(ImportError):
-                from tqdm import tqdm
-
-                self.bar = tqdm(
-                    total=total_bytes, unit="B", unit_scale=True, unit_divisor=1000, file=sys.stderr,
-                    desc=f"0/{files} takes", dynamic_ncols=True, smoothing=0.1,
-                )  # fmt: skip
+            self.bar = tqdm(
+                total=total_bytes, unit="B", unit_scale=True, unit_divisor=1000, file=sys.stderr,
+                desc=f"0/{files} takes", dynamic_ncols=True, smoothing=0.1,
+            )  # fmt: skip
         self.files, self.done = files, 0
 
     def advance(self, result: Result) -> None:
@@ -599,6 +639,8 @@ def run(
     try:
         for job, result in results:
             summary.results.append(result)
+            for level, note in result.notes:
+                _LOG.log(level, "%s: %s", result.input, note)
             progress.advance(result)
             if result.ok and manifest is not None:
                 manifest.record(job, result)

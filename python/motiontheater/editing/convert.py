@@ -307,7 +307,10 @@ def _notes(skeleton: Skeleton) -> tuple[str, frozenset[str], frozenset[str]]:
 def convert(
     motion: Motion,
     *,
-    to: Annotated[Literal["bvh", "asf"] | None, "the convention to convert to (default: the other one)"] = None,
+    to: Annotated[
+        Literal["bvh", "asf"] | None,
+        "the convention to convert to (default: the other one; on the command line, the output's)",
+    ] = None,
     order: Annotated[Literal["ZXY", "XYZ", "XZY", "YXZ", "YZX", "ZYX"], "rotation channel order of BVH joints"] = "ZXY",
 ) -> Motion:
     """The motion in the other file convention: see :func:`to_bvh` and :func:`to_asf`.

@@ -108,8 +108,8 @@ class Pipeline:
         """The recipe text of this pipeline; :meth:`from_toml` reads it back to an equal pipeline."""
         blocks = []
         for entry in self.entries:
-            lines = ["[[step]]", f"run = {_toml(entry.name)}"]
-            lines += [f"{key} = {_toml(value)}" for key, value in entry.options]
+            lines = ["[[step]]", f"run = {toml_value(entry.name)}"]
+            lines += [f"{key} = {toml_value(value)}" for key, value in entry.options]
             blocks.append("\n".join(lines) + "\n")
         return "\n".join(blocks)
 
@@ -149,7 +149,7 @@ class Pipeline:
         return cls().then(name, **options)
 
 
-def _toml(value: Any) -> str:
+def toml_value(value: Any) -> str:
     """A TOML value for an option's value (text, number, bool, path, or a list of them)."""
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -159,7 +159,7 @@ def _toml(value: Any) -> str:
         text = os.fspath(value)
         return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
     if isinstance(value, (tuple, list)):
-        return "[" + ", ".join(_toml(v) for v in value) + "]"
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
     raise TypeError(f"cannot write {value!r} to a recipe")
 
 

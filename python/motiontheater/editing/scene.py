@@ -75,6 +75,7 @@ A scene recipe is a TOML file: a [base] motion, then [[track]] tables laid over 
 order, each with its motion and the combiner's options (cut, scale, blend, preserve,
 joints, discard_old, interpolate, rotation_blend, up).  Paths are relative to the
 recipe; takes may be AMC (with the skeleton given, or found beside the base) or BVH.
+For example, scene.toml:
 
   skeleton = "02.asf"            # optional: else the ASF beside the base motion
   frame_rate = 120               # optional: for AMCs that do not say
