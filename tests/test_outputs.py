@@ -213,3 +213,14 @@ def test_a_chain_of_verbs_works_from_any_folder(cmu, tmp_path, monkeypatch, caps
     assert sorted(p.name for p in cmu.glob("*.asf")) == ["01.asf"]
     (cmu / "01_01_smooth.amc").unlink()
     assert digests(cmu) == before
+
+
+def test_batch_keeps_the_suffix_as_the_take_spells_it(data_dir, tmp_path):
+    from motiontheater.cli import main
+
+    folder = tmp_path / "up"
+    folder.mkdir()
+    shutil.copy(data_dir / "cmu" / "01_01.amc", folder / "01_01.AMC")
+    shutil.copy(data_dir / "cmu" / "01.asf", folder / "01.asf")
+    assert main(["batch", str(folder), "--median", "3", "-o", str(tmp_path / "out"), "--quiet", "--jobs", "1"]) == 0
+    assert sorted(p.name for p in (tmp_path / "out").iterdir() if not p.name.startswith(".")) == ["01.asf", "01_01.AMC"]

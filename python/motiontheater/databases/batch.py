@@ -335,7 +335,10 @@ def _name_outputs(jobs: list[Job], key: Callable[[str], str]) -> list[Job]:
 
     def named(job: Job, keep: bool) -> str:
         stem, suffix = os.path.splitext(job.output)
-        return stem + (suffix if keep else "") + made(job.pipeline, suffix.lower())
+        new = made(job.pipeline, suffix.lower())
+        if new == suffix.lower():  # the take's own format: its suffix as the file spells it (.AMC stays .AMC)
+            new = suffix
+        return stem + (suffix if keep else "") + new
 
     plain = [named(job, False) for job in jobs]
     keys = [key(path) for path in plain]
