@@ -224,3 +224,37 @@ def test_batch_keeps_the_suffix_as_the_take_spells_it(data_dir, tmp_path):
     shutil.copy(data_dir / "cmu" / "01.asf", folder / "01.asf")
     assert main(["batch", str(folder), "--median", "3", "-o", str(tmp_path / "out"), "--quiet", "--jobs", "1"]) == 0
     assert sorted(p.name for p in (tmp_path / "out").iterdir() if not p.name.startswith(".")) == ["01.asf", "01_01.AMC"]
+
+
+@pytest.mark.parametrize("verb", ["apply", "batch", "combine", "retarget"])
+def test_a_recipe_or_map_that_is_a_fifo_is_refused_not_waited_on(data_dir, tmp_path, capsys, verb):
+    import signal
+
+    from motiontheater.cli import main
+
+    take = tmp_path / "01_01.amc"
+    shutil.copy(data_dir / "cmu" / "01_01.amc", take)
+    shutil.copy(data_dir / "cmu" / "01.asf", tmp_path / "01.asf")
+    fifo = tmp_path / "steps.toml"
+    os.mkfifo(fifo)
+    argv = {
+        "apply": ["apply", str(take), "--recipe", str(fifo), "-o", str(tmp_path / "o.amc")],
+        "batch": ["batch", str(take), "--recipe", str(fifo), "-o", str(tmp_path / "out")],
+        "combine": ["combine", str(fifo), "-o", str(tmp_path / "o.amc")],
+        "retarget": [
+            "retarget",
+            str(take),
+            "--to",
+            str(data_dir / "bvh" / "walk01.bvh"),
+            "--map",
+            str(fifo),
+            "-o",
+            str(tmp_path / "o.bvh"),
+        ],
+    }[verb]
+    signal.alarm(60)  # a hang fails the test instead of blocking the suite
+    try:
+        assert main(argv) == 2
+    finally:
+        signal.alarm(0)
+    assert "named pipe (FIFO), not a regular file" in capsys.readouterr().err

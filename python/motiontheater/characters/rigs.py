@@ -37,6 +37,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from .._io import read_source
 from ..model.errors import DuplicateError, UnknownNameError
 from ..model.skeleton import ROTATIONS, Skeleton
 
@@ -221,11 +222,10 @@ def read_map(path: str | os.PathLike) -> tuple[dict[str, str], bool]:
     the rest; ValueError naming the file and what is wrong."""
     where = os.fspath(path)
     try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
+        data = tomllib.loads(read_source(path)[0].decode("utf-8"))  # a FIFO or a device is refused
     except FileNotFoundError:
         raise FileNotFoundError(f"{where}: no such map file") from None
-    except tomllib.TOMLDecodeError as e:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
         raise ValueError(f"{where}: not valid TOML: {e}") from None
     unknown = sorted(set(data) - {"joints", "aliases"})
     if unknown:

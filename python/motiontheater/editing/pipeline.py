@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .._io import read_source
 from ..model.motion import Motion
 from ..model.registry import Step, StepError, lookup
 
@@ -140,8 +141,8 @@ class Pipeline:
     @classmethod
     def read(cls, path: str | os.PathLike) -> Pipeline:
         """The pipeline of a recipe file."""
-        with open(path, encoding="utf-8") as f:
-            return cls.from_toml(f.read(), os.fspath(path), Path(path).parent)
+        data, _ = read_source(path)  # a regular file: a FIFO or a device is refused, not waited on
+        return cls.from_toml(_text(data, path), os.fspath(path), Path(path).parent)
 
     @classmethod
     def of(cls, name: str, **options: Any) -> Pipeline:
@@ -165,3 +166,10 @@ def toml_value(value: Any) -> str:
 
 def _nonfinite(value: float) -> str:
     return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
+
+
+def _text(data: bytes, path: str | os.PathLike) -> str:
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ValueError(f"{os.fspath(path)}: a recipe is UTF-8 text; byte {e.start} is not") from None

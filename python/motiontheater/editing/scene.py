@@ -8,6 +8,7 @@ import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from .._io import read_source
 from ..formats.table import read_take
 from ..model.motion import Motion
 from .combine import Plan, combine_planned
@@ -100,11 +101,11 @@ def read_recipe(path: str | os.PathLike) -> Scene:
     Errors name the recipe and the track at fault.
     """
     path = Path(path)
-    with open(path, "rb") as f:
-        try:
-            recipe = tomllib.load(f)
-        except tomllib.TOMLDecodeError as e:
-            raise ValueError(f"{path}: not a valid TOML recipe: {e}") from None
+    data, _ = read_source(path)  # a regular file: a FIFO or a device is refused, not waited on
+    try:
+        recipe = tomllib.loads(data.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+        raise ValueError(f"{path}: not a valid TOML recipe: {e}") from None
     folder = path.parent
 
     def where(name: str, key: str) -> Path:
