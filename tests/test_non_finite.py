@@ -68,4 +68,4 @@ def test_feet_verbs_on_a_take_of_nan_say_so(folder, capsys, verb):
     argv = [verb, "01_02.amc"] + {"skate": [], "contacts": ["-o", "c.csv"], "cleanup": ["-o", "c.amc"]}[verb]
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert "no frame holds the legs as numbers" in err and "Singular" not in err, err
+    assert "01_02.amc: no frame holds the legs as numbers" in err and "Singular" not in err, err  # named by the take

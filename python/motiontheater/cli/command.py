@@ -69,6 +69,17 @@ def _warning(message: Warning | str, *args: object, **kwargs: object) -> None:
     print(f"warning: {message}", file=sys.stderr)
 
 
+def _naming_the_file(args: argparse.Namespace, text: str) -> str:
+    """A failure's message, led by the take the verb read where it names none of the files given
+    (a step's reason, such as a take of NaN having no feet, does not know its file)."""
+    given = [v for value in vars(args).values() for v in (value if isinstance(value, list) else [value])]
+    files = [v for v in given if isinstance(v, str) and os.path.splitext(v)[1]]
+    take = next((getattr(args, name) for name in ("input", "take") if isinstance(getattr(args, name, None), str)), None)
+    if take is None or any(f in text or os.path.basename(f) in text for f in files):
+        return text
+    return f"{take}: {text}"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status: 0 done, 1 some takes failed (batch), 2 a
     one-line reason on failure, 130 interrupted (Ctrl-C or SIGTERM: nothing partial is left)."""
@@ -98,7 +109,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"motiontheater {args.verb}: not enough memory for this take", file=sys.stderr)
         return 2
     except (ValueError, TypeError, OSError, RuntimeError) as exc:
-        print(f"motiontheater {args.verb}: {exc}", file=sys.stderr)
+        text = _naming_the_file(args, str(exc)) if type(exc) is ValueError else str(exc)  # a step's reason
+        print(f"motiontheater {args.verb}: {text}", file=sys.stderr)
         return 2
     finally:
         logger.removeHandler(notes)
