@@ -92,7 +92,7 @@ BATCH = Verb(
     description=prose(
         "Apply a filter (--median N, --mean N, --binomial N) or a recipe of steps (--recipe FILE) to "
         "every AMC and BVH take under the inputs (files, folders searched recursively, globs), writing "
-        "into an output folder that mirrors the input tree, with each take's skeleton found by the "
+        "into an output folder that mirrors the input tree (several input folders: a subfolder each, named as the folder), with each take's skeleton found by the "
         "CMU/HDM05 naming (or --asf). Runs on all cores (--jobs), or on a Dask cluster (--dask for a "
         "local one, --scheduler tcp://HOST:PORT). Each output is written under a temporary name and "
         "renamed when complete; --resume skips takes already done; a bad take is reported and the "
