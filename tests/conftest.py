@@ -1,4 +1,5 @@
 import os
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -23,3 +24,18 @@ def data_dir() -> Path:
     if not DATA.is_dir():
         pytest.skip(f"real capture corpus not found at {DATA} (set MOTIONTHEATER_DATA)")
     return DATA
+
+
+@pytest.fixture
+def copies(data_dir, tmp_path):
+    """copies(folder, names): a folder of tmp_path holding copies of those files of the corpus's
+    ``folder`` (a test that writes beside its inputs never touches the corpus)."""
+
+    def made(folder: str, names) -> Path:
+        target = tmp_path / folder
+        target.mkdir(exist_ok=True)
+        for name in names:
+            shutil.copy(data_dir / folder / name, target / name)
+        return target
+
+    return made

@@ -19,13 +19,9 @@ from motiontheater.model import registry
 
 
 @pytest.fixture
-def cmu(data_dir, tmp_path):
+def cmu(copies):
     """A folder with subject 02's skeleton and two of its takes."""
-    folder = tmp_path / "cmu"
-    folder.mkdir()
-    for name in ("02.asf", "02_01.amc", "02_02.amc"):
-        shutil.copy(data_dir / "cmu" / name, folder / name)
-    return folder
+    return copies("cmu", ("02.asf", "02_01.amc", "02_02.amc"))
 
 
 def test_outputs_get_the_umasks_permissions(cmu, tmp_path):

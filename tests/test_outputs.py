@@ -42,13 +42,9 @@ def within(seconds: int):
 
 
 @pytest.fixture
-def cmu(data_dir, tmp_path):
+def cmu(copies):
     """A folder with subject 01's skeleton and its take in ASF/AMC and in BVH."""
-    folder = tmp_path / "cmu"
-    folder.mkdir()
-    for name in ("01.asf", "01_01.amc", "01_01.bvh"):
-        shutil.copy(data_dir / "cmu" / name, folder / name)
-    return folder
+    return copies("cmu", ("01.asf", "01_01.amc", "01_01.bvh"))
 
 
 def test_batch_into_a_folder_of_its_inputs_is_refused(cmu, capsys):
