@@ -133,3 +133,14 @@ def test_a_track_is_planned_once(data_dir):
     with pytest.warns(UserWarning, match="blend and preserve exclude each other") as caught:
         mt.Scene(take).add(take, blend=5, preserve="literal").render()
     assert len(caught) == 1
+
+
+def test_combine_keeps_another_skeleton_beside_its_output_unless_in_place(recipe, tmp_path, capsys, data_dir):
+    out = tmp_path / "out.amc"
+    other = (data_dir / "cmu" / "01.asf").read_bytes()  # another subject's skeleton, where out.asf goes
+    (tmp_path / "out.asf").write_bytes(other)
+    assert main(["combine", str(recipe), "-o", str(out)]) == 2
+    assert "out.asf exists and holds another skeleton" in capsys.readouterr().err
+    assert not out.exists() and (tmp_path / "out.asf").read_bytes() == other
+    assert main(["combine", str(recipe), "-o", str(out), "--in-place"]) == 0
+    assert (tmp_path / "out.asf").read_bytes() != other

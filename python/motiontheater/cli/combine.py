@@ -16,6 +16,9 @@ def _arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", help="the take to write (.amc or .bvh, as the motions)")
     parser.add_argument("--dry-run", action="store_true", help="print the frame maps and borders, write nothing")
     add_nan_option(parser)
+    parser.add_argument(
+        "--in-place", action="store_true", help="allow the output's skeleton file to replace another one there"
+    )
 
 
 def _combine(args: argparse.Namespace) -> int:
@@ -28,7 +31,7 @@ def _combine(args: argparse.Namespace) -> int:
     if not args.output:
         raise ValueError("give -o OUT.amc (or --dry-run)")
     result = scene.render()
-    write_take_with_skeleton(result, args.output, allow_non_finite=args.allow_nan)
+    write_take_with_skeleton(result, args.output, allow_non_finite=args.allow_nan, replace=args.in_place)
     print(
         f"{len(scene.tracks)} track(s) over {scene.base.frames} frames: wrote {result.frames} frames "
         f"({result.first_frame}..{result.last_frame}) to {args.output}"
