@@ -28,6 +28,9 @@ from .feet.skate import skate_metrics
 from .formats.amc import read_amc, skeleton_path_for, write_amc
 from .formats.asf import read_asf, write_asf
 from .formats.bvh import read_bvh, write_bvh
+from .formats.export import export
+from .formats.gltf import write_gltf
+from .formats.gltf_read import read_gltf
 from .formats.table import read_take, write_take
 from .model import errors
 from .model.errors import *  # the exceptions, errors.__all__
@@ -55,6 +58,7 @@ __all__ = [
     "clean_footskate",
     "combine",
     "detect_contacts",
+    "export",
     "filter_motion",
     "find_legs",
     "interpolate",
@@ -66,6 +70,7 @@ __all__ = [
     "read_amc",
     "read_asf",
     "read_bvh",
+    "read_gltf",
     "read_recipe",
     "read_take",
     "retarget",
@@ -78,6 +83,7 @@ __all__ = [
     "write_amc",
     "write_asf",
     "write_bvh",
+    "write_gltf",
     "write_positions",
     "write_take",
 ]

@@ -223,8 +223,10 @@ def _why(skeleton, sizing: units.Sizing) -> str:
     source, unit = skeleton.length_source, units.label(skeleton.length_unit)
     if source == "given":
         return "given by the caller"
-    if source == "stated":
+    if source == "stated" and skeleton.convention == "asf":
         return f"the skeleton says so (:units length {skeleton.unit('length')})"
+    if source == "stated":
+        return "its file states it (glTF is in metres)"
     if source == "default":
         return "the Acclaim default: the ASF has no :units length"
     low, high = units.HUMAN_HEIGHT

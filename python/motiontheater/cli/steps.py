@@ -5,6 +5,7 @@ recipe help serve ``batch`` too."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from functools import partial
 from typing import Any
@@ -85,9 +86,13 @@ def _step_verb(step: Step) -> Verb:
 
 def _step_arguments(step: Step, parser: argparse.ArgumentParser) -> None:
     what = "the file to write (" + (", ".join(step.suffixes) if step.is_exporter else ".amc or .bvh") + ")"
-    parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
-    add_output_options(parser, what)
-    add_nan_option(parser)
+    if step.several:
+        parser.add_argument("inputs", metavar="TAKE", nargs="+", help="the takes (AMC, BVH, ...), one skeleton")
+        parser.add_argument("-o", "--output", required=True, help=what)
+    else:
+        parser.add_argument("input", metavar="TAKE", help="the AMC or BVH take")
+        add_output_options(parser, what)
+        add_nan_option(parser)
     add_take_options(parser)
     if step.dry_run is not None:
         parser.add_argument("--dry-run", action="store_true", help="print what the step would do; write nothing")
@@ -121,6 +126,8 @@ def _shown(value: Any) -> str:
 def _run_step(args: argparse.Namespace) -> int:
     step = lookup(args.step)
     options = {o.name: getattr(args, o.name) for o in step.all_options if getattr(args, o.name) is not None}
+    if step.several:
+        return _export_takes(step, args, options)
     source = settle_input(args)
     if getattr(args, "dry_run", False):
         print(step.describe(take_of(args, source), **options))
@@ -138,6 +145,23 @@ def _run_step(args: argparse.Namespace) -> int:
     result = step(motion, **options)
     written = _write_result(motion, result, target, args)
     print(f"{step.name}: {motion.frames} frames of {source} -> {result.frames} frames in {written}")
+    return 0
+
+
+def _export_takes(step: Step, args: argparse.Namespace, options: dict[str, Any]) -> int:
+    """An exporter of several takes: every take given, into the one file -o names."""
+    target = args.output
+    for source in args.inputs:
+        if os.path.exists(target) and os.path.samefile(source, target):
+            raise ValueError(f"{target} is one of the takes read: write the file elsewhere")
+    motions = [take_of(args, source) for source in args.inputs]
+    step(motions if len(motions) > 1 else motions[0], target, **options)
+    frames = sum(m.frames for m in motions)
+    takes = f"{len(motions)} takes" if len(motions) > 1 else args.inputs[0]
+    print(f"{step.name}: wrote {frames} frames of {takes} to {target}")
+    for motion in motions:
+        for note in unit_notes(motion, motion, target):
+            print(note, file=sys.stderr)
     return 0
 
 

@@ -91,9 +91,21 @@ def _number(x: Any) -> float | int:
     return int(x) if isinstance(x, np.integer) else float(x)
 
 
+def node_names(armature: Armature) -> list[str]:
+    """The armature's names as glTF nodes: "root" (every ASF skeleton's) becomes "Root", since
+    three.js binds an animation track of a node named "root" to the scene itself."""
+    names: list[str] = []
+    for name in armature.names:
+        found, n = ("Root" if name == "root" else name), 2
+        while found in names or (found != name and found in armature.names):
+            found, n = f"Root{n}", n + 1
+        names.append(found)
+    return names
+
+
 def _nodes(armature: Armature) -> list[dict[str, Any]]:
     nodes: list[dict[str, Any]] = []
-    for n, name in enumerate(armature.names):
+    for n, name in enumerate(node_names(armature)):
         node: dict[str, Any] = {"name": name}
         children = armature.children(n).tolist()
         if children:

@@ -354,9 +354,9 @@ def _motion(f, nodes, order, parent_of, above, animation, rate, frames, sampled)
         hierarchy=canonical_hierarchy(tuple(bones), pairs),
         root=Root(order=("tx", "ty", "tz", *ORDER), position=(0.0, 0.0, 0.0), name=names[0]),
         name=str(animation.get("name") or ""),
-        units=(("angle", "deg"),),
+        units=(("length", "m"), ("angle", "deg")),  # glTF states metres
         convention="bvh",
-    ).with_length_unit("m", "stated")
+    )
     extras = animation.get("extras", {}) if isinstance(animation.get("extras"), dict) else {}
     first = extras.get("first_frame", 1)
     values = np.concatenate([c.reshape(frames, -1) for c in columns], axis=1)

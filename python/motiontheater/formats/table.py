@@ -26,6 +26,7 @@ from ..model.skeleton import Skeleton, settle_length_unit
 from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
 from .bvh import read_bvh, write_bvh
+from .gltf_read import read_gltf
 
 ReadTake = Callable[..., Motion]  # (path, skeleton or None, frame_rate, unit, workers) -> Motion
 
@@ -70,10 +71,18 @@ def _bvh_skeleton(path) -> Skeleton:
     return read_bvh(path).skeleton
 
 
+def _read_gltf(path, skeleton, frame_rate, unit, workers) -> Motion:
+    motion = read_gltf(path, frame_rate=frame_rate)
+    return motion if unit is None else motion.replace(skeleton=motion.skeleton.with_length_unit(unit, "given"))
+
+
 FORMATS: dict[str, Format] = {
     ".asf": Format(".asf", "ASF", "asf", read_skeleton=read_asf, write_skeleton=write_asf),
     ".amc": Format(".amc", "ASF/AMC", "asf", _read_amc, write_amc, companion=".asf"),
     ".bvh": Format(".bvh", "BVH", "bvh", _read_bvh, write_bvh, read_skeleton=_bvh_skeleton, states_unit=False),
+    # glTF takes are read as BVH motions and written by the export step (formats/export.py)
+    ".glb": Format(".glb", "glTF binary", "bvh", _read_gltf),
+    ".gltf": Format(".gltf", "glTF", "bvh", _read_gltf),
 }
 
 
@@ -280,7 +289,12 @@ def write_take(motion: Motion, path: str | os.PathLike, *, allow_non_finite: boo
     if not allow_non_finite and not np.isfinite(motion.values).all():
         raise ValueError(f"{os.fspath(path)}: {non_finite_text(motion)}")
     row = format_of(path)
-    if row.write is None or motion.skeleton.convention != row.convention:
+    if row.write is None:
+        raise ValueError(
+            f"{os.fspath(path)}: {row.name} files are written by the export step: "
+            f"motiontheater export TAKE -o {os.path.basename(os.fspath(path))}"
+        )
+    if motion.skeleton.convention != row.convention:
         other = suffix_for(motion.skeleton.convention)
         kind = f"{'an' if motion.skeleton.convention[0] in 'aeiou' else 'a'} {motion.skeleton.convention.upper()}"
         raise ValueError(

@@ -239,6 +239,7 @@ class Step:
     frames: str = "splice"
     streamer: Callable[..., Streamer] | None = None
     suffixes: tuple[str, ...] = ()  # an exporter's file suffixes; empty for a step
+    several: bool = False  # an exporter that writes several takes into one file
     aliases: tuple[str, ...] = ()  # other names of the step (command-line verbs, recipes)
     dry_run: Callable[..., str] | None = None
     convention: Callable[[str, dict[str, Any]], str] | None = None
@@ -347,14 +348,16 @@ def step(
 
 
 def exporter(
-    name: str, suffixes: tuple[str, ...], summary: str | None = None
+    name: str, suffixes: tuple[str, ...], summary: str | None = None, *, several: bool = False
 ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """Register the decorated ``f(motion, target, *, options...)`` as the exporter ``name`` writing ``suffixes``."""
+    """Register the decorated ``f(motion, target, *, options...)`` as the exporter ``name`` writing
+    ``suffixes``; ``several``: it also takes a sequence of motions, all into one file (its verb
+    then reads every take it is given)."""
     if not suffixes:
         raise ValueError("an exporter writes at least one file suffix")
 
     def decorate(function: Callable[..., Any]) -> Callable[..., Any]:
-        register(name, function, summary, frames="none", suffixes=tuple(s.lower() for s in suffixes))
+        register(name, function, summary, frames="none", suffixes=tuple(s.lower() for s in suffixes), several=several)
         return function
 
     return decorate
@@ -368,6 +371,7 @@ def register(
     frames: str = "splice",
     streamer: Callable[..., Any] | None = None,
     suffixes: tuple[str, ...] = (),
+    several: bool = False,
     fixed: Mapping[str, Any] | None = None,
     aliases: tuple[str, ...] = (),
     dry_run: Callable[..., str] | None = None,
@@ -398,6 +402,7 @@ def register(
         frames=frames,
         streamer=streamer,
         suffixes=suffixes,
+        several=several,
         aliases=aliases,
         dry_run=dry_run,
         convention=convention,
