@@ -33,6 +33,22 @@ static int check_tree(size_t joints, const long long *parent, const long long *o
     return status;
 }
 
+/* Checks the channel tables of a tree: each joint's dofs of known kinds at columns of the values. */
+static int check_channels(const double *values, size_t frames, size_t channels, size_t joints, const double *axis,
+                          const size_t *dof_start, const int *dof_kind, const size_t *dof_column)
+{
+    if (!axis || !dof_start || (frames > 0 && channels > 0 && !values) ||
+        (dof_start[joints] > 0 && (!dof_kind || !dof_column)))
+        return MT_EINVAL;
+    for (size_t c = 0; c < dof_start[joints]; c++)
+        if (dof_kind[c] < MT_DOF_RX || dof_kind[c] > MT_DOF_L || dof_column[c] >= channels)
+            return MT_EINVAL;
+    for (size_t j = 0; j < joints; j++)
+        if (dof_start[j] > dof_start[j + 1])
+            return MT_EINVAL;
+    return MT_OK;
+}
+
 struct fk {
     const double *values;
     size_t channels, joints;
@@ -130,15 +146,9 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
         return MT_EINVAL;
     if (joints == 0 || begin == end)
         return MT_OK;
-    if (!parent || !order || !axis || !direction || !segment || !dof_start || !positions ||
-        (frames > 0 && channels > 0 && !values) || (dof_start[joints] > 0 && (!dof_kind || !dof_column)))
+    if (!parent || !order || !direction || !segment || !positions ||
+        check_channels(values, frames, channels, joints, axis, dof_start, dof_kind, dof_column) != MT_OK)
         return MT_EINVAL;
-    for (size_t c = 0; c < dof_start[joints]; c++)
-        if (dof_kind[c] < MT_DOF_RX || dof_kind[c] > MT_DOF_L || dof_column[c] >= channels)
-            return MT_EINVAL;
-    for (size_t j = 0; j < joints; j++)
-        if (dof_start[j] > dof_start[j + 1])
-            return MT_EINVAL;
     int status = check_tree(joints, parent, order);
     if (status != MT_OK)
         return status;
@@ -160,4 +170,107 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
     free(k.world);
     free(k.end);
     return status;
+}
+
+/* q = (c, s e_axis) q over lanes: a turn about a coordinate axis (c, s: cosine and sine of half
+ * its angle) after the rotation q (w, x, y, z rows of BLOCK lanes). */
+static MT_INLINE void turn_quaternion_n(double q[4][BLOCK], int axis, const double *s, const double *c)
+{
+    const int a = 1 + axis, p = 1 + mixed_first(axis), r = 1 + mixed_second(axis);
+    for (int f = 0; f < BLOCK; f++) {
+        const double w = q[0][f], u = q[a][f], v = q[p][f], t = q[r][f];
+        q[0][f] = c[f] * w - s[f] * u;
+        q[a][f] = c[f] * u + s[f] * w;
+        q[p][f] = c[f] * v - s[f] * t;
+        q[r][f] = c[f] * t + s[f] * v;
+    }
+}
+
+/* out = a q b over lanes, a and b one quaternion for every lane (out may be q) */
+static MT_INLINE void sandwich_n(const double *a, double q[4][BLOCK], const double *b, double out[4][BLOCK])
+{
+    for (int f = 0; f < BLOCK; f++) {
+        const double w = q[0][f], x = q[1][f], y = q[2][f], z = q[3][f];
+        const double mw = a[0] * w - a[1] * x - a[2] * y - a[3] * z, mx = a[0] * x + a[1] * w + a[2] * z - a[3] * y,
+                     my = a[0] * y - a[1] * z + a[2] * w + a[3] * x, mz = a[0] * z + a[1] * y - a[2] * x + a[3] * w;
+        out[0][f] = mw * b[0] - mx * b[1] - my * b[2] - mz * b[3];
+        out[1][f] = mw * b[1] + mx * b[0] + my * b[3] - mz * b[2];
+        out[2][f] = mw * b[2] - mx * b[3] + my * b[0] + mz * b[1];
+        out[3][f] = mw * b[3] + mx * b[2] - my * b[1] + mz * b[0];
+    }
+}
+
+enum { SPAN = 256 }; /* frames whose channels stay in cache while every chosen joint reads them */
+
+static MT_CLONES void local_quaternions(const double *values, size_t frames, size_t channels, const size_t *dof_start,
+                                        const int *dof_kind, const size_t *dof_column, double angle_scale,
+                                        size_t count, const long long *chosen, const double *outer,
+                                        const double *inner, double *before, float *out)
+{
+    for (size_t s0 = 0; s0 < frames; s0 += SPAN) {
+        const size_t s1 = frames - s0 < SPAN ? frames : s0 + SPAN;
+        for (size_t i = 0; i < count; i++) {
+            const size_t j = (size_t)chosen[i];
+            double *last = before + 4 * i;
+            for (size_t f0 = s0; f0 < s1; f0 += BLOCK) {
+                const size_t n = s1 - f0 < BLOCK ? s1 - f0 : BLOCK;
+                double q[4][BLOCK], v[BLOCK], sn[BLOCK], cs[BLOCK];
+                for (int f = 0; f < BLOCK; f++)
+                    q[0][f] = 1, q[1][f] = q[2][f] = q[3][f] = 0;
+                for (size_t c = dof_start[j]; c < dof_start[j + 1]; c++) {
+                    if (dof_kind[c] > MT_DOF_RZ)
+                        continue;
+                    for (int f = 0; f < BLOCK; f++)
+                        v[f] = values[(f0 + ((size_t)f < n ? (size_t)f : n - 1)) * channels + dof_column[c]] *
+                               (angle_scale / 2);
+                    sincos_lanes(v, sn, cs, BLOCK);
+                    turn_quaternion_n(q, dof_kind[c], sn, cs);
+                }
+                sandwich_n(outer + 4 * i, q, inner + 4 * i, q);
+                for (size_t f = 0; f < n; f++) {
+                    double dot = 0;
+                    for (int e = 0; e < 4; e++)
+                        dot += q[e][f] * last[e];
+                    const double sign = (f0 + f == 0 ? q[0][f] < 0 : dot < 0) ? -1.0 : 1.0;
+                    float *to = out + 4 * (i * frames + f0 + f);
+                    for (int e = 0; e < 4; e++)
+                        last[e] = sign * q[e][f];
+                    to[0] = (float)last[1], to[1] = (float)last[2], to[2] = (float)last[3], to[3] = (float)last[0];
+                }
+            }
+        }
+    }
+}
+
+int mt_local_quaternions(const double *values, size_t frames, size_t channels, size_t joints, const double *axis,
+                         const size_t *dof_start, const int *dof_kind, const size_t *dof_column, double angle_scale,
+                         size_t count, const long long *chosen, const double *turn, float *out)
+{
+    if (count == 0 || frames == 0)
+        return MT_OK;
+    if (joints == 0 || !chosen || !out ||
+        check_channels(values, frames, channels, joints, axis, dof_start, dof_kind, dof_column) != MT_OK)
+        return MT_EINVAL;
+    for (size_t i = 0; i < count; i++)
+        if (chosen[i] < 0 || (size_t)chosen[i] >= joints)
+            return MT_EINVAL;
+    /* L = C M C^T is the quaternion product c q_M c*; the turn T L is t c q_M c* */
+    double *outer = malloc(12 * count * sizeof *outer), *inner = outer + 4 * count, *before = inner + 4 * count;
+    if (outer == NULL)
+        return MT_ENOMEM;
+    for (size_t i = 0; i < count; i++) {
+        double c[4], t[4] = {1, 0, 0, 0};
+        matrix_quaternion(axis + 9 * (size_t)chosen[i], c);
+        if (i == 0 && turn)
+            matrix_quaternion(turn, t);
+        outer[4 * i] = t[0] * c[0] - t[1] * c[1] - t[2] * c[2] - t[3] * c[3];
+        outer[4 * i + 1] = t[0] * c[1] + t[1] * c[0] + t[2] * c[3] - t[3] * c[2];
+        outer[4 * i + 2] = t[0] * c[2] - t[1] * c[3] + t[2] * c[0] + t[3] * c[1];
+        outer[4 * i + 3] = t[0] * c[3] + t[1] * c[2] - t[2] * c[1] + t[3] * c[0];
+        inner[4 * i] = c[0], inner[4 * i + 1] = -c[1], inner[4 * i + 2] = -c[2], inner[4 * i + 3] = -c[3];
+    }
+    local_quaternions(values, frames, channels, dof_start, dof_kind, dof_column, angle_scale, count, chosen, outer,
+                      inner, before, out);
+    free(outer);
+    return MT_OK;
 }

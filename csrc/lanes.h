@@ -467,4 +467,27 @@ static inline void rotvec_exp(const double *v, double *m)
     rotvec_exp_n(v, m, 1);
 }
 
+/* The unit quaternion (w, x, y, z) of a rotation matrix (row-major), w >= 0: Shepperd's method,
+ * dividing by the largest of 4w^2, 4x^2, 4y^2, 4z^2. */
+static inline void matrix_quaternion(const double *m, double *q)
+{
+    const double trace = m[0] + m[4] + m[8];
+    double w, x, y, z;
+    if (trace > 0) {
+        const double s = 2 * sqrt(trace + 1);
+        w = s / 4, x = (m[7] - m[5]) / s, y = (m[2] - m[6]) / s, z = (m[3] - m[1]) / s;
+    } else if (m[0] > m[4] && m[0] > m[8]) {
+        const double s = 2 * sqrt(1 + m[0] - m[4] - m[8]);
+        w = (m[7] - m[5]) / s, x = s / 4, y = (m[1] + m[3]) / s, z = (m[2] + m[6]) / s;
+    } else if (m[4] > m[8]) {
+        const double s = 2 * sqrt(1 + m[4] - m[0] - m[8]);
+        w = (m[2] - m[6]) / s, x = (m[1] + m[3]) / s, y = s / 4, z = (m[5] + m[7]) / s;
+    } else {
+        const double s = 2 * sqrt(1 + m[8] - m[0] - m[4]);
+        w = (m[3] - m[1]) / s, x = (m[2] + m[6]) / s, y = (m[5] + m[7]) / s, z = s / 4;
+    }
+    const double sign = w < 0 ? -1.0 : 1.0;
+    q[0] = sign * w, q[1] = sign * x, q[2] = sign * y, q[3] = sign * z;
+}
+
 #endif /* MT_LANES_H */

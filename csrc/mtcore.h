@@ -323,6 +323,19 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
                           size_t end, double *positions, double *world, double *local);
 
 /*
+ * Local rotations of chosen joints of a tree (the tables of mt_forward_kinematics) as unit
+ * quaternions (x, y, z, w) in single precision, the keys animation formats store: for each of
+ * `count` joints chosen[i], L = C M C^T per frame as mt_forward_kinematics has it, turned by
+ * `turn` (3x3 row-major, applied on the left) for chosen[0] where turn is not NULL, written to
+ * out[4 (i frames + f) ..] for frames f = 0 .. frames-1 (each joint's keys together); the first
+ * with w >= 0, each next one on the hemisphere of the one before, so that interpolation between
+ * frames takes the short way.  NaN in a channel gives NaN in its joint's keys.
+ */
+int mt_local_quaternions(const double *values, size_t frames, size_t channels, size_t joints, const double *axis,
+                         const size_t *dof_start, const int *dof_kind, const size_t *dof_column, double angle_scale,
+                         size_t count, const long long *chosen, const double *turn, float *out);
+
+/*
  * Rotations (rotation.c), n at a time.  Matrices are 3x3 row-major (n x 9);
  * quaternions (n x 4) are (w, x, y, z), need not be unit (they are
  * normalised; a zero quaternion gives NaN) and come out with w >= 0 where

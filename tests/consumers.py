@@ -5,6 +5,7 @@ them with our forward kinematics.  A test skips, with the reason, where a progra
 
 import base64
 import json
+import os
 import shutil
 import subprocess
 import textwrap
@@ -62,6 +63,21 @@ _BLENDER_SCRIPT = textwrap.dedent(
 )
 
 
+def run_blender(script: str, *args: str, timeout: float = 1200) -> subprocess.CompletedProcess:
+    """Headless Blender running ``script`` with ``args`` after ``--``.  Its Python finds its
+    standard library from the python on PATH: a virtualenv's or pyenv's there would hide the
+    system's packages (numpy, which its glTF add-on needs), so PATH holds the system's only."""
+    env = {**os.environ, "PATH": "/usr/local/bin:/usr/bin:/bin"}
+    return subprocess.run(
+        [BLENDER, "-b", "--factory-startup", "--python-expr", script, "--", *args],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=env,
+    )
+
+
 def blender_positions(jobs, tmp_path):
     """For each (path, times) of ``jobs``: {bone name: (len(times), 3)} world positions of the
     bones Blender imports from the file (glTF, FBX or BVH), at ``times`` seconds from its first
@@ -69,13 +85,7 @@ def blender_positions(jobs, tmp_path):
     for all: it takes a second or two to start."""
     listing = tmp_path / "blender-jobs.json"
     listing.write_text(json.dumps([[str(path), [float(t) for t in times]] for path, times in jobs]))
-    result = subprocess.run(
-        [BLENDER, "-b", "--factory-startup", "--python-expr", _BLENDER_SCRIPT, "--", str(listing)],
-        check=False,
-        capture_output=True,
-        text=True,
-        timeout=1200,
-    )
+    result = run_blender(_BLENDER_SCRIPT, str(listing))
     line = next((x for x in result.stdout.splitlines() if x.startswith("POSITIONS")), None)
     assert line is not None, f"Blender failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
     out = []
@@ -105,7 +115,10 @@ function sample(root, clip, times) {{
   root.traverse(o => {{ if (o.isSkinnedMesh) skinned.push(o); }});
   if (skinned.length) bones = skinned[0].skeleton.bones;
   const mixer = new THREE.AnimationMixer(root);
-  mixer.clipAction(clip).play();
+  const action = mixer.clipAction(clip);
+  action.setLoop(THREE.LoopOnce);  // a looping clip is back at its start at its last key
+  action.clampWhenFinished = true;
+  action.play();
   const frames = [], v = new THREE.Vector3();
   for (const t of times) {{
     mixer.setTime(t);

@@ -77,7 +77,7 @@ def glb_document(path):
 @pytest.mark.parametrize("case", IDS)
 def test_the_file_keeps_the_specifications_rules(written, case):
     pygltflib = pytest.importorskip("pygltflib", reason="pygltflib is not installed (pip install pygltflib)")
-    take, armature, points, path = written[case]
+    take, armature, _, path = written[case]
     loaded = pygltflib.GLTF2().load(str(path))
     assert len(loaded.nodes) == armature.nodes + 1 and len(loaded.animations) == 1
     assert loaded.skins[0].joints == list(range(armature.nodes))
@@ -114,7 +114,9 @@ def test_the_file_keeps_the_specifications_rules(written, case):
     np.testing.assert_array_equal(weights.sum(axis=1), 1.0)
     assert values(primitive["attributes"]["JOINTS_0"]).max() < armature.nodes
     inverse_bind = values(document["skins"][0]["inverseBindMatrices"]).reshape(-1, 4, 4).transpose(0, 2, 1)
-    np.testing.assert_allclose(inverse_bind @ armature.rest_world, np.tile(np.eye(4), (armature.nodes, 1, 1)), atol=1e-5)
+    np.testing.assert_allclose(
+        inverse_bind @ armature.rest_world, np.tile(np.eye(4), (armature.nodes, 1, 1)), atol=1e-5
+    )
     assert animation["extras"] == {"frame_rate": take.frame_rate, "first_frame": take.first_frame}
 
 
@@ -146,7 +148,7 @@ def blender_found(written, tmp_path_factory):
 @needs_blender
 @pytest.mark.parametrize("case", IDS)
 def test_blender_draws_every_joint_where_we_do(written, blender_found, case):
-    take, armature, points, path = written[case]
+    _, armature, points, _ = written[case]
     found = blender_found[case]
     names = node_names(armature)
     assert sorted(found) == sorted(names)
@@ -256,7 +258,9 @@ def test_bad_takes_get_a_message_and_no_file(data_dir, tmp_path):
         mt.export(mt.Motion(lone, np.zeros((3, 6))), tmp_path / "one.glb")
     bad = take.skeleton.bones[0].name
     renamed = take.skeleton.__class__(
-        bones=tuple(b if b.name != bad else b.__class__(**{**b.__dict__, "name": "bad\udcff"}) for b in take.skeleton.bones),
+        bones=tuple(
+            b if b.name != bad else b.__class__(**{**b.__dict__, "name": "bad\udcff"}) for b in take.skeleton.bones
+        ),
         hierarchy=tuple(
             (p if p != bad else "bad\udcff", tuple(c if c != bad else "bad\udcff" for c in cs))
             for p, cs in take.skeleton.hierarchy
@@ -279,7 +283,9 @@ def test_an_unwritable_target_is_named(data_dir, tmp_path):
 
 
 def test_batch_exports_a_database_with_a_recipe(copies, tmp_path):
-    folder = copies("hdm05", ["HDM_bd.asf", "HDM_bd_hopBothLegs1hops_005_120.amc", "HDM_bd_kickLFront1Reps_003_120.amc"])
+    folder = copies(
+        "hdm05", ["HDM_bd.asf", "HDM_bd_hopBothLegs1hops_005_120.amc", "HDM_bd_kickLFront1Reps_003_120.amc"]
+    )
     recipe = tmp_path / "export.toml"
     recipe.write_text('[[step]]\nrun = "median"\nsize = 3\n\n[[step]]\nrun = "export"\nmesh = false\n')
     done = _cli("batch", folder, "--recipe", recipe, "-o", tmp_path / "out", "--jobs", "2", cwd=tmp_path)

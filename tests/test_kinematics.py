@@ -9,7 +9,7 @@ from scipy.spatial.transform import Rotation
 import motiontheater as mt
 from corpus import ids, real_files
 from mtcore import rotations as rot
-from mtcore.kinematics import JointTree, forward_kinematics
+from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
 from twins.kinematics import motion_kinematics as twin
 
 REFS = real_files("hdm05/*.ref.npz")
@@ -229,6 +229,92 @@ def test_the_c_kernel_checks_the_tree_again():
         ffi.NULL, ffi.NULL, ffi.NULL, 1.0, 0, 1, c_array(positions), ffi.NULL, ffi.NULL,
     )  # fmt: skip
     assert status == lib.MT_EINVAL
+
+
+@pytest.mark.parametrize("amc", AMCS, ids=ids(AMCS))
+def test_local_quaternions_are_scipys_rotations_of_the_local_matrices(amc):
+    """Every joint of every real take: the keys are scipy's quaternions of forward kinematics'
+    local rotations, up to the sign, which keeps each joint's keys on one side from frame to frame."""
+    take = load(amc)
+    _, _, local = forward_kinematics(take.values, take.skeleton.tree, local=True)
+    joints = np.arange(take.skeleton.tree.joints)
+    keys = local_quaternions(take.values, take.skeleton.tree, joints)
+    assert keys.dtype == np.float32 and keys.shape == (len(joints), take.frames, 4)
+    want = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat().reshape(take.frames, -1, 4).transpose(1, 0, 2)
+    sign = np.sign(np.sum(keys * want, axis=-1, keepdims=True))
+    np.testing.assert_allclose(keys, sign * want, rtol=0, atol=2e-7)
+    assert (keys[:, 0, 3] >= 0).all() and (np.sum(keys[:, 1:] * keys[:, :-1], axis=-1) >= 0).all()
+
+
+def test_local_quaternions_turn_the_first_joint_only(cmu):
+    turn = Rotation.from_euler("x", -90, degrees=True).as_matrix()
+    tree = cmu.skeleton.tree
+    plain, turned = local_quaternions(cmu.values, tree, [0, 5]), local_quaternions(cmu.values, tree, [0, 5], turn)
+    np.testing.assert_array_equal(turned[1], plain[1])
+    want = (Rotation.from_matrix(turn) * Rotation.from_quat(plain[0].astype(float))).as_quat()
+    np.testing.assert_allclose(np.abs(np.sum(turned[0] * want, axis=-1)), 1, atol=1e-6)
+
+
+def test_nan_reaches_its_joints_keys_at_its_frame_only(cmu):
+    values = cmu.values.copy()
+    values[10, cmu.columns("lfemur", "ry")[0]] = np.nan
+    names = cmu.skeleton.joint_names
+    keys = local_quaternions(values, cmu.skeleton.tree, np.arange(len(names)))
+    broken = np.isnan(keys).any(axis=-1)
+    assert broken.sum() == 1 and broken[names.index("lfemur"), 10]
+    plain = local_quaternions(cmu.values, cmu.skeleton.tree, np.arange(len(names)))
+    np.testing.assert_array_equal(keys[:, 11:], plain[:, 11:])  # the next keys keep their side
+
+
+def test_local_quaternions_refuse_bad_arguments(cmu):
+    tree = cmu.skeleton.tree
+    with pytest.raises(
+        ValueError, match=rf"joints must lie in 0 .. {tree.joints - 1}, got joints\[1\] = {tree.joints}"
+    ):
+        local_quaternions(cmu.values, tree, [0, tree.joints])
+    with pytest.raises(ValueError, match=r"turn must be two-dimensional of shape \(3, 3\)"):
+        local_quaternions(cmu.values, tree, [0], np.eye(4))
+    with pytest.raises(ValueError, match="reads column 61 but values have 3 channels"):
+        local_quaternions(cmu.values[:, :3], tree, [0])
+    with pytest.raises(TypeError, match="tree must be a JointTree, got dict"):
+        local_quaternions(cmu.values, {}, [0])
+    assert local_quaternions(cmu.values[:0], tree, [0, 1]).shape == (2, 0, 4)
+    assert local_quaternions(cmu.values, tree, []).shape == (0, cmu.frames, 4)
+
+
+def test_a_pruned_tree_puts_the_joints_it_keeps_where_the_whole_tree_does(rng):
+    from twins import random_tree
+
+    for joints in (1, 2, 7, 15):
+        tree = random_tree(rng, joints)
+        values = rng.uniform(-180, 180, (5, max(len(tree.dof_kind), 1)))
+        whole = forward_kinematics(values, tree, world=True, local=True)
+        for wanted in ([], [0], rng.integers(0, joints, 3).tolist(), list(range(joints))):
+            pruned, index = tree.pruned(wanted)
+            kept = np.flatnonzero(index >= 0)
+            ancestors = set()
+            for j in wanted:
+                while j >= 0:
+                    ancestors.add(j)
+                    j = int(tree.parent[j])
+            assert set(kept.tolist()) == ancestors and pruned.joints == len(kept)
+            for got, want in zip(forward_kinematics(values, pruned, world=True, local=True), whole):
+                np.testing.assert_array_equal(got[:, index[kept]], want[:, kept])
+
+
+def test_the_quaternion_kernel_checks_its_joints_again():
+    from mtcore._cdata import c_array
+    from mtcore._mtcore import ffi, lib
+
+    tree = single_joint(0)
+    out = np.empty((1, 1, 4), np.float32)
+    for chosen in ([-1], [1]):
+        status = lib.mt_local_quaternions(
+            c_array(np.zeros((1, 1))), 1, 1, 1, c_array(tree.axis), c_array(tree.dof_start, "size_t[]"),
+            c_array(tree.dof_kind, "int[]"), c_array(tree.dof_column, "size_t[]"), 1.0, 1,
+            c_array(np.array(chosen), "long long[]"), ffi.NULL, c_array(out, "float[]"),
+        )  # fmt: skip
+        assert status == lib.MT_EINVAL
 
 
 @pytest.mark.parametrize("order", ["xyz", "xzy", "yxz", "yzx", "zxy", "zyx"])

@@ -13,8 +13,9 @@ from . import _checks
 from ._cdata import c_array
 from ._mtcore import lib
 from ._parallel import even_bounds, run_ranges, thread_count
+from ._status import check
 
-__all__ = ["DOFS", "JointTree", "forward_kinematics"]
+__all__ = ["DOFS", "JointTree", "forward_kinematics", "local_quaternions"]
 
 DOFS = {
     "rx": lib.MT_DOF_RX,
@@ -93,6 +94,36 @@ class JointTree:
         """The number of joints."""
         return len(self.parent)
 
+    def pruned(self, joints) -> tuple[JointTree, np.ndarray]:
+        """The tree of ``joints`` (indices) and their ancestors only, and for each joint of this
+        tree its index in that one (-1 where left out).  Forward kinematics of the pruned tree,
+        on the same values, puts the joints it keeps where this tree's does, at their cost only."""
+        wanted = _checks.integers(joints, "joints", (None,), 0, self.joints)
+        keep = np.zeros(self.joints, bool)
+        for j in wanted.tolist():
+            while j >= 0 and not keep[j]:
+                keep[j] = True
+                j = int(self.parent[j])
+        kept = np.flatnonzero(keep)
+        index = np.full(self.joints, -1, np.intp)
+        index[kept] = np.arange(len(kept))
+        parent = self.parent[kept]
+        slices = [np.arange(self.dof_start[j], self.dof_start[j + 1], dtype=np.intp) for j in kept]
+        dofs = np.concatenate(slices) if slices else np.zeros(0, np.intp)
+        tree = JointTree(
+            parent=np.where(parent >= 0, index[np.maximum(parent, 0)], -1),
+            order=index[self.order[keep[self.order]]],
+            axis=self.axis[kept],
+            direction=self.direction[kept],
+            segment=self.segment[kept],
+            dof_start=np.concatenate([[0], np.cumsum([len(d) for d in slices], dtype=np.intp)]),
+            dof_kind=self.dof_kind[dofs],
+            dof_column=self.dof_column[dofs],
+            angle_scale=self.angle_scale,
+            parent_frame=None if self.parent_frame is None else self.parent_frame[kept],
+        )
+        return tree, index
+
 
 def forward_kinematics(
     values: np.ndarray, tree: JointTree, *, world: bool = False, local: bool = False, workers: int | None = None
@@ -131,3 +162,39 @@ def forward_kinematics(
 
     run_ranges(lambda begin, end: lib.mt_forward_kinematics(*args, begin, end, *outs), bounds, "mt_forward_kinematics")
     return positions, world_out, local_out
+
+
+def local_quaternions(values: np.ndarray, tree: JointTree, joints, turn: np.ndarray | None = None) -> np.ndarray:
+    """The local rotations of ``joints`` (indices) per frame as float32 unit quaternions
+    (x, y, z, w), (len(joints), frames, 4): each joint's keys together, the first with w >= 0 and
+    each next on the hemisphere of the one before; ``turn`` (3, 3) turns the first joint's on
+    the left.  The local rotations are :func:`forward_kinematics`'s, without the rest of its work:
+    what an animation file stores, one pass over the frames."""
+    if not isinstance(tree, JointTree):
+        raise TypeError(f"tree must be a JointTree, got {type(tree).__name__}")
+    values = _checks.real(values, "values", (None, None))
+    frames, channels = values.shape
+    if len(tree.dof_column) and tree.dof_column.max() >= channels:
+        raise ValueError(f"the tree reads column {tree.dof_column.max()} but values have {channels} channels")
+    chosen = _checks.integers(joints, "joints", (None,), 0, tree.joints)
+    turned = None if turn is None else _checks.real(turn, "turn", (3, 3))
+    out = np.empty((len(chosen), frames, 4), np.float32)
+    check(
+        lib.mt_local_quaternions(
+            c_array(values),
+            frames,
+            channels,
+            tree.joints,
+            c_array(tree.axis),
+            c_array(tree.dof_start, "size_t[]"),
+            c_array(tree.dof_kind, "int[]"),
+            c_array(tree.dof_column, "size_t[]"),
+            tree.angle_scale,
+            len(chosen),
+            c_array(chosen, "long long[]"),
+            c_array(turned),
+            c_array(out, "float[]"),
+        ),
+        "mt_local_quaternions",
+    )
+    return out

@@ -27,7 +27,7 @@ from mtcore import rotations as rot
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
 from mtcore.combine import combine_frames
-from mtcore.kinematics import JointTree, forward_kinematics
+from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
 from mtcore.retarget import RetargetPlan, retarget_rotations
 
 from . import combine, filters, footskate, kinematics, retarget, rotations
@@ -214,6 +214,19 @@ def kinematics_cases(rng: np.random.Generator) -> list[tuple]:
     for joints, frames in ((1, 0), (1, 1), (3, 8), (6, 9), (9, 17)):
         tree = random_tree(rng, joints)
         out.append((rng.uniform(-180, 180, (frames, max(len(tree.dof_kind), 1))), tree))
+    return out
+
+
+def local_quaternion_cases(rng: np.random.Generator) -> list[tuple]:
+    """Trees as kinematics_cases, frames across the kernel's blocks and spans; no joint, one, all
+    of them, some twice; with and without a turn of the first one."""
+    out = []
+    for joints, frames in ((1, 0), (1, 1), (3, 8), (6, 9), (9, 17), (4, 300)):
+        tree = random_tree(rng, joints)
+        values = rng.uniform(-180, 180, (frames, max(len(tree.dof_kind), 1)))
+        turn = rotations.matrices(rng.uniform(-3, 3, 3), "zxy")
+        for chosen in ([], [joints - 1], list(range(joints)), rng.integers(0, joints, joints + 2).tolist()):
+            out += [(values, tree, chosen, None), (values, tree, chosen, turn)]
     return out
 
 
@@ -849,6 +862,7 @@ TWINS: dict[str, Twin] = {
         kinematics_cases,
         close(1e-12),
     ),
+    "mt_local_quaternions": Twin(local_quaternions, kinematics.local_quaternions, local_quaternion_cases, close(1e-6)),
     "mt_euler_to_matrices": Twin(fast_euler, rotations.euler_to_matrices, euler_cases, close(1e-14)),
     "mt_matrices_to_euler": Twin(
         lambda m, order, extrinsic: rot.matrices_to_euler(m, order, extrinsic=extrinsic),

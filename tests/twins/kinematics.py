@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rotations import axis_matrices, matrices
+from .rotations import axis_matrices, matrices, matrices_to_quaternions, unroll_quaternions
 
 RX, RZ, TX, TZ = 0, 2, 3, 5  # mt_dof codes
 
@@ -40,6 +40,17 @@ def forward_kinematics(values, tree) -> tuple[np.ndarray, np.ndarray, np.ndarray
         turn = world[:, parent] if tree.parent_frame[j] else world[:, j]
         positions[:, j] = positions[:, parent] + np.einsum("fij,fj->fi", turn, vector)
     return positions, world, local
+
+
+def local_quaternions(values, tree, joints, turn) -> np.ndarray:
+    """The local rotations of forward_kinematics for the chosen joints, the first turned on the left
+    by turn where given, as quaternions with w >= 0 at the first frame and each next one on the
+    side of the one before; (x, y, z, w) in float32, (joints, frames, 4)."""
+    local = forward_kinematics(values, tree)[2][:, list(joints)]
+    if turn is not None and len(joints):
+        local[:, 0] = np.asarray(turn) @ local[:, 0]
+    q = unroll_quaternions(matrices_to_quaternions(local), axis=0) if len(local) else np.zeros((0, len(joints), 4))
+    return np.ascontiguousarray(q[..., [1, 2, 3, 0]].transpose(1, 0, 2), dtype=np.float32)
 
 
 def motion_kinematics(motion):

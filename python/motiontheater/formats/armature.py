@@ -10,9 +10,10 @@ world transform is thus exactly the project's forward kinematics: its origin the
 the joint :attr:`Armature.origins` names, its axes that joint's world rotation, both turned by
 :attr:`Armature.turn` and scaled to metres.
 
-The numeric work is the C core's: forward kinematics gives every joint's local rotation, the
-rotation kernels turn them into quaternions and keep each node's keys on one hemisphere (so that
-interpolation between frames takes the short way), a chunk of frames at a time.
+The numeric work is the C core's: one kernel gives the turning nodes' local rotations as
+quaternions straight from the channels, each node's keys on one hemisphere (so that interpolation
+between frames takes the short way); forward kinematics, a chunk of frames at a time, gives the
+translations of the nodes that move.
 """
 
 from __future__ import annotations
@@ -22,14 +23,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mtcore.kinematics import forward_kinematics
-from mtcore.rotations import matrices_to_quaternions, unroll_quaternions
+from mtcore.kinematics import forward_kinematics, local_quaternions
+from mtcore.rotations import matrices_to_quaternions
 
 from ..feet.upright import take_forward, take_up
 from ..model.motion import Motion
 from ..model.skeleton import ROTATIONS, Skeleton
 
-CHUNK = 8192  # frames per pass: the kinematics' scratch stays in cache-friendly, bounded memory
+CHUNK = 2048  # frames per pass: the kinematics' scratch stays in cache-friendly, bounded memory
 MOVES = frozenset(("tx", "ty", "tz", "l"))  # channels that move a point relative to its parent
 
 
@@ -264,33 +265,27 @@ def track(armature: Armature, motion: Motion, name: str = "take") -> Track:
     tree = motion.skeleton.tree
     frames = motion.frames
     turning, moving = armature.turning, armature.moving
-    joints = armature.frames_of[turning]
-    rotations = np.empty((len(turning), frames, 4), np.float32)
+    root_turns = bool(len(turning)) and turning[0] == 0
+    rotations = local_quaternions(
+        motion.values, tree, armature.frames_of[turning], armature.turn if root_turns else None
+    )
     translations = np.empty((len(moving), frames, 3), np.float32)
     shifted = moving[moving > 0]
     root_moves = bool(len(moving)) and moving[0] == 0
-    previous = None
-    for start in range(0, frames, CHUNK):
+    origin, parent, frame = armature.origins, armature.parents, armature.frames_of
+    # forward kinematics of the joints the translations need only: often the root alone
+    needed, index = tree.pruned(np.concatenate([origin[moving], origin[parent[shifted]], frame[parent[shifted]]]))
+    for start in range(0, frames if len(moving) else 0, CHUNK):
         values = motion.values[start : start + CHUNK]
-        positions, world, local = forward_kinematics(values, tree, world=bool(len(shifted)), local=True, workers=1)
-        assert local is not None  # asked for
-        turned = local[:, joints]
-        if len(turning) and turning[0] == 0:
-            turned[:, 0] = armature.turn @ turned[:, 0]
-        q = matrices_to_quaternions(turned)
-        if previous is not None:
-            q = unroll_quaternions(np.concatenate([previous, q]))[1:]
-        else:
-            q = unroll_quaternions(q)
-        previous = q[-1:]
-        rotations[:, start : start + len(values)] = q[..., [1, 2, 3, 0]].transpose(1, 0, 2)
+        positions, world, _ = forward_kinematics(values, needed, world=bool(len(shifted)), workers=1)
         if root_moves:
-            translations[0, start : start + len(values)] = armature.scale * positions[:, 0] @ armature.turn.T
+            translations[0, start : start + len(values)] = (
+                armature.scale * positions[:, index[origin[0]]] @ armature.turn.T
+            )
         if len(shifted):
             assert world is not None  # asked for
-            origin, parent = armature.origins, armature.parents
-            step = positions[:, origin[shifted]] - positions[:, origin[parent[shifted]]]
-            axes = world[:, armature.frames_of[parent[shifted]]]
+            step = positions[:, index[origin[shifted]]] - positions[:, index[origin[parent[shifted]]]]
+            axes = world[:, index[frame[parent[shifted]]]]
             moved = armature.scale * np.einsum("fnij,fni->nfj", axes, step)
             translations[int(root_moves) :, start : start + len(values)] = moved
     return Track(name, rotations, translations, motion.frame_rate, motion.first_frame)

@@ -65,7 +65,7 @@ class _Buffer:
         if target is not None:
             view["target"] = target
         self.views.append(view)
-        self._append(memoryview(array).cast("B"))
+        self._append(array.data.cast("B"))
         accessor: dict[str, Any] = {
             "bufferView": len(self.views) - 1,
             "componentType": kind[array.dtype],

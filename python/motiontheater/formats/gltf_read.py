@@ -338,7 +338,8 @@ def _motion(f, nodes, order, parent_of, above, animation, rate, frames, sampled)
         parent = names[index[parent_of[n]]]
         leaf = not any(c in index for c in nodes[n].get("children", []))
         still = (n, "rotation") not in sampled and n not in moving
-        offset = tuple(float(x) for x in translations[i, 0])
+        x, y, z = (float(v) for v in translations[i, 0])
+        offset = (x, y, z)
         if leaf and still:
             bones.append(Bone(names[i], direction=offset, length=float(np.linalg.norm(offset)), end_site=True))
         else:
