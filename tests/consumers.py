@@ -31,6 +31,11 @@ _BLENDER_SCRIPT = textwrap.dedent(
     import bpy, json, sys
     import numpy
     numpy.bool = bool  # Debian's Blender 3.4 glTF importer still uses this alias, gone in numpy 1.24
+    import builtins
+    _open = builtins.open
+    def open_without_u(file, mode="r", *args, **kwargs):  # its BVH importer opens with "rU", gone in Python 3.11
+        return _open(file, mode.replace("U", ""), *args, **kwargs)
+    builtins.open = open_without_u
     jobs = json.load(open(sys.argv[sys.argv.index("--") + 1]))
     results = []
     for path, times in jobs:

@@ -102,7 +102,7 @@ def test_the_output_suffix_decides_the_format(cmu, tmp_path, capsys):
     )
     assert not (tmp_path / "out.bvh").exists()
     assert main(["median", str(cmu / "02_01.amc"), "-o", str(tmp_path / "out.txt"), "--size", "3"]) == 2
-    assert "out.txt: a take's file name must end in .amc or .bvh" in capsys.readouterr().err
+    assert "out.txt: a take's file name must end in .amc, .bvh, .glb or .gltf" in capsys.readouterr().err
 
 
 def test_messages_name_the_users_paths(cmu, tmp_path, capsys):

@@ -125,18 +125,24 @@ class JointTree:
         return tree, index
 
 
+def _values_of(values: np.ndarray, tree: JointTree) -> np.ndarray:
+    """The channels (frames, channels) checked against the tree that reads them."""
+    if not isinstance(tree, JointTree):
+        raise TypeError(f"tree must be a JointTree, got {type(tree).__name__}")
+    values = _checks.real(values, "values", (None, None))
+    if len(tree.dof_column) and tree.dof_column.max() >= values.shape[1]:
+        raise ValueError(f"the tree reads column {tree.dof_column.max()} but values have {values.shape[1]} channels")
+    return values
+
+
 def forward_kinematics(
     values: np.ndarray, tree: JointTree, *, world: bool = False, local: bool = False, workers: int | None = None
 ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
     """Positions (frames, joints, 3) of each joint's end, and optionally world and
     local rotations (frames, joints, 3, 3), for values (frames, channels).
     Frames are split over the cores for large motions (``workers`` as for the filters)."""
-    if not isinstance(tree, JointTree):
-        raise TypeError(f"tree must be a JointTree, got {type(tree).__name__}")
-    values = _checks.real(values, "values", (None, None))
+    values = _values_of(values, tree)
     frames, channels = values.shape
-    if len(tree.dof_column) and tree.dof_column.max() >= channels:
-        raise ValueError(f"the tree reads column {tree.dof_column.max()} but values have {channels} channels")
     n = tree.joints
     positions = np.empty((frames, n, 3))
     world_out = np.empty((frames, n, 3, 3)) if world else None
@@ -170,12 +176,8 @@ def local_quaternions(values: np.ndarray, tree: JointTree, joints, turn: np.ndar
     each next on the hemisphere of the one before; ``turn`` (3, 3) turns the first joint's on
     the left.  The local rotations are :func:`forward_kinematics`'s, without the rest of its work:
     what an animation file stores, one pass over the frames."""
-    if not isinstance(tree, JointTree):
-        raise TypeError(f"tree must be a JointTree, got {type(tree).__name__}")
-    values = _checks.real(values, "values", (None, None))
+    values = _values_of(values, tree)
     frames, channels = values.shape
-    if len(tree.dof_column) and tree.dof_column.max() >= channels:
-        raise ValueError(f"the tree reads column {tree.dof_column.max()} but values have {channels} channels")
     chosen = _checks.integers(joints, "joints", (None,), 0, tree.joints)
     turned = None if turn is None else _checks.real(turn, "turn", (3, 3))
     out = np.empty((len(chosen), frames, 4), np.float32)
