@@ -235,7 +235,7 @@ def test_convert_command(data_dir, tmp_path, capsys):
     ends = asf_end_points_in_bvh(original.skeleton, bvh.skeleton)
     assert_same_points(back.positions()[:, bvh_points_in_asf(bvh.skeleton, back.skeleton)][:, ends], expected)
     assert main(["convert", str(tmp_path / "w.bvh"), str(tmp_path / "w.txt")]) == 2
-    assert "w.txt: a take's file name must end in .amc or .bvh" in capsys.readouterr().err
+    assert "w.txt: a take's file name must end in .amc, .bvh, .glb or .gltf" in capsys.readouterr().err
 
 
 def test_convert_command_says_when_a_unit_was_assumed(data_dir, tmp_path, capsys):

@@ -47,7 +47,7 @@ def test_a_format_is_one_row_read_take_reads_it(toy_format, toy_take, data_dir):
     motion = mt.read_take(toy_take)
     np.testing.assert_array_equal(motion.values, mt.read_bvh(data_dir / "bvh" / "walk01.bvh").values)
     assert ".toy" in table.take_suffixes()
-    with pytest.raises(ValueError, match=r"walk\.txt: a take's file name must end in .amc, .bvh or .toy"):
+    with pytest.raises(ValueError, match=r"walk\.txt: a take's file name must end in .amc, .bvh, .glb, .gltf or .toy"):
         table.format_of("walk.txt")
 
 

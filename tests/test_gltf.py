@@ -15,9 +15,9 @@ import pytest
 import motiontheater as mt
 from consumers import blender_positions, needs_blender, needs_three, three_page, three_positions  # noqa: F401
 from corpus import real_files
-from motiontheater.formats.armature import animated
-from motiontheater.formats.gltf import node_names, write_gltf
 from motiontheater.formats.gltf_read import read_gltf
+from motiontheater.views.armature import animated
+from motiontheater.views.gltf import node_names, write_gltf
 from variants import with_offset_channels, with_static_root
 
 TOLERANCE = 1e-5  # metres: 0.01 mm
@@ -211,7 +211,7 @@ def test_a_rate_resamples_every_take(data_dir, tmp_path):
 
 
 def test_capsules_face_outwards(data_dir):
-    from motiontheater.formats.capsules import capsules
+    from motiontheater.views.capsules import capsules
 
     armature, _ = expected(mt.read_take(data_dir / "cmu" / "01_01.amc"))
     body = capsules(armature)

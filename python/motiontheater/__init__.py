@@ -28,8 +28,6 @@ from .feet.skate import skate_metrics
 from .formats.amc import read_amc, skeleton_path_for, write_amc
 from .formats.asf import read_asf, write_asf
 from .formats.bvh import read_bvh, write_bvh
-from .formats.export import export
-from .formats.gltf import write_gltf
 from .formats.gltf_read import read_gltf
 from .formats.table import read_take, write_take
 from .model import errors
@@ -38,6 +36,8 @@ from .model.motion import DEFAULT_FRAME_RATE, Motion
 from .model.registry import StepError, steps
 from .model.skeleton import Bone, Root, Skeleton
 from .views import markers  # noqa: F401 (registers the c3d exporter)
+from .views.export import export
+from .views.gltf import write_gltf
 from .views.positions import write_positions
 
 __all__ = [

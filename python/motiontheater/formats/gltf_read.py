@@ -32,7 +32,8 @@ from mtcore.rotations import (
 from .._io import Source, read_source
 from ..model.motion import Motion
 from ..model.skeleton import Bone, Root, Skeleton, canonical_hierarchy
-from .gltf import GLB_BIN, GLB_JSON, GLB_MAGIC
+
+GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942  # the GLB header's and chunks' tags
 
 COMPONENTS = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32, 5126: np.float32}
 WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}

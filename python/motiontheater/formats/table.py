@@ -80,7 +80,7 @@ FORMATS: dict[str, Format] = {
     ".asf": Format(".asf", "ASF", "asf", read_skeleton=read_asf, write_skeleton=write_asf),
     ".amc": Format(".amc", "ASF/AMC", "asf", _read_amc, write_amc, companion=".asf"),
     ".bvh": Format(".bvh", "BVH", "bvh", _read_bvh, write_bvh, read_skeleton=_bvh_skeleton, states_unit=False),
-    # glTF takes are read as BVH motions and written by the export step (formats/export.py)
+    # glTF takes are read as BVH motions and written by the export step (views/export.py)
     ".glb": Format(".glb", "glTF binary", "bvh", _read_gltf),
     ".gltf": Format(".gltf", "glTF", "bvh", _read_gltf),
 }

@@ -22,6 +22,7 @@ import numpy as np
 
 from .._io import Source, output
 from .._version import __version__
+from ..formats.gltf_read import GLB_BIN, GLB_JSON, GLB_MAGIC
 from ..model.motion import Motion
 from .armature import Armature, Track, animated
 from .capsules import capsules
@@ -29,7 +30,6 @@ from .capsules import capsules
 FLOAT, UNSIGNED_SHORT, UNSIGNED_INT = 5126, 5123, 5125
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 TYPES = {1: "SCALAR", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
-GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
 
 
 def take_names(motions: Sequence[Motion]) -> list[str]:
