@@ -100,8 +100,8 @@ class Track:
 def animated(motions: Motion | Sequence[Motion], names: Sequence[str] | None = None) -> tuple[Armature, list[Track]]:
     """The armature of takes of one skeleton and each take's track (``names``: the tracks',
     default take, take_2, ...).  The first take decides the up and forward axes.  ValueError
-    when the takes have different skeletons, a take holds NaN or inf, or the skeleton has no
-    bone."""
+    when the takes have different skeletons, a take holds NaN or inf, the skeleton has no bone,
+    or a joint's name is not text (the formats store names as UTF-8)."""
     takes = [motions] if isinstance(motions, Motion) else list(motions)
     if not takes:
         raise ValueError("no take to export")
@@ -116,6 +116,11 @@ def animated(motions: Motion | Sequence[Motion], names: Sequence[str] | None = N
                 "export them to separate files"
             )
     armature = rest_armature(first)
+    for name in armature.names:
+        try:
+            name.encode("utf-8")
+        except UnicodeEncodeError:
+            raise ValueError(f"joint name {name!r} is not UTF-8 text, which the animation formats store") from None
     return armature, [track(armature, take, name) for take, name in zip(takes, names)]
 
 

@@ -1,5 +1,5 @@
 """The ``export`` exporter: takes of one skeleton into the formats animation tools read (glTF/GLB
-now; each a writer module of its own), chosen by the target's suffix.  One registry entry, so
+and USD, each a writer module of its own), chosen by the target's suffix.  One registry entry, so
 that it is at once ``motiontheater export a.amc b.bvh -o both.glb``, a recipe's last step and a
 batch step that converts a whole database."""
 
@@ -14,18 +14,23 @@ from .._io import Source
 from ..model.motion import Motion
 from ..model.registry import exporter
 from .gltf import write_gltf
+from .usd import write_usd
 
-Kind = Literal["glb", "gltf"]
+Kind = Literal["glb", "gltf", "usd", "usda", "usdc"]
 WRITERS: dict[str, Callable[..., None]] = {
     "glb": partial(write_gltf, binary=True),
     "gltf": partial(write_gltf, binary=False),
+    "usd": partial(write_usd, binary=True),  # the crate, as OpenUSD writes a .usd
+    "usda": partial(write_usd, binary=False),
+    "usdc": partial(write_usd, binary=True),
 }
 
 
 @exporter(
     "export",
-    (".glb", ".gltf"),
-    "write takes as glTF/GLB for Blender, three.js and game engines: skeleton, skin and animation",
+    (".glb", ".gltf", ".usd", ".usda", ".usdc"),
+    "write takes as glTF/GLB or USD for Blender, three.js, game engines and USD pipelines: "
+    "skeleton, skin and animation",
     several=True,
 )
 def export(
@@ -36,7 +41,9 @@ def export(
     rate: Annotated[float | None, "frames per second to resample every take to (default: each take's own)"] = None,
     format: Annotated[Kind | None, "file format (default: from the suffix)"] = None,
 ) -> str:
-    """Write takes of one skeleton into one file, an animation per take, named after their files.
+    """Write takes of one skeleton into one file, an animation per take, named after their files:
+    glTF 2.0 (``.glb`` binary, ``.gltf`` text) or USD's UsdSkel (``.usdc`` or ``.usd``
+    binary, ``.usda`` text; needs usd-core), where several takes are the variants of a variant set ``take``.
 
     The skeleton is a node per joint at its rest pose (the calibration pose; an ASF bone's node
     at its start, a leaf's end as a node of its own) with a skin; each take's animation turns

@@ -159,8 +159,6 @@ def gltf_document(
     """The JSON document and binary buffer of the takes (see :func:`write_gltf`)."""
     takes = [motions] if isinstance(motions, Motion) else list(motions)
     armature, tracks = animated(takes, names if names is not None else take_names(takes))
-    for name in armature.names:
-        _check_name(name)
     buffer = _Buffer()
     nodes = _nodes(armature)
     inverse_bind = buffer.add(armature.inverse_bind.transpose(0, 2, 1).reshape(-1, 16).astype(np.float32))
@@ -190,13 +188,6 @@ def gltf_document(
         document["scenes"][0]["nodes"].append(len(nodes) - 1)
     document["animations"] = [_animation(buffer, armature, track) for track in tracks]
     return document, buffer
-
-
-def _check_name(name: str) -> None:
-    try:
-        name.encode("utf-8")
-    except UnicodeEncodeError:
-        raise ValueError(f"joint name {name!r} is not UTF-8 text, which glTF names must be") from None
 
 
 def write_gltf(
