@@ -38,7 +38,7 @@ _BLENDER_SCRIPT = textwrap.dedent(
     builtins.open = open_without_u
     jobs = json.load(open(sys.argv[sys.argv.index("--") + 1]))
     results = []
-    for path, times in jobs:
+    for path, times, rate in jobs:
         bpy.ops.wm.read_factory_settings(use_empty=True)
         scene = bpy.context.scene
         kind = path.rsplit(".", 1)[-1].lower()
@@ -48,11 +48,15 @@ _BLENDER_SCRIPT = textwrap.dedent(
             elif kind == "fbx":
                 bpy.ops.import_scene.fbx(filepath=path)
             else:
-                bpy.ops.import_anim.bvh(filepath=path, update_scene_fps=True, update_scene_duration=True)
+                # quaternion keys: its default Euler keys are taken from float32 matrices in each
+                # bone's own axes, which loses up to 2.4 mm on frames near gimbal lock there
+                bpy.ops.import_anim.bvh(
+                    filepath=path, update_scene_fps=True, update_scene_duration=True, rotate_mode="QUATERNION"
+                )
         except Exception as e:
             results.append(f"error: {e}")
             continue
-        fps = scene.render.fps / scene.render.fps_base
+        fps = rate or scene.render.fps / scene.render.fps_base
         armature = next(o for o in scene.objects if o.type == "ARMATURE")
         bones = armature.pose.bones
         frames = []
@@ -84,17 +88,22 @@ def run_blender(script: str, *args: str, timeout: float = 1200) -> subprocess.Co
 
 
 def blender_positions(jobs, tmp_path):
-    """For each (path, times) of ``jobs``: {bone name: (len(times), 3)} world positions of the
-    bones Blender imports from the file (glTF, FBX or BVH), at ``times`` seconds from its first
-    frame, in the file's axes (Blender's Z-up scene turned back to Y-up: x, z, -y).  One Blender
-    for all: it takes a second or two to start."""
+    """For each (path, times) or (path, times, rate) of ``jobs``: {bone name: (len(times), 3)}
+    world positions of the bones Blender imports from the file (glTF, FBX or BVH), at ``times``
+    seconds from its first frame, in the file's axes (Blender's Z-up scene turned back to Y-up:
+    x, z, -y).  ``rate``: the frames per second the times count in, where Blender's scene rate
+    is not the take's (its BVH importer keys frame i at scene frame 1 + i, and rounds the scene's
+    rate: 30 Hz for a Frame Time of 0.033333).  One Blender for all: it takes a second or two
+    to start."""
     listing = tmp_path / "blender-jobs.json"
-    listing.write_text(json.dumps([[str(path), [float(t) for t in times]] for path, times in jobs]))
+    listing.write_text(
+        json.dumps([[str(job[0]), [float(t) for t in job[1]], job[2] if len(job) > 2 else None] for job in jobs])
+    )
     result = run_blender(_BLENDER_SCRIPT, str(listing))
     line = next((x for x in result.stdout.splitlines() if x.startswith("POSITIONS")), None)
     assert line is not None, f"Blender failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
     out = []
-    for (path, _), found in zip(jobs, json.loads(line[len("POSITIONS") :])):
+    for (path, *_), found in zip(jobs, json.loads(line[len("POSITIONS") :])):
         assert not isinstance(found, str), f"Blender could not import {path}: {found}"
         frames = np.array(found["frames"])  # (times, bones, 3), Blender's axes
         frames = np.stack([frames[..., 0], frames[..., 2], -frames[..., 1]], axis=-1)
