@@ -115,6 +115,7 @@ _THREE_PAGE = """<!doctype html><meta charset="utf-8">
 <script src="{three}/three.min.js"></script>
 <script src="{three}/examples/js/loaders/GLTFLoader.js"></script>
 <script src="{three}/examples/js/loaders/FBXLoader.js"></script>
+<script src="{three}/examples/js/loaders/BVHLoader.js"></script>
 <script>
 function decoded(text) {{
   const bytes = atob(text), out = new Uint8Array(bytes.length);
@@ -144,7 +145,16 @@ function sample(root, clip, times) {{
 window.positions = function (kind, text, animation, times, done) {{
   try {{
     const data = decoded(text);
-    if (kind === "fbx") {{
+    if (kind === "bvh") {{
+      // as three.js's BVH example plays it: the tracks bind to .bones[name] of a skeleton
+      const found = new THREE.BVHLoader().parse(new TextDecoder().decode(data));
+      const root = new THREE.Group();
+      root.add(found.skeleton.bones[0]);
+      root.skeleton = found.skeleton;
+      const [names, frames] = sample(root, found.clip, times);
+      const kept = names.map((n, i) => i).filter(i => names[i] !== "ENDSITE");  // End Sites: unnamed
+      done([kept.map(i => names[i]), frames.map(f => kept.map(i => f[i]))]);
+    }} else if (kind === "fbx") {{
       const root = new THREE.FBXLoader().parse(data, "");
       done(sample(root, root.animations[animation], times));
     }} else {{
@@ -176,9 +186,11 @@ def three_page(tmp_path_factory):
 
 
 def three_positions(driver, path, times, animation=0):
-    """{bone name: (len(times), 3)} world positions of the bones three.js's loader (GLTFLoader or
-    FBXLoader, by the suffix) builds from ``path``, its animation ``animation`` at ``times``."""
-    kind = "fbx" if str(path).lower().endswith(".fbx") else "gltf"
+    """{bone name: (len(times), 3)} world positions of the bones three.js's loader (GLTFLoader,
+    FBXLoader or BVHLoader, by the suffix; a BVH's End Sites left out) builds from ``path``, its
+    animation ``animation`` at ``times``."""
+    suffix = str(path).lower().rsplit(".", 1)[-1]
+    kind = suffix if suffix in ("fbx", "bvh") else "gltf"
     text = base64.b64encode(Path(path).read_bytes()).decode("ascii")
     found = driver.execute_async_script(
         "window.positions(arguments[0], arguments[1], arguments[2], arguments[3], arguments[4]);",
