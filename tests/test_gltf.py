@@ -258,3 +258,15 @@ def test_batch_exports_a_database_with_a_recipe(copies, tmp_path):
     assert written == ["HDM_bd_hopBothLegs1hops_005_120.glb", "HDM_bd_kickLFront1Reps_003_120.glb"]
     back = read_gltf(tmp_path / "out" / written[0])
     assert back.frames == mt.read_take(folder / "HDM_bd_hopBothLegs1hops_005_120.amc").frames
+
+
+def test_info_names_every_take_of_a_file(copies):
+    folder = copies("cmu", ["02.asf", "02_01.amc", "02_02.amc"])
+    assert _cli("export", "02_01.amc", "02_02.amc", "-o", "both.glb", cwd=folder).returncode == 0
+    done = _cli("info", "both.glb", cwd=folder)
+    assert done.returncode == 0, done.stderr
+    assert "takes        2 in the file; this is the first, 02_01; the others: 02_02" in done.stdout
+    facts = json.loads(_cli("info", "both.glb", "--json", cwd=folder).stdout)
+    assert facts["takes"] == ["02_01", "02_02"]
+    assert _cli("export", "02_01.amc", "-o", "one.glb", cwd=folder).returncode == 0
+    assert "takes" not in _cli("info", "one.glb", cwd=folder).stdout

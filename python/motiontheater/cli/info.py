@@ -85,7 +85,8 @@ def describe(
     return {
         "file": None if source is None else os.fspath(source),
         "skeleton_file": None if skeleton_file is None else os.fspath(skeleton_file),
-        "format": (format_for(skeleton.convention) if source is None else format_of(source)).name,
+        "format": (kind := format_for(skeleton.convention) if source is None else format_of(source)).name,
+        "takes": kind.takes(source) if source is not None and kind.takes is not None else None,
         "frames": motion.frames,
         "first_frame": motion.first_frame,
         "last_frame": motion.last_frame,
@@ -136,6 +137,15 @@ def as_text(facts: dict[str, Any]) -> str:
     field(
         lines, "frames", f"{span}, at {rate:.6g} Hz{rate_note[facts['frame_rate_source']]}: {facts['duration']:.6g} s"
     )
+    takes = facts["takes"]
+    if takes and len(takes) > 1:
+        others = ", ".join(takes[1:])
+        field(
+            lines,
+            "takes",
+            f"{len(takes)} in the file; this is the first, {takes[0]}; the others: {others} "
+            "(Python: mt.read_gltf(path, animation=NAME))",
+        )
     unit_name = label if label == "m" else f"{label} = {_g(meters)} m"
     field(lines, "length unit", f"{unit_name}, {unit['source']}: {unit['why']}. {SET_UNIT[0].upper()}{SET_UNIT[1:]}")
     field(lines, "up axis", f"{facts['up_axis']}: {facts['up_reason']}. Set another with --up AXIS where a verb has it")

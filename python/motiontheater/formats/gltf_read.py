@@ -192,6 +192,11 @@ def read_gltf(source: Source, *, animation: int | str | None = None, frame_rate:
     return _motion(f, nodes, order, parent_of, above, chosen, rate, len(times), sampled)
 
 
+def animation_names(source: Source) -> list[str]:
+    """The names of a glTF file's animations in order (an unnamed one by its index)."""
+    return [str(a.get("name") or i) for i, a in enumerate(_File(source).document.get("animations", []))]
+
+
 def _depth_first(root: int, nodes: list[dict[str, Any]], joints: set[int]) -> list[int]:
     order, stack = [], [root]
     while stack:

@@ -26,7 +26,7 @@ from ..model.skeleton import Skeleton, settle_length_unit
 from .amc import read_amc, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
 from .bvh import read_bvh, write_bvh
-from .gltf_read import read_gltf
+from .gltf_read import animation_names, read_gltf
 
 ReadTake = Callable[..., Motion]  # (path, skeleton or None, frame_rate, unit, workers) -> Motion
 
@@ -40,7 +40,9 @@ class Format:
     a motion of ``convention``'s skeletons.  ``read_skeleton`` reads a skeleton file of this
     format (an ``.asf``, or the hierarchy of a ``.bvh``), ``write_skeleton`` writes one.
     ``companion`` is the suffix of the skeleton file a take needs beside it, or None;
-    ``states_unit`` whether its files state their length unit (a BVH file does not).
+    ``states_unit`` whether its files state their length unit (a BVH file does not);
+    ``takes`` the names of the takes a file holds where it may hold several (glTF's animations;
+    ``read`` gives the first).
     """
 
     suffix: str
@@ -52,6 +54,7 @@ class Format:
     write_skeleton: Callable[[Skeleton, str | os.PathLike | IO[bytes]], None] | None = None
     companion: str | None = None
     states_unit: bool = True
+    takes: Callable[[str | os.PathLike], list[str]] | None = None
 
     @property
     def holds_takes(self) -> bool:
@@ -81,8 +84,8 @@ FORMATS: dict[str, Format] = {
     ".amc": Format(".amc", "ASF/AMC", "asf", _read_amc, write_amc, companion=".asf"),
     ".bvh": Format(".bvh", "BVH", "bvh", _read_bvh, write_bvh, read_skeleton=_bvh_skeleton, states_unit=False),
     # glTF takes are read as BVH motions and written by the export step (views/export.py)
-    ".glb": Format(".glb", "glTF binary", "bvh", _read_gltf),
-    ".gltf": Format(".gltf", "glTF", "bvh", _read_gltf),
+    ".glb": Format(".glb", "glTF binary", "bvh", _read_gltf, takes=animation_names),
+    ".gltf": Format(".gltf", "glTF", "bvh", _read_gltf, takes=animation_names),
 }
 
 
