@@ -115,6 +115,8 @@ def test_steps_lists_options_as_a_recipe_writes_them(capsys):
         else:
             assignment, _, what = line.strip().partition("  # ")
             assert what, line
+            # the description is for a recipe's writer: no command-line syntax
+            assert "comma-separated" not in what and not re.search(r"(^|\s|\()--\w", what), line
             tomllib.loads(assignment)  # each line is TOML by itself
             tables[list(tables)[-1]].append(assignment)
     assert 'joints = ["lfemur", "rfemur"]' in tables["median"] and "size = 5" in tables["median"]

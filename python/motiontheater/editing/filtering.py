@@ -197,8 +197,8 @@ def filter_motion(
     kind: str,
     *,
     size: Annotated[int, "window length in frames (odd: 3, 5, 7, ...)"],
-    joints: Annotated[Joints, "joints to smooth, comma-separated (default: all)"] = None,
-    translation: Annotated[bool, "smooth the root's translation too (--no-translation leaves it)"] = True,
+    joints: Annotated[Joints, "joints to smooth (default: all)"] = None,
+    translation: Annotated[bool, "smooth the root's translation too"] = True,
     mode: Annotated[EdgeMode, "how the edges are extended: nearest holds the edge value"] = "nearest",
     workers: Annotated[int | None, "threads (default: every core for large takes)"] = None,
 ) -> Motion:

@@ -34,7 +34,7 @@ def interpolate(
     method: str = "slerp",
     *,
     frames: Annotated[tuple[int, int], "the key frames A:B; the frames between them are replaced"],
-    joints: Annotated[Joints, "joints to interpolate, comma-separated (default: all)"] = None,
+    joints: Annotated[Joints, "joints to interpolate (default: all)"] = None,
 ) -> Motion:
     """A new motion whose frames strictly between the key frames A and B interpolate the keys.
 
@@ -70,7 +70,7 @@ def interpolate(
 def median3(
     motion: Motion,
     *,
-    joints: Annotated[Joints, "joints to filter, comma-separated (default: all)"] = None,
+    joints: Annotated[Joints, "joints to filter (default: all)"] = None,
 ) -> Motion:
     """The 3-frame median "cut" filter of CS838 on the stored values (edges held).
 

@@ -114,9 +114,9 @@ def _filtered(
 def equalize(
     motion: Motion,
     *,
-    gains: Annotated[tuple[float, ...], "gain of each band, finest first, e.g. 1,1,1.5,1,0.5 (later bands keep 1)"],
-    joints: Annotated[Joints, "joints to equalise, comma-separated (default: all)"] = None,
-    translation: Annotated[bool, "equalise the root's translation too (--no-translation leaves it)"] = True,
+    gains: Annotated[tuple[float, ...], "gain of each band, finest first (later bands keep 1)"],
+    joints: Annotated[Joints, "joints to equalise (default: all)"] = None,
+    translation: Annotated[bool, "equalise the root's translation too"] = True,
     mode: Annotated[EdgeMode, "how each level is extended past the ends: nearest holds the end values"] = "nearest",
     workers: Workers = None,
 ) -> Motion:
@@ -207,7 +207,7 @@ def write_residuals(
     motion: Motion,
     target: Source,
     *,
-    joints: Annotated[Joints, "joints to analyse, comma-separated (default: all)"] = None,
+    joints: Annotated[Joints, "joints to analyse (default: all)"] = None,
     translation: Annotated[bool, "analyse the root's translation too"] = True,
 ) -> None:
     """Write Winter's residual analysis of each channel as CSV: joint, dof, cutoff_hz (where the
@@ -237,8 +237,8 @@ def butterworth(
     ] = None,
     order: Annotated[int, "filter order (1-8 are usual); run forward and backward, so it cuts twice as steeply"] = 4,
     kind: Annotated[Literal["low", "high", "band"], "pass band"] = "low",
-    joints: Annotated[Joints, "joints to filter, comma-separated (default: all)"] = None,
-    translation: Annotated[bool, "filter the root's translation too (--no-translation leaves it)"] = True,
+    joints: Annotated[Joints, "joints to filter (default: all)"] = None,
+    translation: Annotated[bool, "filter the root's translation too"] = True,
     workers: Workers = None,
 ) -> Motion:
     """A new motion filtered by a Butterworth filter forward and backward (no lag).
@@ -485,7 +485,7 @@ def fill_gaps(
         Literal["slerp", "linear", "cubic"],
         "slerp: rotations of three-channel joints by SLERP, the rest linearly; or linear or cubic spline throughout",
     ] = "slerp",
-    joints: Annotated[Joints, "joints to fill, comma-separated (default: all)"] = None,
+    joints: Annotated[Joints, "joints to fill (default: all)"] = None,
     drop: Annotated[Frames, "frames FIRST:LAST to treat as dropped (missing) first"] = None,
 ) -> Motion:
     """A new motion whose short gaps are filled.
