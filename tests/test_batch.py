@@ -114,9 +114,21 @@ def test_resume_skips_what_is_done(data_dir, tmp_path, capsys):
     assert main(["batch", "--median", "3", "--resume", "--jobs", "1", str(src), "-o", str(out)]) == 0
     assert "0 processed, 12 skipped (already done), 0 failed of 12 takes\n" in capsys.readouterr().out
     later = (out / "02_01.amc").stat().st_mtime + 10
-    os.utime(src / "02_01.amc", (later, later))  # an input changed since its output
+    os.utime(src / "02_01.amc", (later, later))  # touched, not changed: its content tells
+    assert main(["batch", "--median", "3", "--resume", "--jobs", "1", str(src), "-o", str(out)]) == 0
+    assert "0 processed, 12 skipped (already done)" in capsys.readouterr().out
+    text = (src / "02_01.amc").read_bytes()
+    changed = text.replace(b"lfemur 1", b"lfemur 2", 1)  # a value changed, the size kept
+    assert changed != text and len(changed) == len(text)
+    (src / "02_01.amc").write_bytes(changed)
     assert main(["batch", "--median", "3", "--resume", "--jobs", "1", str(src), "-o", str(out)]) == 0
     assert "1 processed, 11 skipped (already done)" in capsys.readouterr().out
+    asf = (src / "02.asf").read_bytes()
+    (src / "02.asf").write_bytes(asf.replace(b"length 2", b"length 3", 1))  # the skeleton of 02_*.amc
+    command = ["batch", "--median", "3", "--resume", "--in-place", "--jobs", "1", str(src), "-o", str(out)]
+    assert main(command) == 0  # --in-place: the ASF beside the outputs is the old one
+    done = sum(1 for p in src.glob("02_*.amc"))
+    assert f"{done} processed, {12 - done} skipped (already done)" in capsys.readouterr().out
 
 
 def test_killing_a_run_leaves_no_partial_outputs_and_resume_completes_it(data_dir, tmp_path):

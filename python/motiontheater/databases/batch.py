@@ -103,6 +103,7 @@ class Result:
     seconds: float = 0.0
     stop: str = ""  # an output problem that every take would meet: the run stops
     written: int = 0  # the output's size
+    digest: str = ""  # the input's content (SHA-256), for --resume to know a touched but unchanged take
     notes: list[tuple[int, str]] = field(default_factory=list)  # what the steps logged: (level, message)
 
 
@@ -184,12 +185,34 @@ class Manifest:
         }
 
     def done(self, job: Job) -> bool:
-        """Whether the job's output exists, made by this recipe from these very inputs."""
+        """Whether the job's output exists, made by this recipe from these very inputs: inputs
+        whose times and sizes are those the manifest noted, or, where only a time differs (a file
+        touched, copied or checked out again), whose contents are."""
         entry = self.entries.get(self._key(job))
-        if entry is None or {k: entry.get(k) for k in ("recipe", "input", "stamps")} != self._stamps(job):
+        now = self._stamps(job)
+        if entry is None or {k: entry.get(k) for k in ("recipe", "input")} != {k: now[k] for k in ("recipe", "input")}:
+            return False
+        if entry.get("stamps") != now["stamps"] and not self._same_contents(job, entry, now["stamps"]):
             return False
         written = Path(self.path.parent, entry["written"])
         return written.exists() and written.stat().st_size == entry["size"]
+
+    def _same_contents(self, job: Job, entry: dict[str, Any], stamps: list[Any]) -> bool:
+        noted, digests = entry.get("stamps"), entry.get("digests")
+        if not isinstance(noted, list) or not isinstance(digests, list) or len(noted) != 2 or len(digests) != 2:
+            return False
+        sizes = [s[1] if isinstance(s, list) and len(s) == 2 else None for s in noted]
+        if sizes != [s[1] if s else None for s in stamps]:  # a new size is new content: no need to read it
+            return False
+        with contextlib.suppress(OSError):
+            return digests == self._digests(job, _digest(job.input))
+        return False
+
+    def _digests(self, job: Job, take: str) -> list[str | None]:
+        skeleton = job.stamps[1] if job.stamps else None
+        if job.skeleton and skeleton is None:
+            skeleton = _stamp(os.stat(job.skeleton))
+        return [take, _skeleton_digest(job.skeleton, skeleton) if job.skeleton else None]
 
     def record(self, job: Job, result: Result) -> None:
         """Note a finished job: a line appended to the manifest now."""
@@ -199,6 +222,9 @@ class Manifest:
             "written": _relative(result.output, self.path.parent),
             "size": result.written,  # measured by the worker that wrote it
         }
+        if result.digest:
+            with contextlib.suppress(OSError):
+                entry["digests"] = self._digests(job, result.digest)
         if self._log is None:  # the manifest as found, compacted (atomically, like every output), then appended to
             with output(self.path) as f:
                 f.write(b"".join(_manifest_line(k, e) for k, e in self.entries.items() if k != key))
@@ -456,6 +482,7 @@ def _run_job(job: Job, result: Result) -> None:
             result.output = _write(job, job.pipeline.apply(motion), motion)
             result.frames = motion.frames
         result.written = os.path.getsize(result.output)
+        result.digest = _digest(job.input)
     except OutputError as e:
         result.ok, result.error = False, str(e)
         result.stop = str(e) if e.errno in WRITE_ERRORS else ""
@@ -522,6 +549,20 @@ def _write(job: Job, result: Motion, motion: Motion) -> str:
 
 def _stamp(status: os.stat_result) -> Stamp:
     return status.st_mtime_ns, status.st_size
+
+
+@functools.lru_cache(maxsize=64)
+def _skeleton_digest(path: str, stamp: Stamp) -> str:
+    """A skeleton file's digest, once per version of it (a database's takes share a few)."""
+    return _digest(path)
+
+
+def _digest(path: str) -> str:
+    found = hashlib.sha256()
+    with open(path, "rb") as f:
+        while chunk := f.read(1 << 20):
+            found.update(chunk)
+    return found.hexdigest()
 
 
 def _copy_skeleton(asf: str, folder: str, replace: bool = False) -> None:
