@@ -254,3 +254,19 @@ def test_a_recipe_or_map_that_is_a_fifo_is_refused_not_waited_on(data_dir, tmp_p
     finally:
         signal.alarm(0)
     assert "named pipe (FIFO), not a regular file" in capsys.readouterr().err
+
+
+def test_a_failed_write_removes_the_folders_it_made(tmp_path):
+    from motiontheater._io import output
+
+    (tmp_path / "kept").mkdir()
+    with pytest.raises(RuntimeError), output(tmp_path / "kept" / "new" / "deeper" / "a.amc") as f:
+        f.write(b"half a take")
+        raise RuntimeError("the writer failed")
+    assert [p.name for p in tmp_path.rglob("*")] == ["kept"]
+    with output(tmp_path / "kept" / "new" / "b.amc") as f:
+        f.write(b"whole")
+    assert (tmp_path / "kept" / "new" / "b.amc").read_bytes() == b"whole"
+    with pytest.raises(RuntimeError), output(tmp_path / "kept" / "new" / "c" / "d.amc") as f:
+        raise RuntimeError("the writer failed")
+    assert sorted(p.name for p in (tmp_path / "kept").rglob("*")) == ["b.amc", "new"]  # another file keeps it

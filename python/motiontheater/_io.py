@@ -204,10 +204,12 @@ def output(target: Source) -> Iterator[IO[bytes]]:
     path = os.fspath(target)
     directory = os.path.dirname(os.path.abspath(path))
     remove_stale_partials(directory)
+    made = _missing_folders(directory)
     try:
         os.makedirs(directory, exist_ok=True)  # the folder of a path named for the first time
         fd, tmp = _partial(directory)
     except OSError as e:
+        _remove_empty(made)
         raise OutputError(e.errno, f"cannot write {path}: {e.strerror}") from None
     try:
         with os.fdopen(fd, "wb") as f:
@@ -215,9 +217,27 @@ def output(target: Source) -> Iterator[IO[bytes]]:
         os.replace(tmp, path)
     except BaseException as e:
         os.unlink(tmp)
+        _remove_empty(made)  # a failed write leaves the disk as it found it
         if isinstance(e, OSError) and e.filename in (None, tmp) and e.errno in WRITE_ERRORS:
             raise OutputError(e.errno, f"cannot write {path}: {e.strerror}") from None
         raise
+
+
+def _missing_folders(directory: str) -> list[str]:
+    """The folders of ``directory`` that do not exist yet, deepest first."""
+    missing = []
+    while not os.path.isdir(directory) and os.path.dirname(directory) != directory:
+        missing.append(directory)
+        directory = os.path.dirname(directory)
+    return missing
+
+
+def _remove_empty(folders: list[str]) -> None:
+    for folder in folders:
+        try:
+            os.rmdir(folder)  # only if empty: another writer's file there keeps it
+        except OSError:
+            return
 
 
 WRITE_ERRORS = (errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
