@@ -23,7 +23,7 @@ from ..formats.bvh import NAMES as BVH_CHANNEL_NAMES
 from ..formats.table import format_for, format_of, skeleton_for, states_unit
 from ..model import units
 from ..model.motion import Motion
-from ..model.rig import body_view
+from ..model.rig import body_reason, body_view
 from ..model.skeleton import TRANSLATIONS
 from .takes import add_take_options, take_of
 from .verb import Verb
@@ -289,18 +289,7 @@ def _body(motion: Motion) -> dict[str, Any]:
         if dof in TRANSLATIONS and column not in kept
     ]
     name = skeleton.root.name if view.body == "root" else view.body
-    if skeleton.convention != "bvh":
-        why = "the root of an ASF skeleton carries the body"
-    elif view.body == "root" and not above:
-        why = "the root carries the body"
-    elif any(np.ptp(motion.values[:, c]) > 0 for c in motion.columns(view.body) if motion.frames):
-        why = "the first joint in the file whose position channels move"
-    else:
-        why = "named as the hips; no position channel moves"
-    if above:
-        why += (
-            f"; the joints above it stand still ({', '.join(skeleton.root.name if j == 'root' else j for j in above)})"
-        )
+    why = body_reason(view)
     return {
         "joint": name,
         "why": why,

@@ -224,6 +224,24 @@ def rest_values(skeleton: Skeleton, frames: int = 1) -> np.ndarray:
 POSES = 32  # frames, spread over a take, whose poses tell its up axis: quick on hours of frames
 
 
+def body_reason(view: BodyView) -> str:
+    """Why the view's joint carries the body, in words (what ``info`` says)."""
+    motion, skeleton, above = view.original, view.original.skeleton, view.still_above
+    if skeleton.convention != "bvh":
+        why = "the root of an ASF skeleton carries the body"
+    elif view.body == "root" and not above:
+        why = "the root carries the body"
+    elif any(np.ptp(motion.values[:, c]) > 0 for c in motion.columns(view.body) if motion.frames):
+        why = "the first joint in the file whose position channels move"
+    else:
+        why = "named as the hips; no position channel moves"
+    if above:
+        why += (
+            f"; the joints above it stand still ({', '.join(skeleton.root.name if j == 'root' else j for j in above)})"
+        )
+    return why
+
+
 def sampled_view(motion: Motion) -> Motion:
     """Up to :data:`POSES` frames spread over the take, seen from its body (the view of those
     frames alone, which on an hour of frames is what keeps the up axis and the standing frame
