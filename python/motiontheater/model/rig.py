@@ -18,6 +18,7 @@ take's own layout, every channel the step did not change exactly as found.
 from __future__ import annotations
 
 import re
+import weakref
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -242,11 +243,18 @@ def body_reason(view: BodyView) -> str:
     return why
 
 
+_SAMPLED: weakref.WeakKeyDictionary[Motion, Motion] = weakref.WeakKeyDictionary()
+
+
 def sampled_view(motion: Motion) -> Motion:
     """Up to :data:`POSES` frames spread over the take, seen from its body (the view of those
     frames alone, which on an hour of frames is what keeps the up axis and the standing frame
-    quick to find)."""
-    return body_view(motion.replace(values=motion.values[_sampled(motion.frames)])).motion
+    quick to find).  Made once per take (a Motion does not change): the up axis, the facing and
+    the standing frame all start from it."""
+    view = _SAMPLED.get(motion)
+    if view is None:
+        view = _SAMPLED[motion] = body_view(motion.replace(values=motion.values[_sampled(motion.frames)])).motion
+    return view
 
 
 def sampled_poses(motion: Motion) -> np.ndarray:
