@@ -1,4 +1,4 @@
-"""Bad input to every animation format the export step writes (glTF, GLB, USD): a clear message
+"""Bad input to every animation format the export step writes (glTF, GLB, FBX, USD): a clear message
 naming what is wrong and no file, not even a partial one."""
 
 import importlib.util
@@ -12,7 +12,7 @@ import motiontheater as mt
 needs_usd = pytest.mark.skipif(
     importlib.util.find_spec("pxr") is None, reason="usd-core is not installed (pip install usd-core)"
 )
-SUFFIXES = [".glb", ".gltf", pytest.param(".usda", marks=needs_usd), pytest.param(".usdc", marks=needs_usd)]
+SUFFIXES = [".glb", ".gltf", ".fbx", pytest.param(".usda", marks=needs_usd), pytest.param(".usdc", marks=needs_usd)]
 
 
 @pytest.mark.parametrize("suffix", SUFFIXES)

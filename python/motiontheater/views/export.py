@@ -1,5 +1,5 @@
-"""The ``export`` exporter: takes of one skeleton into the formats animation tools read (glTF/GLB
-and USD, each a writer module of its own), chosen by the target's suffix.  One registry entry, so
+"""The ``export`` exporter: takes of one skeleton into the formats animation tools read (glTF/GLB,
+USD and FBX, each a writer module of its own), chosen by the target's suffix.  One registry entry, so
 that it is at once ``motiontheater export a.amc b.bvh -o both.glb``, a recipe's last step and a
 batch step that converts a whole database."""
 
@@ -13,23 +13,25 @@ from typing import Annotated, Literal
 from .._io import Source
 from ..model.motion import Motion
 from ..model.registry import exporter
+from .fbx import write_fbx
 from .gltf import write_gltf
 from .usd import write_usd
 
-Kind = Literal["glb", "gltf", "usd", "usda", "usdc"]
+Kind = Literal["glb", "gltf", "usd", "usda", "usdc", "fbx"]
 WRITERS: dict[str, Callable[..., None]] = {
     "glb": partial(write_gltf, binary=True),
     "gltf": partial(write_gltf, binary=False),
     "usd": partial(write_usd, binary=True),  # the crate, as OpenUSD writes a .usd
     "usda": partial(write_usd, binary=False),
     "usdc": partial(write_usd, binary=True),
+    "fbx": write_fbx,
 }
 
 
 @exporter(
     "export",
-    (".glb", ".gltf", ".usd", ".usda", ".usdc"),
-    "write takes as glTF/GLB or USD for Blender, three.js, game engines and USD pipelines: "
+    (".glb", ".gltf", ".usd", ".usda", ".usdc", ".fbx"),
+    "write takes as glTF/GLB, USD or FBX for Blender, three.js, game engines, USD pipelines and DCC tools: "
     "skeleton, skin and animation",
     several=True,
 )
@@ -42,16 +44,17 @@ def export(
     format: Annotated[Kind | None, "file format (default: from the suffix)"] = None,
 ) -> str:
     """Write takes of one skeleton into one file, an animation per take, named after their files:
-    glTF 2.0 (``.glb`` binary, ``.gltf`` text) or USD's UsdSkel (``.usdc`` or ``.usd``
-    binary, ``.usda`` text; needs usd-core), where several takes are the variants of a variant set ``take``.
+    glTF 2.0 (``.glb`` binary, ``.gltf`` text), USD's UsdSkel (``.usdc`` or ``.usd`` binary,
+    ``.usda`` text; needs usd-core; several takes are the variants of a variant set ``take``) or
+    binary FBX 7.4 (``.fbx``; an animation stack per take).
 
     The skeleton is a node per joint at its rest pose (the calibration pose; an ASF bone's node
     at its start, a leaf's end as a node of its own) with a skin; each take's animation turns
     every joint and moves the root (and any joint whose position channels move) at every frame,
     at the take's own rate, so that a reader draws every joint where motiontheater's forward
-    kinematics puts it.  Lengths are metres, +Y is up and the take faces +Z, whatever its unit
-    and up axis (a z-up export is stood up, a take in centimetres scaled).  The format is the
-    target's suffix unless given.  A path is written atomically.  Returns the format written.
+    kinematics puts it.  Lengths are metres (in FBX centimetres, its own unit, stated in the
+    file), +Y is up and the take faces +Z, whatever the take's unit and up axis (a z-up export
+    is stood up, a take in inches scaled).  The format is the target's suffix unless given.  A path is written atomically.  Returns the format written.
     """
     if format is None:
         suffix = os.path.splitext(os.fspath(target) if isinstance(target, (str, os.PathLike)) else "")[1]
