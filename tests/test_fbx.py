@@ -22,23 +22,15 @@ from consumers import blender_positions, needs_blender, needs_three, three_page,
 from motiontheater.views.armature import animated
 from motiontheater.views.fbx import FOOTER_ID, FOOTER_MAGIC, KTIME, write_fbx
 from motiontheater.views.gltf import node_names, take_names
-from test_gltf import CASES, IDS, TOLERANCE, expected, take_of
+from test_gltf import IDS, TOLERANCE, expected, written_cases
 
 ufbx = pytest.importorskip("ufbx", reason="ufbx is not installed (pip install ufbx)")
 
 
 @pytest.fixture(scope="module")
 def written(tmp_path_factory):
-    """Each case's take, its armature, the positions it must give and its FBX, written once."""
-    folder = tmp_path_factory.mktemp("fbx")
-    out = {}
-    for (path, variant), name in zip(CASES, IDS):
-        take = take_of(path, variant)
-        armature, points = expected(take)
-        target = folder / (name.replace("/", "_").replace(" ", "_") + ".fbx")
-        write_fbx(take, target)
-        out[name] = (take, armature, points, target)
-    return out
+    """Each case's FBX file, written once (see test_gltf.written_cases)."""
+    return written_cases(tmp_path_factory.mktemp("fbx"), ".fbx", write_fbx)
 
 
 def key_times(take):

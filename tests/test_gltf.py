@@ -42,18 +42,23 @@ def expected(take):
     return armature, armature.scale * take.positions()[:, armature.origins] @ armature.turn.T
 
 
-@pytest.fixture(scope="module")
-def written(tmp_path_factory):
-    """Each case's take, its armature, the positions it must give and its GLB, written once."""
-    folder = tmp_path_factory.mktemp("glb")
+def written_cases(folder, suffix, write):
+    """{case: (take, its armature, the positions it must give, its file)}, each file written by
+    ``write(take, path)`` into ``folder``, named after the case with ``suffix``."""
     out = {}
     for (path, variant), name in zip(CASES, IDS):
         take = take_of(path, variant)
         armature, points = expected(take)
-        target = folder / (name.replace("/", "_").replace(" ", "_") + ".glb")
-        write_gltf(take, target)
+        target = folder / (name.replace("/", "_").replace(" ", "_") + suffix)
+        write(take, target)
         out[name] = (take, armature, points, target)
     return out
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    """Each case's GLB, written once (see written_cases)."""
+    return written_cases(tmp_path_factory.mktemp("glb"), ".glb", write_gltf)
 
 
 def key_times(take):

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
-from test_gltf import CASES, IDS, TOLERANCE, expected, take_of
+from test_gltf import IDS, TOLERANCE, expected, written_cases
 
 pxr = pytest.importorskip("pxr", reason="usd-core is not installed (pip install usd-core)")
 from pxr import Usd, UsdGeom, UsdSkel, UsdValidation
@@ -41,15 +41,8 @@ def world_positions(stage):
 
 @pytest.fixture(scope="module")
 def written(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("usd")
-    out = {}
-    for (path, variant), name in zip(CASES, IDS):
-        take = take_of(path, variant)
-        armature, points = expected(take)
-        target = folder / (name.replace("/", "_").replace(" ", "_") + ".usdc")
-        write_usd(take, target)
-        out[name] = (take, armature, points, target)
-    return out
+    """Each case's USD file, written once (see test_gltf.written_cases)."""
+    return written_cases(tmp_path_factory.mktemp("usdc"), ".usdc", write_usd)
 
 
 @pytest.mark.parametrize("case", IDS)
