@@ -62,7 +62,10 @@ def test_resume_redoes_takes_made_by_another_recipe_or_from_changed_inputs(cmu, 
     assert "2 processed, 0 skipped" in capsys.readouterr().out
     expected = mt.read_amc(cmu / "02_01.amc", mt.read_asf(cmu / "02.asf")).mean(size=3)
     np.testing.assert_array_equal(mt.read_amc(out / "02_01.amc", expected.skeleton).values, expected.values)
-    (cmu / "02_02.amc").write_bytes((cmu / "02_02.amc").read_bytes())  # touched: a new stamp
+    (cmu / "02_02.amc").write_bytes((cmu / "02_02.amc").read_bytes())  # rewritten as it was: still done
+    assert main(["batch", "--mean", "3", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
+    assert "0 processed, 2 skipped" in capsys.readouterr().out
+    (cmu / "02_02.amc").write_bytes((cmu / "02_02.amc").read_bytes() + b"\n")  # changed
     assert main(["batch", "--mean", "3", "--resume", "--jobs", "1", str(cmu), "-o", str(out)]) == 0
     assert "1 processed, 1 skipped" in capsys.readouterr().out
     (out / "02_01.amc").unlink()
