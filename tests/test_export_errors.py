@@ -50,3 +50,14 @@ def test_an_unwritable_target_is_named(data_dir, tmp_path, suffix):
     with pytest.raises(OSError, match=f"cannot write {target}"):
         mt.export(take, target)
     assert os.listdir(tmp_path) == ["a file"]
+
+
+@pytest.mark.parametrize("suffix", [".fbx", ".usdc"])
+def test_a_file_only_written_is_said_not_to_be_read(data_dir, tmp_path, capsys, suffix):
+    from motiontheater.cli import main
+
+    target = tmp_path / f"a{suffix}"
+    target.write_bytes(b"")
+    assert main(["info", str(target)]) == 2
+    said = capsys.readouterr().err
+    assert "writes" in said and "(the export step) but does not read it" in said and "Traceback" not in said

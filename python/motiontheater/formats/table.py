@@ -86,6 +86,11 @@ FORMATS: dict[str, Format] = {
     # glTF takes are read as BVH motions and written by the export step (views/export.py)
     ".glb": Format(".glb", "glTF binary", "bvh", _read_gltf, takes=animation_names),
     ".gltf": Format(".gltf", "glTF", "bvh", _read_gltf, takes=animation_names),
+    # written by the export step only: here so that a file of them read as a take gets told so
+    ".fbx": Format(".fbx", "FBX", "bvh"),
+    ".usd": Format(".usd", "USD", "bvh"),
+    ".usda": Format(".usda", "USD", "bvh"),
+    ".usdc": Format(".usdc", "USD", "bvh"),
 }
 
 
@@ -107,7 +112,10 @@ def format_of(path: str | os.PathLike) -> Format:
     """The format of a take file by its suffix (any case); ValueError naming the file otherwise."""
     found = FORMATS.get(os.path.splitext(os.fspath(path))[1].lower())  # not Path: batch asks for every take
     if found is None or not found.holds_takes:
-        raise ValueError(f"{os.fspath(path)}: a take's file name must end in {_listing(take_suffixes())}")
+        note = ""
+        if found is not None and found.read_skeleton is None:  # a format only the export step writes
+            note = f"motiontheater writes {found.name} (the export step) but does not read it; "
+        raise ValueError(f"{os.fspath(path)}: {note}a take's file name must end in {_listing(take_suffixes())}")
     return found
 
 
