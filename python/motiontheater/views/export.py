@@ -31,7 +31,7 @@ WRITERS: dict[str, Callable[..., None]] = {
 @exporter(
     "export",
     (".glb", ".gltf", ".usd", ".usda", ".usdc", ".fbx"),
-    "write takes as glTF/GLB, USD or FBX for Blender, Maya, three.js, game engines and USD pipelines: "
+    "write takes as glTF/GLB, USD or FBX for Blender, three.js, game engines and USD pipelines: "
     "skeleton, skin and animation",
     several=True,
 )
