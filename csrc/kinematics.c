@@ -172,20 +172,6 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
     return status;
 }
 
-/* q = (c, s e_axis) q over lanes: a turn about a coordinate axis (c, s: cosine and sine of half
- * its angle) after the rotation q (w, x, y, z rows of BLOCK lanes). */
-static MT_INLINE void turn_quaternion_n(double q[4][BLOCK], int axis, const double *s, const double *c)
-{
-    const int a = 1 + axis, p = 1 + mixed_first(axis), r = 1 + mixed_second(axis);
-    for (int f = 0; f < BLOCK; f++) {
-        const double w = q[0][f], u = q[a][f], v = q[p][f], t = q[r][f];
-        q[0][f] = c[f] * w - s[f] * u;
-        q[a][f] = c[f] * u + s[f] * w;
-        q[p][f] = c[f] * v - s[f] * t;
-        q[r][f] = c[f] * t + s[f] * v;
-    }
-}
-
 /* out = a q b over lanes, a and b one quaternion for every lane (out may be q) */
 static MT_INLINE void sandwich_n(const double *a, double q[4][BLOCK], const double *b, double out[4][BLOCK])
 {
@@ -224,7 +210,7 @@ static MT_CLONES void local_quaternions(const double *values, size_t frames, siz
                         v[f] = values[(f0 + ((size_t)f < n ? (size_t)f : n - 1)) * channels + dof_column[c]] *
                                (angle_scale / 2);
                     sincos_lanes(v, sn, cs, BLOCK);
-                    turn_quaternion_n(q, dof_kind[c], sn, cs);
+                    turn_quaternion_n(q[0], q[1], q[2], q[3], dof_kind[c], sn, cs, BLOCK);
                 }
                 sandwich_n(outer + 4 * i, q, inner + 4 * i, q);
                 for (size_t f = 0; f < n; f++) {

@@ -294,6 +294,23 @@ static MT_INLINE int mixed_second(int axis)
     return axis == 0 ? 2 : axis == 1 ? 0 : 1;
 }
 
+/* q = (c, s e_axis) q over n lanes, q given by its rows w, x, y, z: a turn about a coordinate axis
+ * (c, s: cosine and sine of half its angle) after the rotation q.
+ * (c, s e) (w, v) = (w c - v.e s, v c + e w s + e x v s) */
+static MT_INLINE void turn_quaternion_n(double *w, double *x, double *y, double *z, int axis, const double *s,
+                                        const double *c, int n)
+{
+    double *rows[3] = {x, y, z};
+    double *a = rows[axis], *p = rows[mixed_first(axis)], *r = rows[mixed_second(axis)];
+    for (int l = 0; l < n; l++) {
+        const double w0 = w[l], a0 = a[l], p0 = p[l], r0 = r[l];
+        w[l] = c[l] * w0 - s[l] * a0;
+        a[l] = c[l] * a0 + s[l] * w0;
+        p[l] = c[l] * p0 - s[l] * r0;
+        r[l] = c[l] * r0 + s[l] * p0;
+    }
+}
+
 /* m = R(axis) m, R the rotations about a coordinate axis of the given sines and cosines: they mix two rows */
 static MT_INLINE void rotate_left_n(double *m, int axis, const double *s, const double *c, int n)
 {

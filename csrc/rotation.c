@@ -174,19 +174,11 @@ static MT_INLINE void euler_quaternion_block(double angles[3][LANES], const stru
     for (int l = 0; l < LANES; l++)
         q[0][l] = 1, q[1][l] = 0, q[2][l] = 0, q[3][l] = 0;
     for (int step = 0; step < 3; step++) {
-        const int a = cv->intrinsic ? 2 - step : step, axis = cv->axes[a];
-        /* (cos h, sin h e) (w, v) = (w cos h - v.e sin h, v cos h + e w sin h + e x v sin h) */
-        double *w = q[0], *va = q[1 + axis], *vb = q[1 + (axis + 1) % 3], *vd = q[1 + (axis + 2) % 3];
+        const int a = cv->intrinsic ? 2 - step : step;
         for (int l = 0; l < LANES; l++)
             h[l] = angles[a][l] * cv->scale * 0.5;
         sincos_lanes(h, sn, cs, LANES);
-        for (int l = 0; l < LANES; l++) {
-            const double w0 = w[l], a0 = va[l], b0 = vb[l], d0 = vd[l];
-            w[l] = cs[l] * w0 - sn[l] * a0;
-            va[l] = cs[l] * a0 + sn[l] * w0;
-            vb[l] = cs[l] * b0 - sn[l] * d0;
-            vd[l] = cs[l] * d0 + sn[l] * b0;
-        }
+        turn_quaternion_n(q[0], q[1], q[2], q[3], cv->axes[a], sn, cs, LANES);
     }
 }
 
