@@ -19,9 +19,9 @@ import pytest
 
 import motiontheater as mt
 from consumers import blender_positions, needs_blender, needs_three, three_page, three_positions  # noqa: F401
-from motiontheater.views.armature import animated
+from motiontheater.views.armature import animated, take_names
 from motiontheater.views.fbx import FOOTER_ID, FOOTER_MAGIC, KTIME, write_fbx
-from motiontheater.views.gltf import node_names, take_names
+from motiontheater.views.gltf import node_names
 from test_gltf import IDS, TOLERANCE, expected, written_cases
 
 ufbx = pytest.importorskip("ufbx", reason="ufbx is not installed (pip install ufbx)")

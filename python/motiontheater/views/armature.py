@@ -18,6 +18,7 @@ translations of the nodes that move.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -99,13 +100,13 @@ class Track:
 
 def animated(motions: Motion | Sequence[Motion], names: Sequence[str] | None = None) -> tuple[Armature, list[Track]]:
     """The armature of takes of one skeleton and each take's track (``names``: the tracks',
-    default take, take_2, ...).  The first take decides the up and forward axes.  ValueError
+    default :func:`take_names`).  The first take decides the up and forward axes.  ValueError
     when the takes have different skeletons, a take holds NaN or inf, the skeleton has no bone,
     or a joint's name is not text (the formats store names as UTF-8)."""
     takes = [motions] if isinstance(motions, Motion) else list(motions)
     if not takes:
         raise ValueError("no take to export")
-    names = list(names) if names is not None else [f"take_{i + 1}" if i else "take" for i in range(len(takes))]
+    names = list(names) if names is not None else take_names(takes)
     first = takes[0]
     for name, take in zip(names, takes):
         if not np.isfinite(take.values).all():
@@ -122,6 +123,20 @@ def animated(motions: Motion | Sequence[Motion], names: Sequence[str] | None = N
         except UnicodeEncodeError:
             raise ValueError(f"joint name {name!r} is not UTF-8 text, which the animation formats store") from None
     return armature, [track(armature, take, name) for take, name in zip(takes, names)]
+
+
+def take_names(motions: Sequence[Motion]) -> list[str]:
+    """Each take's name for its animation: its file's stem where it was read from one, else
+    take, take_2, ...; unique."""
+    names: list[str] = []
+    for i, motion in enumerate(motions):
+        origin = motion.origin.file.path if motion.origin is not None else None
+        base = os.path.splitext(os.path.basename(origin))[0] if origin else ("take" if i == 0 else f"take_{i + 1}")
+        name, n = base, 2
+        while name in names:
+            name, n = f"{base}_{n}", n + 1
+        names.append(name)
+    return names
 
 
 def same_rig(a: Skeleton, b: Skeleton) -> bool:

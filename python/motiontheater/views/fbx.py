@@ -29,7 +29,7 @@ from .._version import __version__
 from ..model.motion import Motion
 from .armature import Armature, Track, animated
 from .capsules import capsules
-from .gltf import node_names, take_names
+from .gltf import node_names
 
 VERSION = 7400
 MAGIC = b"Kaydara FBX Binary  \x00\x1a\x00"
@@ -322,8 +322,7 @@ def fbx_records(
     motions: Motion | Sequence[Motion], *, body: bool = True, names: Sequence[str] | None = None
 ) -> list[Record]:
     """The top-level records of the takes' file (see :func:`write_fbx`)."""
-    takes = [motions] if isinstance(motions, Motion) else list(motions)
-    armature, tracks = animated(takes, names if names is not None else take_names(takes))
+    armature, tracks = animated(motions, names)
     scene = _Scene()
     models = _skeleton(scene, armature)
     mesh = _body(scene, armature, models) if body else None

@@ -32,20 +32,6 @@ ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 TYPES = {1: "SCALAR", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
 
 
-def take_names(motions: Sequence[Motion]) -> list[str]:
-    """Each take's name for its animation: its file's stem where it was read from one, else
-    take, take_2, ...; unique."""
-    names: list[str] = []
-    for i, motion in enumerate(motions):
-        origin = motion.origin.file.path if motion.origin is not None else None
-        base = os.path.splitext(os.path.basename(origin))[0] if origin else ("take" if i == 0 else f"take_{i + 1}")
-        name, n = base, 2
-        while name in names:
-            name, n = f"{base}_{n}", n + 1
-        names.append(name)
-    return names
-
-
 class _Buffer:
     """The binary buffer and the JSON's bufferViews and accessors that describe it."""
 
@@ -157,8 +143,7 @@ def gltf_document(
     motions: Motion | Sequence[Motion], *, body: bool = True, names: Sequence[str] | None = None
 ) -> tuple[dict[str, Any], _Buffer]:
     """The JSON document and binary buffer of the takes (see :func:`write_gltf`)."""
-    takes = [motions] if isinstance(motions, Motion) else list(motions)
-    armature, tracks = animated(takes, names if names is not None else take_names(takes))
+    armature, tracks = animated(motions, names)
     buffer = _Buffer()
     nodes = _nodes(armature)
     inverse_bind = buffer.add(armature.inverse_bind.transpose(0, 2, 1).reshape(-1, 16).astype(np.float32))

@@ -25,7 +25,6 @@ from .._io import Source, output
 from ..model.motion import Motion
 from .armature import Armature, Track, animated
 from .capsules import capsules
-from .gltf import take_names
 
 
 def _require_usd() -> None:
@@ -112,8 +111,7 @@ def usd_stage(motions: Motion | Sequence[Motion], *, body: bool = True, names: S
     _require_usd()
     from pxr import Sdf, Usd, UsdGeom, UsdSkel, Vt
 
-    takes = [motions] if isinstance(motions, Motion) else list(motions)
-    armature, tracks = animated(takes, names if names is not None else take_names(takes))
+    armature, tracks = animated(motions, names)
     stage = Usd.Stage.CreateInMemory()
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
@@ -171,9 +169,9 @@ def write_usd(
 ) -> None:
     """Write takes of one skeleton as USD (UsdSkel), a SkelAnimation per take (named ``names``,
     default after their files): text (``.usda``) where ``binary`` is false or the target ends
-    in ``.usda``, else OpenUSD's binary crate (``.usdc``, ``.usd``).  ``body``: a capsule along each bone, skinned.  A path is
-    written atomically.  ValueError for takes of different skeletons, NaN or inf values, a
-    skeleton of one joint, or where usd-core is not installed."""
+    in ``.usda``, else OpenUSD's binary crate (``.usdc``, ``.usd``).  ``body``: a capsule along
+    each bone, skinned.  A path is written atomically.  ValueError for takes of different
+    skeletons, NaN or inf values, a skeleton of one joint, or where usd-core is not installed."""
     if binary is None:
         binary = not isinstance(target, (str, os.PathLike)) or not os.fspath(target).lower().endswith(".usda")
     stage = usd_stage(motions, body=body, names=names)
