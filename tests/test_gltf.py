@@ -275,3 +275,10 @@ def test_info_names_every_take_of_a_file(copies):
     assert facts["takes"] == ["02_01", "02_02"]
     assert _cli("export", "02_01.amc", "-o", "one.glb", cwd=folder).returncode == 0
     assert "takes" not in _cli("info", "one.glb", cwd=folder).stdout
+
+
+def test_a_resampled_export_says_so(copies):
+    folder = copies("cmu", ["02.asf", "02_01.amc"])
+    done = _cli("export", "02_01.amc", "-o", "30.glb", "--rate", "30", cwd=folder)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "export: 343 frames of 02_01.amc, resampled to 30 Hz: wrote 30.glb"

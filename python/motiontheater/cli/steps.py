@@ -158,7 +158,10 @@ def _export_takes(step: Step, args: argparse.Namespace, options: dict[str, Any])
     step(motions if len(motions) > 1 else motions[0], target, **options)
     frames = sum(m.frames for m in motions)
     takes = f"{len(motions)} takes" if len(motions) > 1 else args.inputs[0]
-    print(f"{step.name}: wrote {frames} frames of {takes} to {target}")
+    if options.get("rate") is not None:  # what was read, not what was written
+        print(f"{step.name}: {frames} frames of {takes}, resampled to {options['rate']:g} Hz: wrote {target}")
+    else:
+        print(f"{step.name}: wrote {frames} frames of {takes} to {target}")
     for motion in motions:
         for note in unit_notes(motion, motion, target):
             print(note, file=sys.stderr)
