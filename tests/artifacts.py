@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import motiontheater as mt
+from motiontheater.model.rig import body_joint
 from motiontheater.model.skeleton import ROTATIONS, TRANSLATIONS
 
 KINDS = ("spike", "flip", "gap", "frozen", "teleport", "unit")
@@ -52,7 +53,7 @@ def inject(take: mt.Motion, kind: str, rng: np.random.Generator) -> tuple[mt.Mot
     degrees = 1.0 if take.skeleton.angle_unit == "deg" else 180 / np.pi
     values = take.values.copy()
     triples = _triples(take)
-    root = take.skeleton.joint_names[0]
+    root = body_joint(take)
     for _ in range(20):  # a place where the artifact shows: a joint that moves there
         if kind == "unit":
             factor = float(rng.choice([10.0, 0.1, 2.54, 1 / 2.54, 100.0]))
@@ -100,7 +101,8 @@ def inject(take: mt.Motion, kind: str, rng: np.random.Generator) -> tuple[mt.Mot
             if not _moving(take, columns, slice(start - 2, start + n + 2), degrees):
                 continue
             if kind == "spike":
-                c = int(rng.choice(columns))
+                span = slice(start - 2, start + n + 2)
+                c = int(rng.choice([c for c in columns if _moving(take, np.array([c]), span, degrees)]))
                 values[rows_hit, c] += rng.choice([-1, 1]) * rng.uniform(20, 60) / degrees
             else:
                 half = 180.0 / degrees

@@ -29,6 +29,7 @@ from mtcore.rotations import euler_to_quaternions, slerp, unroll_euler
 
 from ..editing.pipeline import Pipeline
 from ..model.motion import Motion
+from ..model.rig import body_joint
 from ..model.skeleton import ROTATIONS, TRANSLATIONS
 from ..model.units import HUMAN_HEIGHT
 from .findings import Finding
@@ -95,7 +96,7 @@ class _Take:
         skeleton = motion.skeleton
         self.meters = skeleton.meters_per_unit
         self.degrees = 1.0 if skeleton.angle_unit == "deg" else 180.0 / math.pi  # degrees per file unit
-        self.root = skeleton.joint_names[0]
+        self.root = body_joint(motion)  # the joint that carries the body (a static root above it is no body)
         self.channels = [_Channel(i, j, d) for i, (j, d) in enumerate(motion.channels)]
         self.triples = {}  # joint -> (order, extrinsic, columns) for joints with three rotation channels
         for order, extrinsic, columns in skeleton.euler_groups():
@@ -129,7 +130,7 @@ def _limits(take: _Take) -> tuple[np.ndarray, np.ndarray]:
     spike_deg = max(SPIKE_DEG, PEAK_ACCELERATION_DEG * dt2 / 2)
     spike_m = max(SPIKE_M, PEAK_ACCELERATION_M * dt2 / 2)
     jump_deg = max(JUMP_DEG, PEAK_ACCELERATION_DEG * dt2)
-    jump_m = RUN_SPEED * take.dt
+    jump_m = RUN_SPEED * take.dt / math.sqrt(3)  # a jump of RUN_SPEED * dt in any direction shows on an axis
     spikes = np.array([spike_deg / take.degrees if c.turns else spike_m / take.meters for c in take.channels])
     steps = np.array([jump_deg / take.degrees if c.turns else jump_m / take.meters for c in take.channels])
     return spikes, steps
@@ -152,14 +153,17 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         repeats = by_kind[kernel.REPEAT][0]
         findings += _repeats(t, repeats, rows)
         findings += _gaps(t, *by_kind[kernel.GAP])
-        findings += _frozen(t, *by_kind[kernel.FROZEN], repeats, min_run)
-        findings += _flips(t, by_kind[kernel.STEP], by_kind[kernel.SPIKE])
-        # the jumps into and out of a flip, a hold or a gap are that finding's, not spikes of their own
+        flips = _flips(t, by_kind[kernel.STEP], by_kind[kernel.SPIKE])
+        edges = {(f.joints[0], frame) for f in flips for frame in (f.first, f.last + 1)}
+        findings += flips + _frozen(t, *by_kind[kernel.FROZEN], repeats, min_run, edges)
+        # the jumps into and out of a flip, a hold or a gap are that finding's, not spikes of their
+        # own: (joint, rotation or position, frame)
         explained = {
-            (joint, frame)
+            (joint, turns, frame)
             for f in findings
             if f.kind in ("flip", "frozen", "gap")
             for joint in f.joints
+            for turns in _turns_of(f)
             for frame in range(f.first - 1, f.last + 3)
         }
         findings += _spikes(t, by_kind[kernel.SPIKE], by_kind[kernel.STEP], explained, spikes)
@@ -167,6 +171,15 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         findings += _bones(t)
         findings += _speed(t)
     return sorted(findings, key=lambda f: (f.first, -f.rank, f.kind, f.joints))
+
+
+def _turns_of(finding: Finding) -> tuple[bool, ...]:
+    """Whether the channels a flip, hold or gap concerns turn (True), place (False) or both."""
+    if finding.kind == "flip":
+        return (True,)
+    if finding.kind == "frozen" and finding.channel is not None:
+        return (finding.channel.rsplit(" ", 1)[1] in ROTATIONS,)
+    return (True, False)
 
 
 def _fill(t: _Take, first_row: int, last_row: int, joints: Iterable[str] | None) -> tuple:
@@ -188,14 +201,21 @@ def _fill(t: _Take, first_row: int, last_row: int, joints: Iterable[str] | None)
 def _joint_runs(
     t: _Take, events: np.ndarray, sizes: np.ndarray, pad: int = 0
 ) -> list[tuple[str, int, int, int, float]]:
-    """Events of one kind joined per joint where their rows overlap (within ``pad``): (joint,
-    first row, last row, worst channel, its size)."""
+    """Events of one kind joined per joint (its rotation channels apart from its position
+    channels) where their rows overlap (within ``pad``): (joint, first row, last row, worst
+    channel, its size)."""
     out: list[list] = []
-    order = np.lexsort((events[:, 1], [t.channels[c].joint for c in events[:, 0]]))
+    group = [f"{t.channels[c].joint} {t.channels[c].turns}" for c in events[:, 0]]
+    order = np.lexsort((events[:, 1], group))
     for i in order:
         c, first, last = int(events[i, 0]), int(events[i, 1]), int(events[i, 2])
         joint, size = t.channels[c].joint, float(sizes[i])
-        if out and out[-1][0] == joint and first <= out[-1][2] + pad:
+        if (
+            out
+            and out[-1][0] == joint
+            and t.channels[out[-1][3]].turns == t.channels[c].turns
+            and first <= out[-1][2] + pad
+        ):
             run = out[-1]
             run[2] = max(run[2], last)
             if abs(t.physical(t.channels[c], size)) > abs(t.physical(t.channels[run[3]], run[4])):
@@ -240,7 +260,9 @@ def _gaps(t: _Take, events: np.ndarray, sizes: np.ndarray) -> list[Finding]:
     return out
 
 
-def _frozen(t: _Take, events: np.ndarray, sizes: np.ndarray, repeats: np.ndarray, min_run: int) -> list[Finding]:
+def _frozen(
+    t: _Take, events: np.ndarray, sizes: np.ndarray, repeats: np.ndarray, min_run: int, flips: set
+) -> list[Finding]:
     values = t.motion.values
     rows = len(values)
     window = max(2, round(FROZEN_SECONDS * t.rate))
@@ -253,6 +275,8 @@ def _frozen(t: _Take, events: np.ndarray, sizes: np.ndarray, repeats: np.ndarray
         channel = t.channels[int(c)]
         if last - first + 1 < min_run or repeated[first + 1 : last + 1].all():
             continue
+        if channel.turns and ({(channel.joint, t.frame(first)), (channel.joint, t.frame(last + 1))} & flips):
+            continue  # a channel that holds still, flipped with its joint's triple
         if first == 0 and last == rows - 1:
             dead.setdefault(channel.joint, []).append(int(c))
             continue
@@ -260,11 +284,18 @@ def _frozen(t: _Take, events: np.ndarray, sizes: np.ndarray, repeats: np.ndarray
         changes = [np.abs(np.diff(a)) for a in around if len(a) > 2]
         if not changes:
             continue
-        speed = min(float(np.median(d)) for d in changes)
         moving = np.concatenate(changes)
         moving = moving[moving > 0]
         quantum = float(moving.min()) if len(moving) else 0.0
-        expected = speed * (last - first)
+        # how far the channel would have gone at its speed on either side, or where it lands
+        # when the hold lets go: a held value rejoins the motion with a jump
+        speed = max(float(np.median(d)) for d in changes)
+        beyond = [values[max(first - 3 - window, 0) : max(first - 3, 0), c], values[last + 4 : last + 4 + window, c]]
+        if not any(len(b) > 1 and np.ptp(b) > 0 for b in beyond):
+            continue  # still on both sides, but for a few frames at the hold's ends: a pop, not a hold
+        after = values[last + 1 : last + 4, c]  # the least of three frames: a pop comes back
+        leap = float(np.nan_to_num(np.abs(after - values[last, c])).min()) if len(after) else 0.0
+        expected = max(speed * (last - first), leap)
         floor = FROZEN_DEG / t.degrees if channel.turns else FROZEN_M / t.meters
         if expected > max(5 * quantum, floor):
             frozen.append((int(c), int(first), int(last), kernel.FROZEN, int(first), expected))
@@ -374,25 +405,19 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     out = []
     edges: dict[int, list[tuple[str, float]]] = {}  # spikes at the first or last frame, by row
     for joint, first, last, c, size in _joint_runs(t, events, sizes, pad=1):
-        if any((joint, t.frame(r)) in explained for r in range(first, last + 1)):
-            continue
         channel = t.channels[c]
-        if channel.turns:
-            if joint in t.triples and 0 < first and last < rows - 1:
-                around = np.arange(first - 1, last + 2)
-                q = t.quaternions(joint, around)
-                if np.isnan(q).any():
-                    continue
-                share = np.arange(1, len(around) - 1) / (len(around) - 1)
-                between = slerp(np.broadcast_to(q[0], (len(share), 4)), np.broadcast_to(q[-1], (len(share), 4)), share)
-                deviation = float(_angle_deg(q[1:-1], between).max())
-            else:
-                deviation = abs(t.physical(channel, size))
-            if deviation <= SPIKE_DEG:
-                continue  # the angles swing (near gimbal lock), the rotation does not
-            if first == 0 or last == rows - 1:
+        if any((joint, channel.turns, t.frame(r)) in explained for r in range(first, last + 1)):
+            continue
+        limit = t.physical(channel, limits[c])
+        first, last, deviation = _trimmed(t, joint, channel.turns, first, last, limit)
+        if deviation is None:  # at an end of the take, or beside a missing value
+            deviation = abs(t.physical(channel, size))
+            if channel.turns and (first == 0 or last == rows - 1):
                 edges.setdefault(first, []).append((joint, deviation))
                 continue
+        if deviation <= limit:
+            continue  # the angles swing (near gimbal lock) or the frames around move fast: no spike
+        if channel.turns:
             severity = "high" if deviation > 30 else "medium" if deviation > 10 else "low"
             out.append(
                 Finding(
@@ -402,14 +427,13 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
                 )
             )  # fmt: skip
             continue
-        distance = abs(t.physical(channel, size))
-        speed = distance * t.rate
-        kind = "teleport" if joint == t.root and (speed > RUN_SPEED or distance > TELEPORT_M) else "spike"
-        severity = "high" if kind == "teleport" or distance > 0.1 else "medium" if distance > 0.03 else "low"
+        speed = deviation * t.rate
+        kind = "teleport" if joint == t.root and (speed > RUN_SPEED or deviation > TELEPORT_M) else "spike"
+        severity = "high" if kind == "teleport" or deviation > 0.1 else "medium" if deviation > 0.03 else "low"
         out.append(
             Finding(
-                t.name, kind, (joint,), t.frame(first), t.frame(last), severity, round(distance, 6), "m",
-                f"{joint} jumps {distance:.3g} m away from its neighbours for {last - first + 1} frame(s)"
+                t.name, kind, (joint,), t.frame(first), t.frame(last), severity, round(deviation, 6), "m",
+                f"{joint} jumps {deviation:.3g} m away from its neighbours for {last - first + 1} frame(s)"
                 + (f" and back: {speed:.3g} m/s, faster than anyone runs" if kind == "teleport" else ""),
                 channel.name, _fill(t, first, last, [joint]),
             )
@@ -431,7 +455,9 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     events, sizes = steps
     for (c, first, last, _, at), size in zip(events[stay], sizes[stay]):
         channel = t.channels[int(c)]
-        if (channel.joint, t.frame(at)) in explained or (channel.turns and abs(t.physical(channel, size)) > FLIP_DEG):
+        if (channel.joint, channel.turns, t.frame(at)) in explained or (
+            channel.turns and abs(t.physical(channel, size)) > FLIP_DEG
+        ):
             continue
         if near_spike[int(c), max(first - 1, 0) : last + 2].any():
             continue  # the jumps into and out of a spike
@@ -464,6 +490,49 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     return out
 
 
+def _deviations(t: _Take, joint: str, turns: bool, first: int, last: int) -> np.ndarray | None:
+    """How far each of rows first..last lies off the path between the rows around them: the
+    joint's rotation in degrees from the SLERP between them (its angles, unwrapped, from the line
+    between them where it has fewer than three), or its position in metres from the line
+    between them.  None at an end of the take or where a value is missing."""
+    if first < 1 or last > t.motion.frames - 2:
+        return None
+    around = np.arange(first - 1, last + 2)
+    share = (around[1:-1] - around[0]) / (around[-1] - around[0])
+    if turns and joint in t.triples:
+        q = t.quaternions(joint, around)
+        if np.isnan(q).any():
+            return None
+        between = slerp(np.broadcast_to(q[0], (len(share), 4)), np.broadcast_to(q[-1], (len(share), 4)), share)
+        return _angle_deg(q[1:-1], between)
+    columns = [c.index for c in t.channels if c.joint == joint and c.turns == turns]
+    block = t.motion.values[np.ix_(around, columns)]
+    if np.isnan(block).any():
+        return None
+    if turns:
+        block = np.unwrap(block, axis=0, period=t.motion.skeleton.period)
+    block = block * (t.degrees if turns else t.meters)
+    line = block[0] + share[:, None] * (block[-1] - block[0])
+    off = block[1:-1] - line
+    return np.abs(off).max(axis=1) if turns else np.linalg.norm(off, axis=1)
+
+
+def _trimmed(t: _Take, joint: str, turns: bool, first: int, last: int, limit: float) -> tuple[int, int, float | None]:
+    """The run without the rows at its ends that lie on the path between the rows around them
+    (the median of five beside a large spike can leave a fast-moving neighbour), and its largest
+    deviation (None where :func:`_deviations` has none)."""
+    while True:
+        off = _deviations(t, joint, turns, first, last)
+        if off is None:
+            return first, last, None
+        if first < last and off[0] <= limit:
+            first += 1
+        elif first < last and off[-1] <= limit:
+            last -= 1
+        else:
+            return first, last, float(off.max())
+
+
 def _jitter(t: _Take, roughness: np.ndarray, counts: np.ndarray) -> list[Finding]:
     smooth = SMOOTH_ACCELERATION_DEG * t.dt**2 / 2
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -493,7 +562,10 @@ def _jitter(t: _Take, roughness: np.ndarray, counts: np.ndarray) -> list[Finding
 def _bones(t: _Take) -> list[Finding]:
     out = []
     skeleton = t.motion.skeleton
-    for joint in skeleton.joint_names[1:]:
+    above = set(_chain_to(skeleton, t.root))  # the body's joint and those above it carry no bone
+    for joint in skeleton.joint_names:
+        if joint in above:
+            continue
         columns = t.motion.columns(joint, TRANSLATIONS) if set(TRANSLATIONS) <= set(skeleton.dofs(joint)) else []
         if len(columns) != 3:
             continue
@@ -513,6 +585,13 @@ def _bones(t: _Take) -> list[Finding]:
                 )
             )  # fmt: skip
     return out
+
+
+def _chain_to(skeleton, joint: str) -> list[str]:
+    chain = [joint]
+    while not skeleton.is_root(chain[-1]):
+        chain.append(skeleton.parent(chain[-1]))
+    return chain
 
 
 def _speed(t: _Take) -> list[Finding]:
