@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import motiontheater as mt
+from motiontheater.databases.check import HUMAN_JOINTS
 from motiontheater.model.rig import body_joint
 from motiontheater.model.skeleton import ROTATIONS, TRANSLATIONS
 
@@ -56,6 +57,8 @@ def inject(take: mt.Motion, kind: str, rng: np.random.Generator) -> tuple[mt.Mot
     root = body_joint(take)
     for _ in range(20):  # a place where the artifact shows: a joint that moves there
         if kind == "unit":
+            if len(take.skeleton.joint_names) < HUMAN_JOINTS:
+                return None  # no unit makes a chain of a few bones a person: the check suggests none
             factor = float(rng.choice([10.0, 0.1, 2.54, 1 / 2.54, 100.0]))
             return take.with_units(length_factor=factor), Truth("unit", None, take.first_frame, take.last_frame)
         length = {
@@ -90,6 +93,9 @@ def inject(take: mt.Motion, kind: str, rng: np.random.Generator) -> tuple[mt.Mot
             if not _moving(take, np.array([c]), span, degrees) or np.ptp(values[span, c]) * degrees < 10:
                 continue
             values[rows_hit, c] = values[start - 1, c]
+            if (values[rows_hit] == values[start - 1]).all():
+                values[rows_hit, c] = take.values[rows_hit, c]
+                continue  # nothing else moves there: a held channel is a held frame
             joint = take.channels[c][0]
             return _made(
                 take, values, Truth("frozen", joint, take.first_frame + start - 1, take.first_frame + start + n - 1)

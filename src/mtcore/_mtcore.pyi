@@ -7,6 +7,11 @@ class _Lib:
     MT_BLEND_ALIGNED_EXPMAP: int
     MT_BLEND_EXPMAP: int
     MT_BLEND_SLERP: int
+    MT_CHECK_FROZEN: int
+    MT_CHECK_GAP: int
+    MT_CHECK_REPEAT: int
+    MT_CHECK_SPIKE: int
+    MT_CHECK_STEP: int
     MT_CONTINUITY_NONE: int
     MT_CONTINUITY_PATH: int
     MT_CONTINUITY_REFERENCE: int
@@ -103,6 +108,7 @@ class _Lib:
     def mt_point_speeds(self, points_: CData, tracks_: int, frames_: int, per_frame_: int, which_: CData, count_: int, rate_: float, speed_: CData, central_: CData, /) -> int: ...
     def mt_footskate_write(self, legs_: int, frames_: int, channels_: int, values_: CData, angles_: CData, solved_: CData, columns_: CData, angle_scale_: float, root_: CData, root_columns_: CData, out_: CData, /) -> int: ...
     def mt_retarget(self, values_: CData, frames_: int, source_: CData, target_: CData, plan_: CData, begin_: int, end_: int, out_: CData, /) -> int: ...
+    def mt_check_channels(self, values_: CData, rows_: int, channels_: int, stride_: int, begin_: int, end_: int, spike_limit_: CData, step_limit_: CData, min_run_: int, events_: CData, sizes_: CData, capacity_: int, count_: CData, roughness_: CData, smooth_rows_: CData, /) -> int: ...
 
 ffi: FFI
 lib: _Lib

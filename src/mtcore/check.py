@@ -14,7 +14,7 @@ from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._status import check
 
-__all__ = ["GAP", "FROZEN", "SPIKE", "STEP", "REPEAT", "KINDS", "ChannelEvents", "channel_events"]
+__all__ = ["FROZEN", "GAP", "KINDS", "REPEAT", "SPIKE", "STEP", "ChannelEvents", "channel_events"]
 
 GAP, FROZEN, SPIKE, STEP, REPEAT = (
     lib.MT_CHECK_GAP,

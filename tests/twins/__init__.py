@@ -23,10 +23,10 @@ import numpy as np
 
 import mtcore
 from mtcore import footskate as fs
-from mtcore.check import channel_events
 from mtcore import rotations as rot
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
+from mtcore.check import channel_events
 from mtcore.combine import combine_frames
 from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
 from mtcore.retarget import RetargetPlan, retarget_rotations

@@ -47,6 +47,9 @@ JUMP_DEG = 10.0
 """Degrees a frame's change of angle must differ from the changes beside it to be a jump."""
 FLIP_DEG = 90.0
 """Degrees by which unrolled Euler angles must differ from the file's for a frame to be flipped."""
+LEAD_FRAMES = 3
+"""A take whose every frame after its first few is flipped from them has those first frames
+flipped (a rest pose before the capture), not the rest."""
 RUN_SPEED = 12.0
 """m/s: faster than any sprinter (12.4 m/s is the fastest measured): a root moving faster has
 teleported, or the unit or rate is wrong."""
@@ -164,13 +167,20 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
             if f.kind in ("flip", "frozen", "gap")
             for joint in f.joints
             for turns in _turns_of(f)
-            for frame in range(f.first - 1, f.last + 3)
+            for frame in _edges_of(f)
         }
         findings += _spikes(t, by_kind[kernel.SPIKE], by_kind[kernel.STEP], explained, spikes)
         findings += _jitter(t, found.roughness, found.smooth_rows)
         findings += _bones(t)
         findings += _speed(t)
     return sorted(findings, key=lambda f: (f.first, -f.rank, f.kind, f.joints))
+
+
+def _edges_of(finding: Finding) -> Iterable[int]:
+    """The frames whose jumps a flip (its ends), a hold or a gap (all of it) explains."""
+    if finding.kind == "flip":
+        return (*range(finding.first - 1, finding.first + 2), *range(finding.last, finding.last + 3))
+    return range(finding.first - 1, finding.last + 3)
 
 
 def _turns_of(finding: Finding) -> tuple[bool, ...]:
@@ -199,30 +209,26 @@ def _fill(t: _Take, first_row: int, last_row: int, joints: Iterable[str] | None)
 
 
 def _joint_runs(
-    t: _Take, events: np.ndarray, sizes: np.ndarray, pad: int = 0
+    t: _Take, events: np.ndarray, sizes: np.ndarray, pad: int = 0, apart: bool = True
 ) -> list[tuple[str, int, int, int, float]]:
     """Events of one kind joined per joint (its rotation channels apart from its position
-    channels) where their rows overlap (within ``pad``): (joint, first row, last row, worst
+    channels, unless not ``apart``) where their rows overlap (within ``pad``): (joint, first row, last row, worst
     channel, its size)."""
     out: list[list] = []
-    group = [f"{t.channels[c].joint} {t.channels[c].turns}" for c in events[:, 0]]
+    group = np.array([f"{t.channels[c].joint} {t.channels[c].turns and apart}" for c in events[:, 0]])
     order = np.lexsort((events[:, 1], group))
     for i in order:
         c, first, last = int(events[i, 0]), int(events[i, 1]), int(events[i, 2])
         joint, size = t.channels[c].joint, float(sizes[i])
-        if (
-            out
-            and out[-1][0] == joint
-            and t.channels[out[-1][3]].turns == t.channels[c].turns
-            and first <= out[-1][2] + pad
-        ):
+        kin = not apart or (bool(out) and t.channels[out[-1][3]].turns == t.channels[c].turns)
+        if out and out[-1][0] == joint and kin and first <= out[-1][2] + pad:
             run = out[-1]
             run[2] = max(run[2], last)
             if abs(t.physical(t.channels[c], size)) > abs(t.physical(t.channels[run[3]], run[4])):
                 run[3], run[4] = c, size
         else:
             out.append([joint, first, last, c, size])
-    return [tuple(r) for r in out]  # type: ignore[misc]
+    return [(r[0], r[1], r[2], r[3], r[4]) for r in out]
 
 
 def _repeats(t: _Take, events: np.ndarray, rows: int) -> list[Finding]:
@@ -230,8 +236,8 @@ def _repeats(t: _Take, events: np.ndarray, rows: int) -> list[Finding]:
     for _, first, last, _, _ in events:
         count = last - first + 1
         seconds = count / t.rate
-        held = first <= 1 or last >= rows - 1
-        severity = "low" if held and seconds >= FILL_SECONDS else "medium"
+        held = (first <= 1 or last >= rows - 1) and seconds >= FILL_SECONDS
+        severity = "low" if held else "medium"
         what = "the take starts or ends with a held pose" if held else "dropped frames filled by repeating one"
         out.append(
             Finding(
@@ -245,7 +251,7 @@ def _repeats(t: _Take, events: np.ndarray, rows: int) -> list[Finding]:
 
 def _gaps(t: _Take, events: np.ndarray, sizes: np.ndarray) -> list[Finding]:
     out = []
-    for joint, first, last, c, _ in _joint_runs(t, events, sizes):
+    for joint, first, last, c, _ in _joint_runs(t, events, sizes, apart=False):
         seconds = (last - first + 1) / t.rate
         fix = _fill(t, first, last, [joint])
         severity = "high" if not fix else "medium"
@@ -348,12 +354,21 @@ def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
             columns = np.array([c.index for c in t.channels if c.joint == joint and c.turns])
             angles = values[:, columns]
             rolled = np.unwrap(angles, axis=0, period=360.0 / t.degrees)
-        off = np.nan_to_num(np.abs(rolled - angles).max(axis=1)) * t.degrees > FLIP_DEG
+        delta = (rolled - angles) * t.degrees
+        off = np.nan_to_num(np.abs(delta).max(axis=1)) > FLIP_DEG
+        finite = np.isfinite(angles).all(axis=1)
+        runs = _runs(off)
+        # every frame but the first few off their triple: the first frames (a rest pose) are the flipped ones
+        inverted = len(runs) == 1 and runs[0][0] <= LEAD_FRAMES and runs[0][1] == len(off) - 1
+        if inverted:
+            off = finite & ~off
         for first, last in _runs(off):
-            whole = np.all(
-                np.isclose((rolled - angles)[first : last + 1] * t.degrees / 360, np.round(
-                    (rolled - angles)[first : last + 1] * t.degrees / 360), atol=1e-6))  # fmt: skip
-            jump = float(np.nanmax(np.abs(angles[first] - angles[first - 1]))) * t.degrees if first else 0.0
+            beside = first - 1 if first > 0 else last + 1  # a frame of the other triple, for an inverted run
+            shift = delta[beside] if inverted and beside < len(delta) else delta[first : last + 1]
+            whole = bool(np.all(np.isclose(shift / 360, np.round(shift / 360), atol=1e-6)))
+            edge = first if first > 0 else min(last + 1, len(angles) - 1)
+            jump = float(np.nan_to_num(np.abs(angles[edge] - angles[edge - 1])).max()) * t.degrees if edge else 0.0
+            fixable = not whole and first > 0
             what = "wrap by whole turns" if whole else "flip to the other Euler triple of the same rotation"
             out.append(
                 Finding(
@@ -362,7 +377,7 @@ def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
                     f"{joint}'s Euler angles {what} for {last - first + 1} frame(s): a jump of {jump:.3g} deg "
                     "with no jump of the rotation",
                     t.channels[int(columns[0])].name,
-                    () if whole else (("unroll", {"joints": [joint], "frames": [t.frame(first), t.frame(last)]}),),
+                    (("unroll", {"joints": [joint], "frames": [t.frame(first), t.frame(last)]}),) if fixable else (),
                 )
             )  # fmt: skip
     return out
@@ -445,7 +460,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
             Finding(
                 t.name, "spike", tuple(j for j, _ in turned), t.frame(row), t.frame(row), "low", round(worst, 6),
                 "deg", f"frame {t.frame(row)} is another pose than the frames beside it (a rest pose?): {names} "
-                f"turn up to {worst:.3g} deg away",
+                f"{'turns' if len(turned) == 1 else 'turn'} up to {worst:.3g} deg away from them",
             )
         )  # fmt: skip
     # jumps that stay: of the root's position a teleport, of a rotation a jump (flips are found above)
@@ -506,7 +521,7 @@ def _deviations(t: _Take, joint: str, turns: bool, first: int, last: int) -> np.
         between = slerp(np.broadcast_to(q[0], (len(share), 4)), np.broadcast_to(q[-1], (len(share), 4)), share)
         return _angle_deg(q[1:-1], between)
     columns = [c.index for c in t.channels if c.joint == joint and c.turns == turns]
-    block = t.motion.values[np.ix_(around, columns)]
+    block = t.motion.values[np.ix_(around, np.array(columns, dtype=np.intp))]
     if np.isnan(block).any():
         return None
     if turns:

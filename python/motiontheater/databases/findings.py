@@ -24,6 +24,7 @@ KINDS = {
     "unit": "a height no person has in the length unit in effect",
     "skate": "a planted foot slides along the floor",
     "floor": "the feet stand below or above the floor level zero",
+    "unreadable": "the file cannot be read as a take",
 }
 """Every kind of finding, and what it means."""
 
