@@ -112,3 +112,43 @@ def test_scale_multiplies_lengths_and_refuses_a_bad_factor(data_dir):
     np.testing.assert_allclose(scaled.scale(factor=0.1).values, take.values, rtol=1e-12, atol=1e-12)
     with pytest.raises(ValueError, match="factor must be a positive number"):
         take.scale(factor=0.0)
+
+
+def test_the_html_report_sorts_and_opens_the_viewer_at_a_finding(spiked, tmp_path, capsys):
+    browsers = pytest.importorskip("test_view_browser", reason="selenium is not installed")
+    if browsers.BROWSER is None or browsers.DRIVER is None:
+        pytest.skip("no Chromium with chromedriver here (Debian: apt-get install chromium chromium-driver)")
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    report = tmp_path / "report.html"
+    assert main(["check", str(spiked), "-o", str(report), "--quiet"]) == 0
+    options = webdriver.ChromeOptions()
+    options.binary_location = browsers.BROWSER
+    for flag in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1280,800"):
+        options.add_argument(flag)
+    driver = webdriver.Chrome(service=Service(browsers.DRIVER), options=options)
+    try:
+        driver.get(report.as_uri())
+
+        def column(i):
+            return [
+                r.find_elements(By.TAG_NAME, "td")[i].text for r in driver.find_elements(By.CSS_SELECTOR, "tbody tr")
+            ]
+
+        ranks = [{"low": 0, "medium": 1, "high": 2}[s] for s in column(0)]
+        assert ranks == sorted(ranks, reverse=True) and len(ranks) >= 2  # worst first
+        driver.find_element(By.XPATH, "//th[text()='kind']").click()
+        assert column(1) == sorted(column(1))
+        assert driver.find_elements(By.CSS_SELECTOR, "svg.plot polyline")  # the worst channels are drawn
+        spike = driver.find_element(By.XPATH, "//tr[td[2]='spike' and td[4]='lfemur']//a")
+        spike.click()
+        WebDriverWait(driver, 30).until(lambda d: d.execute_script("return document.body.dataset.ready === '1'"))
+        state = driver.execute_script(
+            "const s = window.mtView.state; return [s.cur, s.selected, s.takes[0].joints[s.selected]]"
+        )
+        assert state[0] == 99 and state[2] == "lfemur"  # frame 100 is row 99
+    finally:
+        driver.quit()

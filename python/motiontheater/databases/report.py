@@ -175,7 +175,7 @@ _SCRIPT = """
   }
   Array.from(heads).forEach((h, i) => {
     if (h.dataset.sort === undefined) return;
-    h.addEventListener("click", () => sort(i, h.getAttribute("aria-sort") !== "descending"));
+    h.addEventListener("click", () => sort(i, h.getAttribute("aria-sort") === "ascending"));
   });
   sort(0, true);
 })();
