@@ -65,6 +65,7 @@ class CheckJob:
     unit: str | None = None
     bytes: int = 0
     views: str | None = None  # a folder for the viewer page of a take with medium or high findings
+    curves: bool = False  # the curve of each finding, for a report's plots
 
 
 def check_job(job: CheckJob) -> TakeCheck:
@@ -76,7 +77,7 @@ def check_job(job: CheckJob) -> TakeCheck:
         unreadable = Finding(job.take, "unreadable", (), 0, -1, "high", 0.0, "", reason)
         return TakeCheck(job.take, job.relative, (unreadable,), (None,), bytes=job.bytes)
     findings = tuple(check_motion(motion, job.take))
-    curves = tuple(_curve(motion, f) for f in findings)
+    curves = tuple(_curve(motion, f) for f in findings) if job.curves else ()
     view = None
     if job.views is not None and any(f.severity != "low" for f in findings):
         from ..views.viewer import write_page
@@ -106,8 +107,10 @@ def _curve(motion, finding: Finding) -> Curve | None:
     else:
         values = values * skeleton.meters_per_unit
         unit = "m"
-    shown = tuple(None if not np.isfinite(v) else round(float(v), 6) for v in values)
-    return Curve(tuple(int(r) + motion.first_frame for r in rows), shown, unit)
+    shown = np.round(values, 6).tolist()
+    if not np.isfinite(values).all():
+        shown = [v if np.isfinite(v) else None for v in shown]
+    return Curve(tuple((rows + motion.first_frame).tolist()), tuple(shown), unit)
 
 
 def plan(
@@ -117,9 +120,11 @@ def plan(
     frame_rate: float | None = None,
     unit: str | None = None,
     views: str | os.PathLike | None = None,
+    curves: bool = False,
 ) -> list[CheckJob]:
     """A job per AMC and BVH take under the inputs (files, folders searched recursively, globs);
-    ``views``: the folder where each take with medium or high findings gets its viewer page."""
+    ``views``: the folder where each take with medium or high findings gets its viewer page;
+    ``curves``: keep each finding's curve (for an HTML report's plots)."""
     jobs = []
     for take, relative in find_takes(inputs):
         try:
@@ -127,7 +132,7 @@ def plan(
         except OSError:
             size = 0
         folder = None if views is None else os.fspath(views)
-        jobs.append(CheckJob(os.fspath(take), relative.as_posix(), asf, frame_rate, unit, size, folder))
+        jobs.append(CheckJob(os.fspath(take), relative.as_posix(), asf, frame_rate, unit, size, folder, curves))
     return jobs
 
 
