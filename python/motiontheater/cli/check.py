@@ -49,7 +49,15 @@ def _check(args: argparse.Namespace) -> int:
     views = None
     if report is not None and Path(report).suffix.lower() == ".html":
         views = Path(report).with_name(Path(report).stem + "_views")
-    jobs = plan(args.inputs, asf=args.asf, frame_rate=args.frame_rate, unit=args.unit, views=views, curves=bool(views))
+    jobs = plan(
+        args.inputs,
+        asf=args.asf,
+        frame_rate=args.frame_rate,
+        unit=args.unit,
+        views=views,
+        curves=bool(views),
+        body=args.body,
+    )
     if not jobs:
         raise ValueError(f"no AMC or BVH take under {' '.join(args.inputs)}")
     start = time.perf_counter()

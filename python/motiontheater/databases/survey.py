@@ -14,6 +14,7 @@ import numpy as np
 from .._io import output
 from ..formats.table import read_take
 from ..model.errors import FormatError
+from ..model.rig import choose_body
 from .batch import Progress, find_takes, run_each
 from .check import check_motion, recipe
 from .findings import Finding
@@ -66,6 +67,7 @@ class CheckJob:
     bytes: int = 0
     views: str | None = None  # a folder for the viewer page of a take with medium or high findings
     curves: bool = False  # the curve of each finding, for a report's plots
+    body: str | None = None  # the joint that carries the body, where the take's own is not it
 
 
 def check_job(job: CheckJob) -> TakeCheck:
@@ -76,6 +78,8 @@ def check_job(job: CheckJob) -> TakeCheck:
         reason = str(e) if job.take in str(e) else f"{job.take}: {e}"
         unreadable = Finding(job.take, "unreadable", (), 0, -1, "high", 0.0, "", reason)
         return TakeCheck(job.take, job.relative, (unreadable,), (None,), bytes=job.bytes)
+    if job.body is not None:  # a joint the take lacks is the caller's mistake: it stops the run
+        motion = choose_body(motion, job.body)
     findings = tuple(check_motion(motion, job.take))
     curves = tuple(_curve(motion, f) for f in findings) if job.curves else ()
     view = None
@@ -121,6 +125,7 @@ def plan(
     unit: str | None = None,
     views: str | os.PathLike | None = None,
     curves: bool = False,
+    body: str | None = None,
 ) -> list[CheckJob]:
     """A job per AMC and BVH take under the inputs (files, folders searched recursively, globs);
     ``views``: the folder where each take with medium or high findings gets its viewer page;
@@ -132,7 +137,7 @@ def plan(
         except OSError:
             size = 0
         folder = None if views is None else os.fspath(views)
-        jobs.append(CheckJob(os.fspath(take), relative.as_posix(), asf, frame_rate, unit, size, folder, curves))
+        jobs.append(CheckJob(os.fspath(take), relative.as_posix(), asf, frame_rate, unit, size, folder, curves, body))
     return jobs
 
 
