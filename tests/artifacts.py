@@ -7,16 +7,19 @@ frames around it (which the fixes interpolate from) are the take's own."""
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 import motiontheater as mt
 from motiontheater.databases.check import HUMAN_JOINTS
+from motiontheater.feet.contacts import detect_contacts, runs
+from motiontheater.feet.footskate import prepare
 from motiontheater.model.rig import body_joint
 from motiontheater.model.skeleton import ROTATIONS, TRANSLATIONS
 
-KINDS = ("spike", "flip", "gap", "frozen", "teleport", "unit")
+KINDS = ("spike", "flip", "gap", "frozen", "teleport", "unit", "skate")
 MARGIN = 8
 
 
@@ -56,6 +59,8 @@ def inject(take: mt.Motion, kind: str, rng: np.random.Generator) -> tuple[mt.Mot
     triples = _triples(take)
     root = body_joint(take)
     for _ in range(20):  # a place where the artifact shows: a joint that moves there
+        if kind == "skate":
+            return _skate(take, rng)
         if kind == "unit":
             if len(take.skeleton.joint_names) < HUMAN_JOINTS:
                 return None  # no unit makes a chain of a few bones a person: the check suggests none
@@ -92,6 +97,9 @@ def inject(take: mt.Motion, kind: str, rng: np.random.Generator) -> tuple[mt.Mot
             span = slice(start - 2, start + n + 2)
             if not _moving(take, np.array([c]), span, degrees) or np.ptp(values[span, c]) * degrees < 10:
                 continue
+            before, after = slice(start - 6, start), slice(start + n, start + n + 6)
+            if not (_moving(take, np.array([c]), before, degrees) and _moving(take, np.array([c]), after, degrees)):
+                continue  # a hold beside a hold the take has is one hold, not the injection's
             values[rows_hit, c] = values[start - 1, c]
             if (values[rows_hit] == values[start - 1]).all():
                 values[rows_hit, c] = take.values[rows_hit, c]
@@ -120,6 +128,53 @@ def inject(take: mt.Motion, kind: str, rng: np.random.Generator) -> tuple[mt.Mot
         truth = Truth(kind, joint, take.first_frame + start, take.first_frame + start + n - 1)
         return _made(take, values, truth)
     return None
+
+
+SKATE_SPEED = 0.25  # m/s: slow enough that the sliding foot still reads as planted
+SKATE_SECONDS = 0.6  # the shortest plant slid: 15 cm or more
+
+
+def _skate(take: mt.Motion, rng: np.random.Generator) -> tuple[mt.Motion, Truth] | None:
+    """The take with the body pushed along the floor at SKATE_SPEED through one of its plants, and
+    kept where that leaves it: the planted foot slides (the body's translation moves it)."""
+    root = body_joint(take)
+    columns = take.columns(root, TRANSLATIONS)
+    if len(columns) != 3 or not np.ptp(take.values[:, columns], axis=0).all():
+        return None  # a body that never moves is no place to push
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            arrays, ground, mpu = prepare(take)
+    except ValueError:
+        return None  # no legs
+    masks = detect_contacts(arrays, ground, take.frame_rate, mpu, take.first_frame).masks(arrays.legs)
+    shortest = round(SKATE_SECONDS * take.frame_rate)
+    plants = [
+        (int(s), int(e))
+        for row in masks.transpose(0, 2, 1).reshape(-1, masks.shape[1])
+        for s, e in zip(*runs(row))
+        if e - s >= shortest and s >= MARGIN and e <= take.frames - MARGIN
+    ]
+    if not plants:
+        return None
+    start, end = plants[int(rng.integers(len(plants)))]
+    up = np.asarray(ground.up)
+    direction = np.cross(up, rng.normal(size=3))
+    direction /= np.linalg.norm(direction)
+    # how a unit of each translation channel moves the body in the world (a static root above
+    # it may turn it): the channels that move it along the direction
+    frame = take.crop(take.first_frame + start, take.first_frame + start)
+    body = take.skeleton.joint_names.index(root)
+    moved = []
+    for c in columns:
+        values = frame.values.copy()
+        values[0, c] += 1.0
+        moved.append(frame.replace(values=values).positions()[0, body] - frame.positions()[0, body])
+    per_unit = np.linalg.solve(np.array(moved).T, direction)  # channel units per world unit
+    ramp = np.minimum(np.arange(take.frames) - start, end - start).clip(0) / take.frame_rate
+    values = take.values.copy()
+    values[:, columns] += (ramp * SKATE_SPEED / mpu)[:, None] * per_unit
+    return _made(take, values, Truth("skate", None, take.first_frame + start, take.first_frame + end - 1))
 
 
 def _made(take: mt.Motion, values: np.ndarray, truth: Truth) -> tuple[mt.Motion, Truth]:

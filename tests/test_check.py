@@ -14,6 +14,7 @@ from corpus import real_files
 from motiontheater.databases.check import check_motion, recipe
 from motiontheater.databases.findings import KINDS as FINDING_KINDS
 from motiontheater.databases.findings import SEVERITIES
+from motiontheater.feet.footskate import prepare
 from variants import with_offset_channels, with_static_root
 
 TAKES = real_files("*/*.amc") + real_files("*/*.bvh")
@@ -154,3 +155,44 @@ def _smooth_take(rate: float) -> mt.Motion:
     values = 20 * np.sin(2 * np.pi * 0.8 * t + phase)
     values[:, :3] = np.hstack([t * 10, np.full_like(t, 17.0), t * 5])  # a walk at 1 m/s in inch/0.45
     return mt.Motion(skeleton, values, frame_rate=rate)
+
+
+def _walk():
+    cmu = real_files("cmu/02_01.amc")
+    if not cmu:
+        pytest.skip("the real-file corpus (../shared/data) is absent")
+    return mt.read_take(cmu[0])
+
+
+def _legs_found(take, kind):
+    return [f for f in check_motion(take) if f.kind == kind]
+
+
+def test_a_knee_bent_backwards_is_found_where_it_is():
+    take = _walk()
+    assert _legs_found(take, "knee") == []
+    values = take.values.copy()
+    (column,) = take.columns("ltibia", ("rx",))
+    bend = np.sign(np.median(values[:, column]))  # the way this knee bends
+    values[100:110, column] = -bend * 40.0
+    (finding,) = _legs_found(take.replace(values=values), "knee")
+    assert finding.joints == ("ltibia",) and (finding.first, finding.last) == (101, 110)
+    assert 35 < finding.size < 45 and finding.unit == "deg"
+
+
+def test_feet_in_the_floor_and_a_floor_away_from_zero_are_found_in_metres():
+    take = _walk()
+    assert _legs_found(take, "penetration") == [] and _legs_found(take, "floor") == []
+    (ty,) = take.columns("root", ("ty",))
+    metre = 1 / take.skeleton.meters_per_unit
+    values = take.values.copy()
+    values[200:218, ty] -= 0.15 * metre
+    found = _legs_found(take.replace(values=values), "penetration")
+    assert found and all(195 <= f.first and f.last <= 225 for f in found), found
+    arrays, ground, mpu = prepare(take)
+    lowest = np.min(ground.heights(arrays.points)[:, 200:218], axis=(0, 2)) * mpu  # the clean feet there
+    assert max(f.size for f in found) == pytest.approx(0.15 - lowest.min(), abs=0.01)
+    values = take.values.copy()
+    values[:, ty] += 0.5 * metre
+    (floor,) = _legs_found(take.replace(values=values), "floor")
+    assert floor.severity == "low" and floor.size == pytest.approx(0.5, abs=0.06) and floor.unit == "m"

@@ -109,7 +109,7 @@ def _listing(checks, least: str) -> None:
 
 CHECK = Verb(
     "check",
-    "find what is wrong with each take (spikes, flips, gaps, frozen channels, teleports, units) and the recipe that fixes it",
+    "find what is wrong with each take (spikes, flips, gaps, frozen channels, teleports, skating feet, units) and the recipe that fixes it",
     _arguments,
     _check,
     description=(

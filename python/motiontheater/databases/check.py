@@ -7,12 +7,14 @@ only if the joint's rotation leaves its neighbours (near gimbal lock the angles 
 rotation does not); a jump of the angles with no jump of the rotation is a flip; a jump of the
 root that no runner makes is a teleport; a held value is frozen only where the channel moves
 around it.  Every limit is stated in degrees, metres, seconds and Hz below and converted with
-the skeleton's length unit and the take's frame rate.
+the skeleton's length unit and the take's frame rate.  The legs (skating and sinking feet, the
+floor, knees bent backwards) are judged in :mod:`.check_feet`.
 
 Each finding carries the steps that fix it, confined to its frames and joints (see
 :func:`recipe`): missing, spiked, frozen and repeated frames are dropped and filled from the
 frames around them (``fill_gaps``), flips unrolled (``unroll``), a unit off by a known factor
-rescaled (``scale``), jitter low-passed (``butterworth`` at Winter's cut-off).
+rescaled (``scale``), jitter low-passed (``butterworth`` at Winter's cut-off), skating feet held
+(``cleanup`` over their frames).
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from ..model.motion import Motion
 from ..model.rig import body_joint
 from ..model.skeleton import ROTATIONS, TRANSLATIONS
 from ..model.units import HUMAN_HEIGHT
+from .check_feet import leg_findings
 from .findings import Finding
 
 SPIKE_DEG = 5.0
@@ -113,6 +116,10 @@ class _Take:
         """A value of the channel in degrees or metres."""
         return value * (self.degrees if channel.turns else self.meters)
 
+    def gaps(self, joint: str) -> bool:
+        """Whether the joint's channels miss values (NaN) anywhere."""
+        return bool(np.isnan(self.motion.values[:, self.motion.columns(joint)]).any())
+
     def unit(self, channel: _Channel) -> str:
         return "deg" if channel.turns else "m"
 
@@ -173,6 +180,7 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         findings += _jitter(t, found.roughness, found.smooth_rows)
         findings += _bones(t)
         findings += _speed(t)
+        findings += leg_findings(motion, take, t.meters)
     return sorted(findings, key=lambda f: (f.first, -f.rank, f.kind, f.joints))
 
 
@@ -568,7 +576,8 @@ def _jitter(t: _Take, roughness: np.ndarray, counts: np.ndarray) -> list[Finding
                 t.name, "jitter", (joint,), t.motion.first_frame, t.motion.last_frame, severity, round(level, 6),
                 t.unit(channel), f"{channel.name} jitters by about {level:.3g} {t.unit(channel)} frame to frame",
                 channel.name,
-                (("butterworth", {"joints": [joint]}),) if severity == "medium" else (),
+                # a low pass needs every value: a joint with a gap left unfilled gets none
+                (("butterworth", {"joints": [joint]}),) if severity == "medium" and not t.gaps(joint) else (),
             )
         )  # fmt: skip
     return out
@@ -662,8 +671,9 @@ def _unit(t: _Take) -> list[Finding]:
 
 def recipe(findings: Iterable[Finding], severities: tuple[str, ...] = ("medium", "high")) -> Pipeline:
     """The steps that fix the findings of ``severities`` (those with a fix): unit first, then
-    flips, then the frames filled, then smoothing, each confined to its frames and joints."""
-    order = ("scale", "unroll", "fill_gaps", "butterworth")
+    flips, then the frames filled, then smoothing, then the feet, each confined to its frames and
+    joints."""
+    order = ("scale", "unroll", "fill_gaps", "butterworth", "cleanup")
     entries = [step for f in findings if f.severity in severities for step in f.fix]
     entries.sort(key=lambda e: order.index(e[0]) if e[0] in order else len(order))
     pipeline = Pipeline()

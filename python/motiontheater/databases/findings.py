@@ -23,7 +23,9 @@ KINDS = {
     "bone": "the length of a bone with position channels drifts",
     "unit": "a height no person has in the length unit in effect",
     "skate": "a planted foot slides along the floor",
-    "floor": "the feet stand below or above the floor level zero",
+    "penetration": "a foot goes into the floor",
+    "floor": "the feet rest on a floor away from level zero",
+    "knee": "a knee bent backwards past what knees do",
     "unreadable": "the file cannot be read as a take",
 }
 """Every kind of finding, and what it means."""

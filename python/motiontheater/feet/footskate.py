@@ -52,6 +52,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Literal
@@ -62,9 +63,9 @@ from mtcore import footskate as kernels
 
 from ..model import units
 from ..model.motion import Motion
-from ..model.registry import Joints, step
+from ..model.registry import Frames, Joints, step
 from ..model.rig import body_view
-from .contacts import DEFAULT, Contacts, Thresholds, detect_contacts, plant_targets
+from .contacts import DEFAULT, Contacts, Plant, Thresholds, detect_contacts, plant_targets
 from .legs import Ground, LegArrays, Legs, fit_ground, leg_arrays, resolve_legs
 
 UP_AXES = ("x", "y", "z", "-x", "-y", "-z")
@@ -187,6 +188,8 @@ def clean_footskate(
     knee_soft: float = 3.0,
     thresholds: Thresholds = DEFAULT,
     workers: int | None = None,
+    frames: tuple[int, int] | None = None,
+    plants: Iterable[Plant] = (),
 ) -> Cleanup:
     """Footskate cleanup of a motion, with what it stood on (see :class:`Cleanup` and the
     module docstring); the step ``cleanup`` (``motion.cleanup(...)``, ``motiontheater
@@ -205,6 +208,11 @@ def clean_footskate(
       of straight that a constrained knee keeps unless the input's is straighter.
     - ``workers``: threads for the two legs (None: both on takes of 1,000 frames or more; 1: the
       calling thread only).
+    - ``frames``: (first, last) frame numbers: only the plants within them are held and only
+      those frames change (the take check's recipes give a range ``blend`` seconds wider than
+      the plants, so that the adjustments fade within it); default: all.
+    - ``plants``: footplants to hold besides the table's (those the take check found sliding,
+      which detection, holding no point faster than 0.45 m/s, may not plant).
 
     Raises ValueError (UnknownNameError and FormatError among its kinds) naming
     what is wrong: no recognisable legs, contacts of another take, a floor
@@ -217,11 +225,19 @@ def clean_footskate(
         raise ValueError(f"knee_soft must be below 90 degrees, got {knee_soft}")
     if up is not None and (not isinstance(up, str) or up.strip().lower().lstrip("+") not in UP_AXES):
         raise ValueError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
-    view = body_view(motion)
+    given, view = motion, body_view(motion)
     motion = view.motion
     root_columns = _root_translation(motion, view.body)
     arrays, ground, mpu = prepare(motion, legs=legs, up=up, floor=floor, meters_per_unit=meters_per_unit)
     table = contacts_of(contacts, motion, arrays, ground, mpu, thresholds)
+    plants = tuple(plants)
+    if plants:
+        table = Contacts([*table.plants, *plants], table.first_frame, table.frames, table.frame_rate)
+        table.masks(arrays.legs)  # every foot named is one of the legs'
+    rows = _rows(motion, frames)
+    if frames is not None:
+        masks = _within(table.masks(arrays.legs), rows, axis=1)
+        table = Contacts.from_masks(masks, arrays.legs, motion.first_frame, motion.frame_rate)
     masks = table.masks(arrays.legs)
     options = kernels.CleanupOptions(
         up=(float(ground.up[0]), float(ground.up[1]), float(ground.up[2])),
@@ -247,12 +263,16 @@ def clean_footskate(
         motion.values, arrays.angles, angles, arrays.columns, arrays.angle_scale, root, root_columns
     )
     values.flags.writeable = False
-    return Cleanup(view.restore(motion.replace(values=values)), table, ground, arrays.legs, root, enforced, mpu)
+    cleaned = view.restore(motion.replace(values=values))
+    if frames is not None:  # the floor's lifts outside the range are not asked for, nor the
+        # last bits of the body view's round trip
+        values = _within(cleaned.values, rows, given.values)
+        values.flags.writeable = False
+        cleaned, root = cleaned.replace(values=values), _within(root, rows)
+    return Cleanup(cleaned, table, ground, arrays.legs, root, enforced, mpu)
 
 
-@step(
-    "cleanup", "footskate cleanup: planted heels and balls held still on the floor (Kovar et al. 2002)", frames="none"
-)
+@step("cleanup", "footskate cleanup: planted heels and balls held still on the floor (Kovar et al. 2002)", frames="own")
 def cleanup(
     motion: Motion,
     *,
@@ -265,6 +285,12 @@ def cleanup(
     legs: Annotated[Joints, "hip,knee,ankle[,toe] of the left then the right leg (default: found by name)"] = None,
     blend: Annotated[float, "seconds over which adjustments fade in and out around plants"] = 0.2,
     knee_soft: Annotated[float, "degrees short of straight that a constrained knee keeps"] = 3.0,
+    frames: Annotated[
+        Frames, "hold the plants within frames FIRST..LAST only and change no other frame (default: all)"
+    ] = None,
+    plants: Annotated[
+        tuple[str, ...] | None, "plants to hold besides those detected, each FOOT:heel|ball:FIRST:LAST (frame numbers)"
+    ] = None,
 ) -> Motion:
     """Hold planted feet still on the floor: every planted heel and ball at one target per plant,
     the legs solved analytically and the root moved where a leg cannot reach.
@@ -283,7 +309,40 @@ def cleanup(
         floor=floor,
         blend=blend,
         knee_soft=knee_soft,
+        frames=frames,
+        plants=[_plant(text) for text in plants or ()],
     ).motion
+
+
+def _plant(text: str) -> Plant:
+    """A plant written FOOT:POINT:FIRST:LAST (the foot's name may hold colons: Mixamo's do)."""
+    parts = str(text).rsplit(":", 3)
+    usage = f"a plant is FOOT:heel|ball:FIRST:LAST (frame numbers), got {text!r}"
+    if len(parts) != 4 or not all(p.strip().lstrip("-").isdigit() for p in parts[2:]):
+        raise ValueError(usage)
+    try:
+        return Plant(parts[0], parts[1], int(parts[2]), int(parts[3]))
+    except ValueError as error:
+        raise ValueError(f"{usage}: {error}") from None
+
+
+def _rows(motion: Motion, frames: tuple[int, int] | None) -> slice:
+    """The rows of frames first..last (frame numbers), checked to be the motion's."""
+    if frames is None:
+        return slice(0, motion.frames)
+    if not motion.first_frame <= frames[0] <= frames[1] <= motion.last_frame:
+        raise ValueError(
+            f"frames {frames[0]}:{frames[1]} are not within the motion's frames {motion.first_frame}..{motion.last_frame}"
+        )
+    return slice(frames[0] - motion.first_frame, frames[1] - motion.first_frame + 1)
+
+
+def _within(a: np.ndarray, rows: slice, outside: np.ndarray | None = None, axis: int = 0) -> np.ndarray:
+    """``a`` at ``rows`` of its frame ``axis``; elsewhere ``outside`` (default zero, False)."""
+    out = np.zeros_like(a) if outside is None else outside.copy()
+    index = (slice(None),) * axis + (rows,)
+    out[index] = a[index]
+    return out
 
 
 def _root_translation(motion: Motion, body: str = "root") -> list[int]:

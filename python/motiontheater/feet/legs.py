@@ -25,7 +25,9 @@ ball does.  A rig whose rest pose does not stand (its foot more than 45
 degrees from horizontal there, e.g. pointing down the leg) takes it from the
 take instead: the point below the ankle, along the world's up axis seen from
 the foot, at the ball's depth, in the frames where ankle and ball both rest
-low and still (flat stance); a take without such frames raises ValueError.
+low and still (flat stance: within 0.2 m/s and 2 cm of their lowest tenth, or twice or four
+times that in a take with fewer than three such frames); a take without such frames raises
+ValueError.
 
 The floor is a plane: the level at which the lowest contact point rests,
 tilted as the resting contact points say (capture volumes are often
@@ -498,12 +500,15 @@ def _heel_from_take(
 ) -> np.ndarray:
     """The heel of one leg, in the foot's frame, from the take's flat stance (module docstring)."""
     ankle, ball = points[:, 1], points[:, 2]
-    slow = _FLAT_SPEED * body_scale(legs, mpu) / mpu
-    band = _FLAT_BAND / mpu
-    flat = np.ones(len(points), bool)
-    for p in (ankle, ball):
-        h = p @ up
-        flat &= (speeds(p, frame_rate) < slow) & (h <= np.nanpercentile(h, 10) + band)
+    for looser in (1, 2, 4):  # a take with few flat frames (a jump, a fall) has them less still
+        slow = looser * _FLAT_SPEED * body_scale(legs, mpu) / mpu
+        band = looser * _FLAT_BAND / mpu
+        flat = np.ones(len(points), bool)
+        for p in (ankle, ball):
+            h = p @ up
+            flat &= (speeds(p, frame_rate) < slow) & (h <= np.nanpercentile(h, 10) + band)
+        if flat.sum() >= 3:
+            break
     if flat.sum() < 3:
         raise ValueError(
             f"{legs.legs[i].side} leg: the rest pose does not stand on its foot and the take has no flat "

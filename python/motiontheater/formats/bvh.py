@@ -72,8 +72,8 @@ def read_bvh(source: Source, *, unit: str | None = None, frame_rate: float | Non
 
 
 def _posed(motion: Motion) -> Skeleton:
-    """The skeleton, sized from the take's poses where its rest pose tells no unit or tells it
-    only by an extent other than its height (a rig drawn along x, a rest pose lying down); and
+    """The skeleton, sized from the take's poses where its rest pose does not stand, tells no unit,
+    or tells it only by an extent other than its height (a rig drawn along x, lying down); and
     where the rest pose does not stand, with the channels of the frame that stands best
     (``Skeleton.standing``: what retargeting plans such a rig on)."""
     skeleton = motion.skeleton
@@ -83,8 +83,10 @@ def _posed(motion: Motion) -> Skeleton:
         return skeleton
     if not stands:
         skeleton = replace(skeleton, standing=standing_frame(motion))
-    if rest.unit is not None and rest.axis == rest.up:
+    elif rest.unit is not None and rest.axis == rest.up:
         return skeleton
+    # a rest pose that does not stand has no height: its extent along z or y is a lying or
+    # T-posed body's (LAFAN's lies 2.1 m along z in cm; the same take in mm would pass for cm)
     posed = size_up_poses(sampled_poses(motion), cmu=skeleton.cmu_named)
     return replace(skeleton, posed=posed) if posed.unit is not None else skeleton
 

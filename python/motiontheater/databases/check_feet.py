@@ -1,0 +1,205 @@
+"""The take check's findings on the legs: planted feet that slide (skate), feet below the floor
+(penetration), a floor away from level zero, and knees bent backwards.
+
+The legs, the floor and the footplants are found as footskate cleanup finds them
+(:mod:`motiontheater.feet`), so that what the check calls a skate is what the cleanup fixes, and
+the recipe for it is the ``cleanup`` step over the plant's frames and the fades around them.
+Feet in the floor are reported, not fixed: where the floor is depends on the frames the floor is
+fitted to, and a recipe that moves the legs on a guess of it is no repair.  A
+take without recognisable legs (a hand, a chain of bones) has no findings here.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+from ..feet.contacts import runs
+from ..feet.footskate import prepare
+from ..feet.legs import Ground, LegArrays, speeds
+from ..feet.skate import knee_bends
+from ..model.motion import Motion
+from ..model.rig import body_view
+from .findings import Finding
+
+SKATE_M = 0.12
+"""Metres a planted heel or ball must slide over its plant to skate (a real plant moves 1-5 cm as
+the foot settles; 12 cm is a foot that visibly slides); three times as far is high."""
+SKATE_HEIGHT, SKATE_SPEED, SKATE_SECONDS = 0.03, 0.6, 0.25
+SKATE_AROUND = 2.0
+"""A heel or ball within 3 cm of its lowest in the SKATE_AROUND seconds before and after, slower
+than 0.6 m/s, for 0.25 s or more, is on the floor (a swinging foot passes lower, but faster)."""
+PENETRATION_M = 0.05
+"""Metres a heel, ball or toe tip must sink below where it rests on the floor, for
+PENETRATION_SECONDS or more, to be in the floor."""
+PENETRATION_SECONDS = 0.1
+FLOOR_M = 0.15
+"""Metres the floor the feet rest on may lie from level zero before the check says so (a joint
+centre rests a few centimetres above the sole)."""
+KNEE_BACK_DEG = 20.0
+"""Degrees a knee may bend backwards (past straight; 5-10 degrees is human) before it is bent
+backwards; 45 is high.  Bends the other way deeper than 90 degrees are not counted: there the
+knee's hinge turns with the thigh and says nothing of which way the knee bends."""
+FOOT_ACROSS = math.cos(math.radians(45))
+"""A foot within 45 degrees of square to the shin tells which way the knee bends."""
+BLEND_SECONDS = 0.2 + 0.1
+"""The cleanup's fades (its blend) and root smoothing: a recipe's cleanup range reaches this far
+beyond the frames it fixes, so that the adjustments fade within it."""
+
+
+def leg_findings(motion: Motion, take: str, meters: float) -> list[Finding]:
+    """The findings on the legs of a take whose length unit is ``meters`` metres."""
+    if motion.frames < 2:
+        return []
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the take's unit and rig are the check's own findings
+            arrays, ground, mpu = prepare(motion, meters_per_unit=meters)
+    except ValueError:
+        return []  # no legs, or none that are numbers: nothing to judge here
+    context = _Legs(motion, take, arrays, ground, mpu)
+    return context.skates() + context.penetrations() + context.floor() + context.knees()
+
+
+class _Legs:
+    def __init__(self, motion: Motion, take: str, arrays: LegArrays, ground: Ground, mpu: float):
+        self.motion, self.take, self.arrays, self.ground, self.mpu = motion, take, arrays, ground, mpu
+        self.up = np.asarray(ground.up)
+        view = body_view(motion).motion  # the cleanup moves the body: it needs its translation
+        self.movable = {"tx", "ty", "tz"} <= set(view.skeleton.dofs("root"))
+
+    def frame(self, row: int) -> int:
+        return self.motion.first_frame + int(row)
+
+    def cleanup(self, first: int, last: int, plant: tuple[str, str] | None = None) -> tuple:
+        """The cleanup step over rows first..last and the fades around them, holding the foot's
+        point (foot, "heel" or "ball") over them where given; none where the body cannot move."""
+        if not self.movable:
+            return ()
+        margin = round(BLEND_SECONDS * self.motion.frame_rate) + 1
+        a, b = max(first - margin, 0), min(last + margin, self.motion.frames - 1)
+        options: dict = {"frames": [self.frame(a), self.frame(b)]}
+        if plant is not None:
+            options["plants"] = [f"{plant[0]}:{plant[1]}:{self.frame(first)}:{self.frame(last)}"]
+        return (("cleanup", options),)
+
+    def skates(self) -> list[Finding]:
+        """Runs of frames in which a heel or ball stays on the floor and slower than a step, over
+        which it slides farther than SKATE_M: found without the footplants, which a slide splits."""
+        arrays, legs = self.arrays, self.arrays.legs
+        shortest = max(2, round(SKATE_SECONDS * self.motion.frame_rate))
+        window = max(1, round(SKATE_AROUND * self.motion.frame_rate))
+        out = []
+        for i, foot in enumerate(legs.feet):
+            slides = []  # (first row, last row, metres, point)
+            for k, (column, point) in enumerate(((3, "heel"), (2, "ball"))):
+                p = arrays.points[i, :, column]
+                vertical = p @ self.up
+                p = p - vertical[:, None] * self.up
+                # the height above the point's own lowest in the seconds around (not the fitted
+                # floor, which moves with the frames that rest: a foot that slides rests in none;
+                # nor its lowest over the take, which a crouch or a step down sets elsewhere)
+                low = (vertical - _lowest_around(vertical, window)) * self.mpu < SKATE_HEIGHT
+                slow = speeds(p, self.motion.frame_rate) * self.mpu < SKATE_SPEED
+                for s, e in zip(*runs(low & slow)):
+                    if e - s < shortest:
+                        continue
+                    slide = float(np.linalg.norm(p[s:e] - p[s], axis=-1).max()) * self.mpu
+                    if slide > SKATE_M:
+                        slides.append((int(s), int(e) - 1, slide, point))
+            for first, last, slide, point in _merged(slides):
+                out.append(
+                    Finding(
+                        self.take, "skate", (foot,), self.frame(first), self.frame(last),
+                        "high" if slide > 3 * SKATE_M else "medium", round(slide, 6), "m",
+                        f"the {point} of {foot} slides {slide:.3g} m along the floor", None,
+                        self.cleanup(first, last, (foot, point)),
+                    )
+                )  # fmt: skip
+        return out
+
+    def penetrations(self) -> list[Finding]:
+        legs = self.arrays.legs
+        heights = self.ground.heights(self.arrays.points) * self.mpu  # (legs, frames, 3) heel, ball, tip
+        shortest = max(1, round(PENETRATION_SECONDS * self.motion.frame_rate))
+        out = []
+        for i, foot in enumerate(legs.feet):
+            points = 3 if legs.points[i, 4] >= 0 else 2
+            with np.errstate(invalid="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # frames of NaN (a gap) sink nowhere
+                depth = -np.nanmin(heights[i, :, :points], axis=1)
+            for s, e in zip(*runs(np.nan_to_num(depth) > PENETRATION_M)):
+                if e - s < shortest:
+                    continue
+                worst = float(depth[s:e].max())
+                out.append(
+                    Finding(
+                        self.take, "penetration", (foot,), self.frame(s), self.frame(e - 1), "medium",
+                        round(worst, 6), "m", f"{foot} goes {worst:.3g} m into the floor",
+                    )
+                )  # fmt: skip
+        return out
+
+    def floor(self) -> list[Finding]:
+        level = self.ground.level * self.mpu
+        if abs(level) <= FLOOR_M:
+            return []
+        axis = "".join(f"{'-' if v < 0 else ''}{'xyz'[i]}" for i, v in enumerate(self.ground.up) if abs(v) > 0.5)
+        return [
+            Finding(
+                self.take, "floor", (), self.motion.first_frame, self.motion.last_frame, "low", round(level, 6),
+                "m", f"the feet rest on a floor {abs(level):.3g} m {'above' if level > 0 else 'below'} level zero "
+                f"(up is {axis or 'tilted'})",
+            )
+        ]  # fmt: skip
+
+    def knees(self) -> list[Finding]:
+        arrays, legs = self.arrays, self.arrays.legs
+        bends = knee_bends(arrays)
+        thigh = arrays.points[:, :, 0] - arrays.hips
+        shin = arrays.points[:, :, 1] - arrays.points[:, :, 0]
+        foot = arrays.points[:, :, 2] - arrays.points[:, :, 1]
+        # a knee bends the shin away from where the foot points: the turn from thigh to shin is
+        # the other way round than the turn from shin to foot, at any bend and any hip; told only
+        # where the foot stands across the shin (a pointed foot lies along it) and the knee is
+        # not folded (where the turns' axes are of little length)
+        turns = np.sum(np.cross(thigh, shin) * np.cross(shin, foot), axis=-1)
+        across = np.abs(_cosine(shin, foot)) < FOOT_ACROSS
+        backwards = np.where((turns > 0) & across & (bends < 90), bends, 0.0)
+        out = []
+        for i, leg in enumerate(legs.legs):
+            for s, e in zip(*runs(backwards[i] > KNEE_BACK_DEG)):
+                worst = float(backwards[i, s:e].max())
+                out.append(
+                    Finding(
+                        self.take, "knee", (leg.knee,), self.frame(s), self.frame(e - 1),
+                        "high" if worst > 45 else "medium", round(worst, 6), "deg",
+                        f"{leg.knee} bends {worst:.3g} deg backwards, past what a knee does",
+                    )
+                )  # fmt: skip
+        return out
+
+
+def _lowest_around(x: np.ndarray, half: int) -> np.ndarray:
+    """The least of x over the ``half`` samples before and after each (NaN ignored)."""
+    padded = np.pad(np.where(np.isnan(x), np.inf, x), half, mode="edge")
+    return sliding_window_view(padded, 2 * half + 1).min(axis=1)
+
+
+def _cosine(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.sum(a * b, -1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
+
+
+def _merged(slides: list[tuple[int, int, float, str]]) -> list[tuple[int, int, float, str]]:
+    """Overlapping slides of one foot's heel and ball as one, the farther point's."""
+    out: list[tuple[int, int, float, str]] = []
+    for first, last, slide, point in sorted(slides):
+        if out and first <= out[-1][1]:
+            a, b, worst, name = out[-1]
+            out[-1] = (a, max(b, last), *((slide, point) if slide > worst else (worst, name)))
+        else:
+            out.append((first, last, slide, point))
+    return out
