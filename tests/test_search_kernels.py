@@ -496,7 +496,7 @@ def test_a_corrupt_tree_is_refused_not_followed(rng):
     tree = ms.KDTree(walk(rng, 100, 3), 4)
     tree.index[50] = 100  # beyond the rows
     with pytest.raises(ValueError, match="mt_kdtree_query"):
-        tree.query(np.zeros((5, 3)) + tree.points[tree.index[49]], 100)
+        tree.query(np.zeros((5, 3)) + tree.rows[49], 100)
     tree = ms.KDTree(walk(rng, 100, 3), 4)
     tree._tree.depth = 2  # not the depth of 100 rows in leaves of 4
     with pytest.raises(ValueError, match="mt_kdtree_query"):

@@ -220,15 +220,16 @@ class KDTree:
     under squared Euclidean distance.
 
     Leaves hold at most ``leaf_size`` rows; nodes split their rows at the median of the
-    dimension they spread most in.  The points are copied (the tree reads them at every
-    query).  Queries are exact, ties included: what sorting every row's distance gives.
+    dimension they spread most in.  The tree keeps a copy of the points, in the order of its
+    leaves (``rows``; row i is row ``index[i]`` of ``points``).  Queries are exact, ties
+    included: what sorting every row's distance gives.
     """
 
-    def __init__(self, points: ArrayLike, leaf_size: int = 32) -> None:
+    def __init__(self, points: ArrayLike, leaf_size: int = 64) -> None:
         a = np.asarray(points) if points is not None else None
-        self.points = _checks.real(a, "points", (None, "dims")).copy()
-        _finite(self.points, "points")
-        n, dims = self.points.shape
+        source = _checks.real(a, "points", (None, "dims"))
+        _finite(source, "points")
+        n, dims = source.shape
         if dims == 0:
             raise ValueError("points must have at least one column (dimension), got shape (n, 0)")
         self.leaf_size = _checks.integer(leaf_size, "leaf_size", 1)
@@ -236,30 +237,33 @@ class KDTree:
         check(lib.mt_kdtree_depth(n, self.leaf_size, depth), "mt_kdtree_depth")
         self.depth = int(depth[0])
         self.index = np.empty(n, dtype=np.uintp)
+        self.rows = np.empty_like(source)
         self.split_dim = np.empty((1 << self.depth) - 1, dtype=np.uintp)
         self.split_value = np.empty((1 << self.depth) - 1)
-        # the struct points into the arrays; the cdata views keep them alive with it
+        # the struct points into the arrays; these cdata views keep them alive with it
         self._views = [
-            c_array(self.points),
             c_array(self.index, "size_t[]"),
+            c_array(self.rows),
             c_array(self.split_dim, "size_t[]"),
             c_array(self.split_value),
         ]
         tree: Any = ffi.new("struct mt_kdtree *")
-        tree.points, tree.index, tree.split_dim, tree.split_value = self._views
+        tree.index, tree.rows, tree.split_dim, tree.split_value = self._views
         tree.n, tree.dims, tree.leaf_size, tree.depth = n, dims, self.leaf_size, self.depth
+        tree.points = c_array(source)  # read by the build only
         check(lib.mt_kdtree_build(tree), "mt_kdtree_build")
+        tree.points = ffi.NULL
         self._tree = tree
 
     @property
     def n(self) -> int:
         """Rows in the tree."""
-        return int(self.points.shape[0])
+        return int(self.rows.shape[0])
 
     @property
     def dims(self) -> int:
         """Columns of each row."""
-        return int(self.points.shape[1])
+        return int(self.rows.shape[1])
 
     def query(
         self, queries: ArrayLike, k: int = 1, *, exclude: ArrayLike | None = None, workers: int | None = None
