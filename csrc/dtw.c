@@ -7,7 +7,9 @@
  * time series subsequences under dynamic time warping" (KDD 2012), without
  * their cascade of cheaper bounds: every window's LB_Keogh is computed, and the
  * windows are warped in the order of their bounds, so that the k-th best
- * distance falls fast and most windows are never warped at all.
+ * distance falls fast and most windows are never warped at all.  Once most
+ * are pruned, the bounds take nearly all the time, and each stops as soon as
+ * it passes the k-th distance of a few windows warped first (the seeds).
  *
  * Exactness.  Pruning a window must never lose one that brute force keeps,
  * after rounding too.  Per frame, LB_Keogh's term sums the squares of
@@ -275,6 +277,15 @@ static void sift_down(size_t *heap, size_t size, size_t i, const double *bounds)
     }
 }
 
+/* Candidates whose bounds choose the seeds of mt_dtw_search: about this many (4 k if more), spread evenly. */
+enum { SEED_SAMPLE = 1024 };
+
+static int by_value(const void *a, const void *b)
+{
+    const size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return (x > y) - (x < y);
+}
+
 /* The k best so far, sorted by (distance, start); found of them. */
 struct best {
     size_t *starts;
@@ -342,12 +353,37 @@ int mt_dtw_search(const double *query, size_t m, const double *series, size_t n,
         }
     }
 
+    const size_t nseeds = k < count ? k : count;
+    size_t *seeds = malloc(nseeds * sizeof *seeds);
+    if (seeds == NULL) {
+        free(scratch);
+        return MT_ENOMEM;
+    }
     struct best best = {.starts = hits, .distances = distances, .k = k};
     struct mt_dtw_stats counted = {0};
-    /* The first k windows, warped in full, give a first k-th best: the bounds of the others stop there. */
-    const size_t seeds = k < count ? k : count;
-    for (size_t i = 0; i < seeds; i++) {
-        offer(&best, starts[i], dtw(query, m, series + starts[i] * dims, m, dims, r, INFINITY, rows, rows + m));
+    /*
+     * The seeds, warped first: the k candidates of least bound in a sample spread evenly over all of them.
+     * Good windows have small bounds, so their k-th distance is near the final k-th best, and at it the
+     * bounds of the others stop after a few frames.
+     */
+    const size_t wanted = SEED_SAMPLE > 4 * nseeds ? SEED_SAMPLE : 4 * nseeds;
+    const size_t step = count > wanted ? count / wanted : 1;
+    size_t sampled = 0;
+    for (size_t i = 0; i < count; i += step) {
+        bounds[i] = m && dims ? lb_keogh(series + starts[i] * dims, upper, lower, m, dims, INFINITY) : 0.0;
+        order[sampled++] = i;
+    }
+    for (size_t i = sampled / 2; i-- > 0;)
+        sift_down(order, sampled, i, bounds);
+    for (size_t j = 0; j < nseeds; j++) {
+        seeds[j] = order[0];
+        order[0] = order[--sampled];
+        sift_down(order, sampled, 0, bounds);
+    }
+    qsort(seeds, nseeds, sizeof *seeds, by_value);
+    for (size_t j = 0; j < nseeds; j++) {
+        const double *window = series + starts[seeds[j]] * dims;
+        offer(&best, starts[seeds[j]], dtw(query, m, window, m, dims, r, INFINITY, rows, rows + m));
         counted.warped++;
     }
     const double first = kth(&best);
@@ -363,7 +399,7 @@ int mt_dtw_search(const double *query, size_t m, const double *series, size_t n,
             break; /* and so is every bound left */
         order[0] = order[--size];
         sift_down(order, size, 0, bounds);
-        if (i < seeds)
+        if (bsearch(&i, seeds, nseeds, sizeof *seeds, by_value) != NULL)
             continue;
         const double threshold = kth(&best);
         const double d = dtw(query, m, series + starts[i] * dims, m, dims, r, threshold, rows, rows + m);
@@ -375,6 +411,7 @@ int mt_dtw_search(const double *query, size_t m, const double *series, size_t n,
         offer(&best, starts[i], d);
     }
     counted.pruned = count - counted.warped - counted.abandoned;
+    free(seeds);
     free(scratch);
     *found = best.found;
     if (stats != NULL)

@@ -885,14 +885,15 @@ struct mt_dtw_stats {
  * every candidate and sorting (distance, start) gives: the search only skips
  * windows that could not be among those k.
  *
- * It warps the first k candidates, computes LB_Keogh of every candidate
- * against the query's envelope (bounds, count doubles: each candidate's bound,
- * or where it passed the k-th distance of those first k, the partial sum that
- * did; never above the candidate's distance), then warps the candidates in the
- * order of their bounds (then starts), each abandoned above the k-th best
- * found so far, until the next bound is above it.  order (count) is the
- * caller's scratch for that order.  stats may be NULL.  k >= 1; count 0 finds
- * nothing.  Scratch: 2 m dims + 2 m doubles.
+ * It warps k seeds (the candidates of least LB_Keogh among about max(1024,
+ * 4k) spread evenly over them), computes LB_Keogh of every candidate against
+ * the query's envelope (bounds, count doubles: each candidate's bound, or
+ * where it passed the k-th distance of the seeds, the partial sum that did;
+ * never above the candidate's distance), then warps the others in the order of
+ * their bounds (then starts), each abandoned above the k-th best found so far,
+ * until the next bound is above it.  order (count) is the caller's scratch for
+ * that order.  stats may be NULL.  k >= 1; count 0 finds nothing.  Scratch: 2
+ * m dims + 2 m doubles and min(k, count) indices.
  */
 int mt_dtw_search(const double *query, size_t m, const double *series, size_t n, size_t dims, size_t radius,
                   const size_t *starts, size_t count, size_t k, double *bounds, size_t *order, size_t *hits,

@@ -147,9 +147,9 @@ def dtw(a: ArrayLike, b: ArrayLike, radius: int | None = None, threshold: float 
 class DTWHits(NamedTuple):
     """The result of :func:`dtw_search`: ``starts`` and ``distances`` of the windows found,
     nearest first (a tie to the lower start); ``bounds``, each candidate's LB_Keogh (or, where
-    it passed the k-th distance of the first k candidates, the partial sum that did: a lower
-    bound of its distance all the same); and how many candidates were warped to the end,
-    ``abandoned`` on the way, and ``pruned`` (never warped)."""
+    it passed the k-th distance of the k windows warped first, the partial sum that did: a
+    lower bound of its distance all the same); and how many candidates were warped to the
+    end, ``abandoned`` on the way, and ``pruned`` (never warped)."""
 
     starts: np.ndarray
     distances: np.ndarray
