@@ -207,6 +207,8 @@ int mt_feature_index_find(const struct mt_feature_index *index, const uint64_t *
             begin = b;
             end = e;
         }
+        if (b > e || e > index->segments)
+            return MT_EINVAL;
         if (b == e)
             return MT_OK;
     }

@@ -453,6 +453,28 @@ def test_feature_bad_input():
 
 
 # ---------------------------------------------------------------------------
+# layouts: any real dtype and memory layout, computed in float64
+
+
+def test_dtypes_and_layouts_give_the_float64_results(rng):
+    series = np.round(walk(rng, 200, 4) * 10)
+    query = series[50:62].copy()
+    wide = np.zeros((200, 8))
+    wide[:, ::2] = series  # every other column: a strided view
+    variants = [series.astype(np.float32), series.astype(np.int32), wide[:, ::2], np.asfortranarray(series)]
+    want = ms.dtw_search(query, series, 3, 2)
+    tree = ms.KDTree(series, 8)
+    neighbours = tree.query(query, 4)
+    for x in variants:
+        got = ms.dtw_search(query, x, 3, 2)
+        assert got.starts.tolist() == want.starts.tolist() and got.distances.tolist() == want.distances.tolist()
+        np.testing.assert_array_equal(ms.KDTree(x, 8).query(query, 4).indices, neighbours.indices)
+        np.testing.assert_array_equal(tree.query(x[50:62], 4).indices, neighbours.indices)
+    np.testing.assert_array_equal(ms.lb_envelope(series[:, 0], 3).upper, ms.lb_envelope(series[:, :1], 3).upper)
+    assert ms.dtw(series[:10, 1], series[5:15, 1], 2) == ms.dtw(series[:10, 1:2], series[5:15, 1:2], 2)
+
+
+# ---------------------------------------------------------------------------
 # the C layer's own checks: what Python validates is checked again, and reported through the one status map
 
 
