@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import DATA
+from conftest import amc_copies
 from motiontheater import Pipeline
 from motiontheater.databases import batch
 
@@ -25,14 +25,7 @@ COPIES = 75
 
 @pytest.fixture(scope="module")
 def corpus(tmp_path_factory):
-    if not DATA.is_dir():
-        pytest.skip(f"real capture corpus not found at {DATA}")
-    root = tmp_path_factory.mktemp("corpus")
-    for copy in range(COPIES):
-        shutil.copytree(
-            DATA, root / f"copy{copy:02d}", ignore=shutil.ignore_patterns("*.npz", "*.csv", "*.bvh", "licenses", "*.md")
-        )
-    return root
+    return amc_copies(tmp_path_factory, COPIES)
 
 
 TARGETS = {"disk": None, "memory": Path("/dev/shm")}

@@ -7,6 +7,7 @@ figure least disturbed by other load on a shared machine.
 """
 
 import re
+import shutil
 from collections import defaultdict
 
 import pytest
@@ -93,3 +94,16 @@ def pytest_terminal_summary(terminalreporter):
         )
     for note in NOTES:
         write(note)
+
+
+def amc_copies(tmp_path_factory, copies: int):
+    """The corpus's AMC takes and skeletons copied ``copies`` times into a fresh folder (a
+    database to time batch and check on); skips when the corpus is absent."""
+    if not DATA.is_dir():
+        pytest.skip(f"real capture corpus not found at {DATA}")
+    root = tmp_path_factory.mktemp("corpus")
+    for copy in range(copies):
+        shutil.copytree(
+            DATA, root / f"copy{copy:02d}", ignore=shutil.ignore_patterns("*.npz", "*.csv", "*.bvh", "licenses", "*.md")
+        )
+    return root

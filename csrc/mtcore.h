@@ -994,6 +994,40 @@ int mt_feature_index_build(struct mt_feature_index *index);
  */
 int mt_feature_index_find(const struct mt_feature_index *index, const uint64_t *query, size_t length, size_t *hits,
                           size_t capacity, size_t *count);
+/*
+ * The take check (check.c): what is wrong with the channels of a take, in one pass.
+ *
+ * values is (rows, stride), channel k of row t at values[t * stride + k].  Rows begin .. end-1
+ * are checked; the rows around them are read as neighbours only (so that a take checked in
+ * pieces, each with 3 rows of its neighbours before and 2 after, finds what the whole take
+ * gives).  Each event is a row of 5 in events (capacity x 5): channel, first row, last row
+ * (inclusive), kind (an mt_check_kind) and the row where its size peaks; its size goes to
+ * sizes[i].  *count receives how many events there are, in the order they end; only the first
+ * `capacity` are written.  Per channel, roughness[k] receives the sum of r^2 over the rows
+ * checked, r = x[t] - (x[t-1] + x[t+1]) / 2, taken where both neighbours exist and |r| is
+ * within spike_limit[k], and smooth_rows[k] how many such rows there were.
+ */
+enum mt_check_kind {
+    MT_CHECK_GAP = 0,    /* a run of NaN; size 0 */
+    MT_CHECK_FROZEN = 1, /* a run of rows equal to the first of them, at least min_run long, or
+                            shorter where it touches row begin - 1 or end - 1 (a piece of a run
+                            that the pieces around may continue); size: the value held */
+    MT_CHECK_SPIKE = 2,  /* rows farther than spike_limit[k] from the median of the five around
+                            them (the line mirrored at its ends: d c b | a b c d | c b a; no
+                            spike is told beside a NaN nor in lines of fewer than 3 rows); size:
+                            x minus that median, the largest */
+    MT_CHECK_STEP = 3,   /* rows whose change from the row before differs by more than
+                            step_limit[k] from the changes into the rows before and after
+                            (one of them at the ends); size: that change minus the mean of the
+                            changes beside it, the largest */
+    MT_CHECK_REPEAT = 4  /* a run of rows equal to the row before in every channel; channel is
+                            `channels`, size 0 */
+};
+
+int mt_check_channels(const double *values, size_t rows, size_t channels, size_t stride, size_t begin, size_t end,
+                      const double *spike_limit, const double *step_limit, size_t min_run, size_t *events,
+                      double *sizes, size_t capacity, size_t *count, double *roughness, size_t *smooth_rows);
+
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

@@ -23,6 +23,7 @@ OTHERS = {
     "filter": ["filter", "{take}", "--median", "3", "-o", "out.bvh"],
     "apply": ["apply", "{take}", "--recipe", "{recipe}", "-o", "out.bvh"],
     "batch": ["batch", "{take}", "--recipe", "{recipe}", "-o", "out", "--quiet", "--jobs", "1"],
+    "check": ["check", "{take}", "-o", "report.json", "--quiet", "--jobs", "1"],
     "skate": ["skate", "{take}", "--json"],
     "contacts": ["contacts", "{take}", "-o", "contacts.csv"],
     "view": ["view", "{take}", "--no-open", "-o", "page.html"],

@@ -14,7 +14,7 @@ from mtcore import binomial_filter1d, median_filter1d, pascal_weights, uniform_f
 from ._version import __version__
 from .characters.retarget import plan_retarget, retarget
 from .characters.rigs import joint_map
-from .editing import convert, filtering, interpolators, signal  # noqa: F401 (importing them registers their steps)
+from .editing import convert, filtering, interpolators, repair, signal  # noqa: F401 (importing them registers their steps)
 from .editing.combine import combine
 from .editing.convert import to_asf, to_bvh
 from .editing.filtering import filter_motion

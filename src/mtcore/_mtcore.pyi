@@ -7,6 +7,11 @@ class _Lib:
     MT_BLEND_ALIGNED_EXPMAP: int
     MT_BLEND_EXPMAP: int
     MT_BLEND_SLERP: int
+    MT_CHECK_FROZEN: int
+    MT_CHECK_GAP: int
+    MT_CHECK_REPEAT: int
+    MT_CHECK_SPIKE: int
+    MT_CHECK_STEP: int
     MT_CONTINUITY_NONE: int
     MT_CONTINUITY_PATH: int
     MT_CONTINUITY_REFERENCE: int
@@ -115,6 +120,7 @@ class _Lib:
     def mt_segments(self, words_: CData, n_: int, first_: CData, values_: CData, capacity_: int, count_: CData, /) -> int: ...
     def mt_feature_index_build(self, index_: CData, /) -> int: ...
     def mt_feature_index_find(self, index_: CData, query_: CData, length_: int, hits_: CData, capacity_: int, count_: CData, /) -> int: ...
+    def mt_check_channels(self, values_: CData, rows_: int, channels_: int, stride_: int, begin_: int, end_: int, spike_limit_: CData, step_limit_: CData, min_run_: int, events_: CData, sizes_: CData, capacity_: int, count_: CData, roughness_: CData, smooth_rows_: CData, /) -> int: ...
 
 ffi: FFI
 lib: _Lib

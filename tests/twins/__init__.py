@@ -27,11 +27,12 @@ from mtcore import rotations as rot
 from mtcore import search as mt_search
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
+from mtcore.check import channel_events
 from mtcore.combine import combine_frames
 from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
 from mtcore.retarget import RetargetPlan, retarget_rotations
 
-from . import combine, filters, footskate, kinematics, retarget, rotations
+from . import check, combine, filters, footskate, kinematics, retarget, rotations
 from . import search as search_twins
 from . import signal as signal_twins
 from . import text as text_twins  # binds twins.text too: mtcore's is mt_text
@@ -847,6 +848,43 @@ def fast_feature_index(takes):
     return index.keys, index.offsets.astype(np.intp), index.ids.astype(np.intp)
 
 
+# --- the take check ---------------------------------------------------------------------------
+
+
+def check_cases(rng: np.random.Generator) -> list[tuple]:
+    """Random walks with spikes, steps, NaN runs, frozen runs and repeated rows, over sizes from
+    empty to a few hundred rows, the whole line or a piece of it checked."""
+    out = []
+    for rows in (0, 1, 2, 3, 4, 5, 8, 31, 300):
+        for channels in (0, 1, 4):
+            x = np.cumsum(rng.standard_normal((rows, channels)), axis=0)
+            if rows > 4 and channels:
+                for _ in range(rows // 10 + 1):
+                    t, k = int(rng.integers(rows)), int(rng.integers(channels))
+                    what = rng.integers(5)
+                    if what == 0:
+                        x[t, k] += rng.choice([-1, 1]) * rng.uniform(5, 50)
+                    elif what == 1:
+                        x[t:, k] += rng.choice([-1, 1]) * rng.uniform(5, 50)
+                    elif what == 2:
+                        x[t : t + int(rng.integers(1, 5)), k] = np.nan
+                    elif what == 3:
+                        x[t : t + int(rng.integers(2, 9)), k] = x[t, k]
+                    else:
+                        x[t : t + int(rng.integers(1, 4))] = x[t - 1]
+            spike = rng.uniform(0.5, 8, channels) if rng.random() < 0.7 else float(rng.uniform(0, 8))
+            step = rng.uniform(0.5, 8, channels)
+            begin = int(rng.integers(0, rows // 3 + 1))
+            end = int(rng.integers(begin, rows + 1)) if rng.random() < 0.5 else rows
+            out.append((x, spike, step, int(rng.integers(1, 6)), begin, end))
+    return out
+
+
+def fast_check(x, spike, step, min_run, begin, end):
+    found = channel_events(x, spike, step, min_run, begin, end)
+    return found.events, found.sizes, found.roughness, found.smooth_rows
+
+
 # --- the registry ---------------------------------------------------------------------------
 
 TWINS: dict[str, Twin] = {
@@ -931,6 +969,8 @@ TWINS: dict[str, Twin] = {
     ),
     "mt_upfirdn": Twin(fast_upfirdn, signal_twins.upfirdn_twin, upfirdn_cases, close(1e-12)),
     "mt_fill_gaps": Twin(fast_fill, signal_twins.fill_gaps_twin, gap_cases, close(1e-9)),
+    # rows and kinds exactly; sizes and the roughness sum to rounding (both sum in row order)
+    "mt_check_channels": Twin(fast_check, check.check_channels_twin, check_cases, close(1e-12)),
     "mt_nan_runs": Twin(
         lambda x, *_: mt_signal.nan_runs(x), lambda x, *_: signal_twins.nan_runs_twin(x), nan_run_cases, exact
     ),

@@ -18,6 +18,7 @@ from .._signals import terminate_as_interrupt
 from .._version import __version__
 from . import feet, views
 from .batch import BATCH
+from .check import CHECK
 from .combine import COMBINE
 from .demo import DEMO
 from .info import INFO
@@ -28,7 +29,7 @@ from .verb import Verb, VerbParser
 
 def verbs() -> list[Verb]:
     """Every verb: those of the modules here and one per registered step (as registered now)."""
-    return [DEMO, LISTING, INFO, FILTER, APPLY, *step_verbs(), BATCH, COMBINE, *feet.VERBS, BENCH, *views.VERBS]
+    return [DEMO, LISTING, INFO, FILTER, APPLY, *step_verbs(), BATCH, CHECK, COMBINE, *feet.VERBS, BENCH, *views.VERBS]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -33,7 +33,7 @@ from collections import Counter
 from collections.abc import Callable, Generator, Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from tqdm import tqdm
 
@@ -65,6 +65,9 @@ STREAM_ABOVE = 256 << 20  # bytes of AMC above which a take is streamed (when it
 MANIFEST = ".motiontheater-batch.jsonl"
 _OLD_MANIFEST = ".motiontheater-batch.json"  # version 1, one JSON object: read where there is no other
 Stamp = tuple[int, int]  # a file's modification time (ns) and size: it has not changed while they hold
+
+T = TypeVar("T")
+R = TypeVar("R")
 
 
 @dataclass(frozen=True)
@@ -679,7 +682,7 @@ def run(
     _check_writable(out)
     start = time.perf_counter()
     remove_stale_partials(out, recursive=True)
-    results = _run_dask(jobs, workers, scheduler) if scheduler or dask_local else _run_local(jobs, workers)
+    results = run_each(jobs, run_job, workers, scheduler=scheduler, dask_local=dask_local)
     try:
         for job, result in results:
             summary.results.append(result)
@@ -712,11 +715,19 @@ def _check_writable(out: str | os.PathLike) -> None:
         raise OutputError(e.errno, f"cannot write to the output folder {os.fspath(out)}: {e.strerror}") from None
 
 
-def _run_local(jobs: list[Job], workers: int) -> Generator[tuple[Job, Result]]:
+def run_each(
+    items: list[T], work: Callable[[T], R], workers: int = 0, *, scheduler: str | None = None, dask_local: bool = False
+) -> Generator[tuple[T, R]]:
+    """(item, work(item)) for each item as it is done: on local processes (``workers``, 0 for every
+    core; in this process for one worker or one item), a Dask cluster at ``scheduler``, or a local
+    Dask cluster.  ``work`` is a module-level function (the workers import it)."""
+    if scheduler or dask_local:
+        yield from _run_dask(items, work, workers, scheduler)
+        return
     count = workers or cpu_count()
-    if count == 1 or len(jobs) <= 1:
-        for job in jobs:
-            yield job, run_job(job)
+    if count == 1 or len(items) <= 1:
+        for item in items:
+            yield item, work(item)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
@@ -724,7 +735,7 @@ def _run_local(jobs: list[Job], workers: int) -> Generator[tuple[Job, Result]]:
         others = set(multiprocessing.active_children())
         pool = ProcessPoolExecutor(max_workers=count, initializer=_worker_start, initargs=(os.getpid(), count))
         try:
-            futures = {pool.submit(_run_jobs, group): group for group in _groups(jobs, count)}
+            futures = {pool.submit(_run_group, work, group): group for group in _groups(items, count)}
             for future in as_completed(futures):
                 yield from zip(futures[future], future.result())
         finally:
@@ -733,7 +744,7 @@ def _run_local(jobs: list[Job], workers: int) -> Generator[tuple[Job, Result]]:
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _groups(jobs: list[Job], workers: int) -> list[list[Job]]:
+def _groups(jobs: list[T], workers: int) -> list[list[T]]:
     """The jobs in groups, each sent to a worker at once: up to 8 takes, for the parent to handle
     a message per group, not per take (over thousands of small takes that was a tenth of the
     run's time), and at most a 1/16th of each worker's share, so that the workers finish close
@@ -742,8 +753,8 @@ def _groups(jobs: list[Job], workers: int) -> list[list[Job]]:
     return [jobs[i : i + size] for i in range(0, len(jobs), size)]
 
 
-def _run_jobs(jobs: list[Job]) -> list[Result]:
-    return [run_job(job) for job in jobs]
+def _run_group(work: Callable[[T], R], items: list[T]) -> list[R]:
+    return [work(item) for item in items]
 
 
 def _worker_start(parent: int, processes: int) -> None:
@@ -762,7 +773,7 @@ def _worker_start(parent: int, processes: int) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
-def _run_dask(jobs: list[Job], workers: int, scheduler: str | None) -> Generator[tuple[Job, Result]]:
+def _run_dask(items: list[T], work: Callable[[T], R], workers: int, scheduler: str | None) -> Generator[tuple[T, R]]:
     try:
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError:
@@ -777,10 +788,10 @@ def _run_dask(jobs: list[Job], workers: int, scheduler: str | None) -> Generator
     try:
         if cluster is not None:  # a local cluster's workers share this machine's cores (a scheduler's may be anywhere)
             client.run(share_cores, processes)
-        futures = client.map(run_job, jobs, pure=False)
-        job_of = {future.key: job for future, job in zip(futures, jobs)}
+        futures = client.map(work, items, pure=False)
+        item_of = {future.key: item for future, item in zip(futures, items)}
         for future in as_completed(futures):
-            yield job_of[future.key], future.result()
+            yield item_of[future.key], future.result()
     finally:
         client.close()
         if cluster is not None:

@@ -533,7 +533,8 @@ def fill_gaps(
         values[:, columns] = block
     values.flags.writeable = False
     result = motion.replace(values=values)
-    left = find_gaps(result)
+    chosen = set(result.skeleton.joint_names if joints is None else joints)
+    left = [gap for gap in find_gaps(result) if gap.joint in chosen]  # the others were not asked for
     if left:
         shown = ", ".join(map(str, left[:5])) + (f" and {len(left) - 5} more" if len(left) > 5 else "")
         log.warning(

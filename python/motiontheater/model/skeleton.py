@@ -385,7 +385,12 @@ class Skeleton:
             position=_scaled(self.root.position, length_factor),
             orientation=_scaled(self.root.orientation, factor),
         )
-        return replace(self, bones=bones, root=root, units=tuple(units.items()), length_choice=choice)
+        posed = self.posed
+        if posed is not None and length_factor != 1.0:  # the poses' size scales with the lengths
+            extents = tuple(e * length_factor for e in posed.extents)
+            told = extents["xyz".index(posed.axis or posed.up)]
+            posed = replace(posed, extents=extents, unit=length_units.human_unit(told))  # type: ignore[arg-type]
+        return replace(self, bones=bones, root=root, units=tuple(units.items()), length_choice=choice, posed=posed)
 
 
 def settle_length_unit(skeleton: Skeleton, unit: str | None = None) -> Skeleton:

@@ -554,6 +554,16 @@
     return take.firstFrame + i * take.step;
   }
 
+  /* the address says where to open: #frame=N&joint=NAME (a report's link to a finding) */
+  function fromAddress() {
+    const t = take0();
+    const asked = new URLSearchParams(location.hash.slice(1));
+    const frame = Number(asked.get("frame"));
+    seek(asked.has("frame") && Number.isFinite(frame) ? (frame - t.firstFrame) / t.step : 0);
+    const joint = t.jointIndex.get(asked.get("joint"));
+    select(joint === undefined ? t.body : joint);
+  }
+
   function seek(i) {
     const t = take0();
     S.cur = Math.min(t.frames - 1, Math.max(0, Math.round(i)));
@@ -1425,8 +1435,8 @@
     buildTree();
     setUpControls();
     setUpEditor();
-    seek(0);
-    select(t.body);
+    fromAddress();
+    window.addEventListener("hashchange", fromAddress);
     $("e-from").value = frameNumber(t, 0);
     $("e-to").value = frameNumber(t, Math.min(t.frames - 1, 1));
     drawView();

@@ -1,0 +1,676 @@
+"""The take check: what is wrong with a take, where, how badly, and the steps that repair it.
+
+One C pass over the channels (:func:`mtcore.check.channel_events`) lists the candidates: runs of
+NaN, held values, samples far from their neighbours' median, jumps and repeated frames.  This
+module judges them as a person would, in physical units: a spike in an Euler channel is a spike
+only if the joint's rotation leaves its neighbours (near gimbal lock the angles swing while the
+rotation does not); a jump of the angles with no jump of the rotation is a flip; a jump of the
+root that no runner makes is a teleport; a held value is frozen only where the channel moves
+around it.  Every limit is stated in degrees, metres, seconds and Hz below and converted with
+the skeleton's length unit and the take's frame rate.
+
+Each finding carries the steps that fix it, confined to its frames and joints (see
+:func:`recipe`): missing, spiked, frozen and repeated frames are dropped and filled from the
+frames around them (``fill_gaps``), flips unrolled (``unroll``), a unit off by a known factor
+rescaled (``scale``), jitter low-passed (``butterworth`` at Winter's cut-off).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from mtcore import check as kernel
+from mtcore import median_filter1d
+from mtcore.rotations import euler_to_quaternions, slerp, unroll_euler
+
+from ..editing.pipeline import Pipeline
+from ..model.motion import Motion
+from ..model.rig import body_joint
+from ..model.skeleton import ROTATIONS, TRANSLATIONS
+from ..model.units import HUMAN_HEIGHT
+from .findings import Finding
+
+SPIKE_DEG = 5.0
+"""Degrees a joint's rotation must leave the median of the five frames around it to be a spike."""
+SPIKE_M = 0.02
+"""Metres a position channel must leave the median of the five frames around it to be a spike."""
+PEAK_ACCELERATION_DEG = 20_000.0
+"""deg/s^2: at low rates a smooth turn of this acceleration leaves its neighbours' median by
+a dt^2 / 2, and the spike limit grows to that (5 degrees at 120 Hz, 11 at 30 Hz)."""
+PEAK_ACCELERATION_M = 60.0
+"""m/s^2: the same for positions."""
+JUMP_DEG = 10.0
+"""Degrees a frame's change of angle must differ from the changes beside it to be a jump."""
+FLIP_DEG = 90.0
+"""Degrees by which unrolled Euler angles must differ from the file's for a frame to be flipped."""
+LEAD_FRAMES = 3
+"""A take whose every frame after its first few is flipped from them has those first frames
+flipped (a rest pose before the capture), not the rest."""
+RUN_SPEED = 12.0
+"""m/s: faster than any sprinter (12.4 m/s is the fastest measured): a root moving faster has
+teleported, or the unit or rate is wrong."""
+FROZEN_SECONDS = 0.1
+"""The shortest run of one held value that can be frozen."""
+FROZEN_DEG, FROZEN_M = 2.0, 0.01
+"""How far the channel would have moved over the run, at its speed around it, to be frozen."""
+JITTER_DEG, JITTER_M = 0.5, 0.002
+"""The noise level (standard deviation of white noise) that is jitter, and twice it medium."""
+SMOOTH_ACCELERATION_DEG = 3_000.0
+"""deg/s^2: the RMS acceleration of smooth motion, whose residual at low rates is not noise."""
+BONE_DRIFT_M, BONE_DRIFT_SHARE = 0.02, 0.05
+"""A bone with position channels drifts when its length leaves its median by both of these."""
+FILL_SECONDS = 0.5
+"""The longest run the recipes fill by interpolation; longer ones are reported, not invented."""
+STEP_PAIR_SECONDS = 0.05
+"""An opposite jump within this time after a jump brings a channel back: a pop, not a jump
+(longer excursions are motion as often as not), or within POP_FRAMES frames at low rates."""
+POP_FRAMES = 3
+TELEPORT_M = 0.25
+"""Metres: a root that leaves its neighbours by this for a few frames has teleported, however slow."""
+
+
+@dataclass(frozen=True)
+class _Channel:
+    index: int
+    joint: str
+    dof: str
+
+    @property
+    def turns(self) -> bool:
+        return self.dof in ROTATIONS
+
+    @property
+    def name(self) -> str:
+        return f"{self.joint} {self.dof}"
+
+
+class _Take:
+    """A take as the detectors see it: its channels, units and rate."""
+
+    def __init__(self, motion: Motion, name: str):
+        self.motion = motion
+        self.name = name
+        self.rate = motion.frame_rate
+        self.dt = 1.0 / motion.frame_rate
+        skeleton = motion.skeleton
+        self.meters = skeleton.meters_per_unit
+        self.degrees = 1.0 if skeleton.angle_unit == "deg" else 180.0 / math.pi  # degrees per file unit
+        self.root = body_joint(motion)  # the joint that carries the body (a static root above it is no body)
+        self.channels = [_Channel(i, j, d) for i, (j, d) in enumerate(motion.channels)]
+        self.triples = {}  # joint -> (order, extrinsic, columns) for joints with three rotation channels
+        for order, extrinsic, columns in skeleton.euler_groups():
+            for row in columns:
+                self.triples[motion.channels[int(row[0])][0]] = (order, extrinsic, row)
+
+    def frame(self, row: int) -> int:
+        return self.motion.first_frame + int(row)
+
+    def physical(self, channel: _Channel, value: float) -> float:
+        """A value of the channel in degrees or metres."""
+        return value * (self.degrees if channel.turns else self.meters)
+
+    def unit(self, channel: _Channel) -> str:
+        return "deg" if channel.turns else "m"
+
+    def quaternions(self, joint: str, rows: np.ndarray) -> np.ndarray:
+        order, extrinsic, columns = self.triples[joint]
+        angles = self.motion.values[np.ix_(rows, columns)]
+        return euler_to_quaternions(angles, order, extrinsic=extrinsic, degrees=self.degrees == 1.0)
+
+
+def _angle_deg(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
+    """The angle of the rotation between unit quaternions, in degrees."""
+    dot = np.abs(np.sum(q0 * q1, axis=-1))
+    return np.degrees(2 * np.arccos(np.clip(dot, -1.0, 1.0)))
+
+
+def _limits(take: _Take) -> tuple[np.ndarray, np.ndarray]:
+    dt2 = take.dt**2
+    spike_deg = max(SPIKE_DEG, PEAK_ACCELERATION_DEG * dt2 / 2)
+    spike_m = max(SPIKE_M, PEAK_ACCELERATION_M * dt2 / 2)
+    jump_deg = max(JUMP_DEG, PEAK_ACCELERATION_DEG * dt2)
+    jump_m = RUN_SPEED * take.dt / math.sqrt(3)  # a jump of RUN_SPEED * dt in any direction shows on an axis
+    spikes = np.array([spike_deg / take.degrees if c.turns else spike_m / take.meters for c in take.channels])
+    steps = np.array([jump_deg / take.degrees if c.turns else jump_m / take.meters for c in take.channels])
+    return spikes, steps
+
+
+def check_motion(motion: Motion, take: str = "") -> list[Finding]:
+    """Every finding of the take (named ``take`` in them), sorted by first frame, severity and kind."""
+    t = _Take(motion, take)
+    findings = _unit(t)
+    for finding in findings:  # lengths are judged in the unit the fix makes them
+        for name, options in finding.fix:
+            t.meters *= options["factor"] if name == "scale" else 1.0
+    if motion.frames:
+        spikes, steps = _limits(t)
+        rows = motion.frames
+        min_run = max(3, round(FROZEN_SECONDS * t.rate))
+        found = kernel.channel_events(motion.values, spikes, steps, min_run)
+        ev, sizes = found.events, found.sizes
+        by_kind = {kind: (ev[ev[:, 3] == kind], sizes[ev[:, 3] == kind]) for kind in kernel.KINDS}
+        repeats = by_kind[kernel.REPEAT][0]
+        findings += _repeats(t, repeats, rows)
+        findings += _gaps(t, *by_kind[kernel.GAP])
+        flips = _flips(t, by_kind[kernel.STEP], by_kind[kernel.SPIKE])
+        edges = {(f.joints[0], frame) for f in flips for frame in (f.first, f.last + 1)}
+        findings += flips + _frozen(t, *by_kind[kernel.FROZEN], repeats, min_run, edges)
+        # the jumps into and out of a flip, a hold or a gap are that finding's, not spikes of their
+        # own: (joint, rotation or position, frame)
+        explained = {
+            (joint, turns, frame)
+            for f in findings
+            if f.kind in ("flip", "frozen", "gap")
+            for joint in f.joints
+            for turns in _turns_of(f)
+            for frame in _edges_of(f)
+        }
+        findings += _spikes(t, by_kind[kernel.SPIKE], by_kind[kernel.STEP], explained, spikes)
+        findings += _jitter(t, found.roughness, found.smooth_rows)
+        findings += _bones(t)
+        findings += _speed(t)
+    return sorted(findings, key=lambda f: (f.first, -f.rank, f.kind, f.joints))
+
+
+def _edges_of(finding: Finding) -> Iterable[int]:
+    """The frames whose jumps a flip (its ends), a hold or a gap (all of it) explains."""
+    if finding.kind == "flip":
+        return (*range(finding.first - 1, finding.first + 2), *range(finding.last, finding.last + 3))
+    return range(finding.first - 1, finding.last + 3)
+
+
+def _turns_of(finding: Finding) -> tuple[bool, ...]:
+    """Whether the channels a flip, hold or gap concerns turn (True), place (False) or both."""
+    if finding.kind == "flip":
+        return (True,)
+    if finding.kind == "frozen" and finding.channel is not None:
+        return (finding.channel.rsplit(" ", 1)[1] in ROTATIONS,)
+    return (True, False)
+
+
+def _fill(t: _Take, first_row: int, last_row: int, joints: Iterable[str] | None) -> tuple:
+    """The fill_gaps step that drops rows first..last and fills them from the frames beside, or
+    () where there is no frame on one side or the run is too long to invent."""
+    count = last_row - first_row + 1
+    if first_row < 1 or last_row >= t.motion.frames - 1 or count > FILL_SECONDS * t.rate:
+        return ()
+    options: dict = {
+        "max_gap": math.ceil((count + 1) / t.rate * 1000) / 1000,
+        "drop": [t.frame(first_row), t.frame(last_row)],
+        "frames": [t.frame(first_row - 1), t.frame(last_row + 1)],
+    }
+    if joints is not None:
+        options["joints"] = sorted(joints)
+    return (("fill_gaps", options),)
+
+
+def _joint_runs(
+    t: _Take, events: np.ndarray, sizes: np.ndarray, pad: int = 0, apart: bool = True
+) -> list[tuple[str, int, int, int, float]]:
+    """Events of one kind joined per joint (its rotation channels apart from its position
+    channels, unless not ``apart``) where their rows overlap (within ``pad``): (joint, first row, last row, worst
+    channel, its size)."""
+    out: list[list] = []
+    group = np.array([f"{t.channels[c].joint} {t.channels[c].turns and apart}" for c in events[:, 0]])
+    order = np.lexsort((events[:, 1], group))
+    for i in order:
+        c, first, last = int(events[i, 0]), int(events[i, 1]), int(events[i, 2])
+        joint, size = t.channels[c].joint, float(sizes[i])
+        kin = not apart or (bool(out) and t.channels[out[-1][3]].turns == t.channels[c].turns)
+        if out and out[-1][0] == joint and kin and first <= out[-1][2] + pad:
+            run = out[-1]
+            run[2] = max(run[2], last)
+            if abs(t.physical(t.channels[c], size)) > abs(t.physical(t.channels[run[3]], run[4])):
+                run[3], run[4] = c, size
+        else:
+            out.append([joint, first, last, c, size])
+    return [(r[0], r[1], r[2], r[3], r[4]) for r in out]
+
+
+def _repeats(t: _Take, events: np.ndarray, rows: int) -> list[Finding]:
+    out = []
+    for _, first, last, _, _ in events:
+        count = last - first + 1
+        seconds = count / t.rate
+        held = (first <= 1 or last >= rows - 1) and seconds >= FILL_SECONDS
+        severity = "low" if held else "medium"
+        what = "the take starts or ends with a held pose" if held else "dropped frames filled by repeating one"
+        out.append(
+            Finding(
+                t.name, "repeated", (), t.frame(first), t.frame(last), severity, round(seconds, 6), "s",
+                f"{count} frame(s) ({seconds:.3g} s) equal to the frame before in every channel: {what}",
+                fix=() if severity == "low" else _fill(t, first, last, None),
+            )
+        )  # fmt: skip
+    return out
+
+
+def _gaps(t: _Take, events: np.ndarray, sizes: np.ndarray) -> list[Finding]:
+    out = []
+    for joint, first, last, c, _ in _joint_runs(t, events, sizes, apart=False):
+        seconds = (last - first + 1) / t.rate
+        fix = _fill(t, first, last, [joint])
+        severity = "high" if not fix else "medium"
+        out.append(
+            Finding(
+                t.name, "gap", (joint,), t.frame(first), t.frame(last), severity, round(seconds, 6), "s",
+                f"{joint}: {last - first + 1} frame(s) ({seconds:.3g} s) missing (NaN)"
+                + ("" if fix else ", too long or at an end of the take to fill"),
+                t.channels[c].name, fix,
+            )
+        )  # fmt: skip
+    return out
+
+
+def _frozen(
+    t: _Take, events: np.ndarray, sizes: np.ndarray, repeats: np.ndarray, min_run: int, flips: set
+) -> list[Finding]:
+    values = t.motion.values
+    rows = len(values)
+    window = max(2, round(FROZEN_SECONDS * t.rate))
+    repeated = np.zeros(rows, bool)
+    for _, first, last, _, _ in repeats:
+        repeated[first : last + 1] = True
+    frozen: list[tuple] = []
+    dead: dict[str, list[int]] = {}
+    for (c, first, last, _, _), _size in zip(events, sizes):
+        channel = t.channels[int(c)]
+        if last - first + 1 < min_run or repeated[first + 1 : last + 1].all():
+            continue
+        if channel.turns and ({(channel.joint, t.frame(first)), (channel.joint, t.frame(last + 1))} & flips):
+            continue  # a channel that holds still, flipped with its joint's triple
+        if first == 0 and last == rows - 1:
+            dead.setdefault(channel.joint, []).append(int(c))
+            continue
+        around = [values[max(first - window, 0) : first + 1, c], values[last : last + window + 1, c]]
+        changes = [np.abs(np.diff(a)) for a in around if len(a) > 2]
+        if not changes:
+            continue
+        moving = np.concatenate(changes)
+        moving = moving[moving > 0]
+        quantum = float(moving.min()) if len(moving) else 0.0
+        # how far the channel would have gone at its speed on either side, or where it lands
+        # when the hold lets go: a held value rejoins the motion with a jump
+        speed = max(float(np.median(d)) for d in changes)
+        beyond = [values[max(first - 3 - window, 0) : max(first - 3, 0), c], values[last + 4 : last + 4 + window, c]]
+        if not any(len(b) > 1 and np.ptp(b) > 0 for b in beyond):
+            continue  # still on both sides, but for a few frames at the hold's ends: a pop, not a hold
+        after = values[last + 1 : last + 4, c]  # the least of three frames: a pop comes back
+        leap = float(np.nan_to_num(np.abs(after - values[last, c])).min()) if len(after) else 0.0
+        expected = max(speed * (last - first), leap)
+        floor = FROZEN_DEG / t.degrees if channel.turns else FROZEN_M / t.meters
+        if expected > max(5 * quantum, floor):
+            frozen.append((int(c), int(first), int(last), kernel.FROZEN, int(first), expected))
+    out = []
+    table = np.array([f[:5] for f in frozen], dtype=np.intp).reshape(-1, 5)
+    for joint, first, last, c, moved in _joint_runs(t, table, np.array([f[5] for f in frozen])):
+        channel = t.channels[c]
+        seconds = (last - first) / t.rate
+        out.append(
+            Finding(
+                t.name, "frozen", (joint,), t.frame(first), t.frame(last),
+                "high" if seconds > FILL_SECONDS else "medium", round(seconds, 6), "s",
+                f"{channel.name} held for {seconds:.3g} s where it would move about "
+                f"{t.physical(channel, moved):.3g} {t.unit(channel)} at its speed around the hold",
+                channel.name, _fill(t, first + 1, last, [joint]),
+            )
+        )  # fmt: skip
+    for joint, columns in dead.items():
+        mine = t.motion.skeleton.columns_of([joint])
+        if len(columns) < len(mine):  # the joint's other channels move
+            names = ", ".join(t.channels[c].dof for c in columns)
+            out.append(
+                Finding(
+                    t.name, "dead", (joint,), t.motion.first_frame, t.motion.last_frame, "low",
+                    round(rows / t.rate, 6), "s",
+                    f"{joint}: {names} never move{'s' if len(columns) == 1 else ''} while its other channels do",
+                    t.channels[columns[0]].name,
+                )
+            )  # fmt: skip
+    return out
+
+
+def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
+    """Frames whose Euler angles are another triple of the same rotation than the frames before
+    give: found by unrolling the joints whose angles jump by more than FLIP_DEG."""
+    values = t.motion.values
+    suspects: set[str] = set()
+    for events, sizes in (steps, spikes):
+        for (c, *_), size in zip(events, sizes):
+            channel = t.channels[int(c)]
+            if channel.turns and abs(t.physical(channel, size)) > FLIP_DEG:
+                suspects.add(channel.joint)
+    out = []
+    for joint in sorted(suspects):
+        if joint in t.triples:
+            order, _, columns = t.triples[joint]
+            angles = values[:, columns]
+            rolled = unroll_euler(angles, order, degrees=t.degrees == 1.0)
+        else:
+            columns = np.array([c.index for c in t.channels if c.joint == joint and c.turns])
+            angles = values[:, columns]
+            rolled = np.unwrap(angles, axis=0, period=360.0 / t.degrees)
+        delta = (rolled - angles) * t.degrees
+        off = np.nan_to_num(np.abs(delta).max(axis=1)) > FLIP_DEG
+        finite = np.isfinite(angles).all(axis=1)
+        runs = _runs(off)
+        # every frame but the first few off their triple: the first frames (a rest pose) are the flipped ones
+        inverted = len(runs) == 1 and runs[0][0] <= LEAD_FRAMES and runs[0][1] == len(off) - 1
+        if inverted:
+            off = finite & ~off
+        for first, last in _runs(off):
+            beside = first - 1 if first > 0 else last + 1  # a frame of the other triple, for an inverted run
+            shift = delta[beside] if inverted and beside < len(delta) else delta[first : last + 1]
+            whole = bool(np.all(np.isclose(shift / 360, np.round(shift / 360), atol=1e-6)))
+            edge = first if first > 0 else min(last + 1, len(angles) - 1)
+            jump = float(np.nan_to_num(np.abs(angles[edge] - angles[edge - 1])).max()) * t.degrees if edge else 0.0
+            fixable = not whole and first > 0
+            what = "wrap by whole turns" if whole else "flip to the other Euler triple of the same rotation"
+            out.append(
+                Finding(
+                    t.name, "flip", (joint,), t.frame(first), t.frame(last), "low" if whole else "medium",
+                    round(jump, 6), "deg",
+                    f"{joint}'s Euler angles {what} for {last - first + 1} frame(s): a jump of {jump:.3g} deg "
+                    "with no jump of the rotation",
+                    t.channels[int(columns[0])].name,
+                    (("unroll", {"joints": [joint], "frames": [t.frame(first), t.frame(last)]}),) if fixable else (),
+                )
+            )  # fmt: skip
+    return out
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    edges = np.diff(np.r_[0, flags.astype(np.int8), 0])
+    return list(zip(np.flatnonzero(edges == 1).tolist(), (np.flatnonzero(edges == -1) - 1).tolist()))
+
+
+def _pops(t: _Take, steps: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Jumps that a jump back within STEP_PAIR_SECONDS undoes, joined into excursions (channel,
+    first, last, SPIKE, peak) with the first jump's size; and the jumps that stay."""
+    events, sizes = steps
+    window = max(STEP_PAIR_SECONDS * t.rate, POP_FRAMES)
+    pops, popsizes, kept = [], [], np.ones(len(events), bool)
+    for i in range(len(events) - 1):
+        (c0, f0, *_), (c1, f1, *_) = events[i], events[i + 1]
+        s0, s1 = sizes[i], sizes[i + 1]
+        if (
+            kept[i]
+            and c0 == c1
+            and 0 < f1 - f0 <= window
+            and s0 * s1 < 0
+            and abs(s0 + s1) < 0.5 * max(abs(s0), abs(s1))
+        ):
+            pops.append((c0, f0, f1 - 1, kernel.SPIKE, f0))
+            popsizes.append(s0)
+            kept[i] = kept[i + 1] = False
+    table = np.array(pops, dtype=np.intp).reshape(-1, 5)
+    return table, np.array(popsizes, dtype=float), kept
+
+
+def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.ndarray) -> list[Finding]:
+    events, sizes = spikes
+    pops, popsizes, stay = _pops(t, steps)
+    events, sizes = np.concatenate([events, pops]), np.concatenate([sizes, popsizes])
+    values = t.motion.values
+    rows = len(values)
+    out = []
+    edges: dict[int, list[tuple[str, float]]] = {}  # spikes at the first or last frame, by row
+    for joint, first, last, c, size in _joint_runs(t, events, sizes, pad=1):
+        channel = t.channels[c]
+        if any((joint, channel.turns, t.frame(r)) in explained for r in range(first, last + 1)):
+            continue
+        limit = t.physical(channel, limits[c])
+        first, last, deviation = _trimmed(t, joint, channel.turns, first, last, limit)
+        if deviation is None:  # at an end of the take, or beside a missing value
+            deviation = abs(t.physical(channel, size))
+            if channel.turns and (first == 0 or last == rows - 1):
+                edges.setdefault(first, []).append((joint, deviation))
+                continue
+        if deviation <= limit:
+            continue  # the angles swing (near gimbal lock) or the frames around move fast: no spike
+        if channel.turns:
+            severity = "high" if deviation > 30 else "medium" if deviation > 10 else "low"
+            out.append(
+                Finding(
+                    t.name, "spike", (joint,), t.frame(first), t.frame(last), severity, round(deviation, 6), "deg",
+                    f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s)",
+                    channel.name, _fill(t, first, last, [joint]),
+                )
+            )  # fmt: skip
+            continue
+        speed = deviation * t.rate
+        kind = "teleport" if joint == t.root and (speed > RUN_SPEED or deviation > TELEPORT_M) else "spike"
+        severity = "high" if kind == "teleport" or deviation > 0.1 else "medium" if deviation > 0.03 else "low"
+        out.append(
+            Finding(
+                t.name, kind, (joint,), t.frame(first), t.frame(last), severity, round(deviation, 6), "m",
+                f"{joint} jumps {deviation:.3g} m away from its neighbours for {last - first + 1} frame(s)"
+                + (f" and back: {speed:.3g} m/s, faster than anyone runs" if kind == "teleport" else ""),
+                channel.name, _fill(t, first, last, [joint]),
+            )
+        )  # fmt: skip
+    for row, turned in sorted(edges.items()):
+        worst = max(d for _, d in turned)
+        names = ", ".join(j for j, _ in turned[:4]) + (f" and {len(turned) - 4} more" if len(turned) > 4 else "")
+        out.append(
+            Finding(
+                t.name, "spike", tuple(j for j, _ in turned), t.frame(row), t.frame(row), "low", round(worst, 6),
+                "deg", f"frame {t.frame(row)} is another pose than the frames beside it (a rest pose?): {names} "
+                f"{'turns' if len(turned) == 1 else 'turn'} up to {worst:.3g} deg away from them",
+            )
+        )  # fmt: skip
+    # jumps that stay: of the root's position a teleport, of a rotation a jump (flips are found above)
+    near_spike = np.zeros((len(t.channels), rows), bool)
+    for c, first, last, *_ in events:
+        near_spike[c, first : last + 1] = True
+    events, sizes = steps
+    for (c, first, last, _, at), size in zip(events[stay], sizes[stay]):
+        channel = t.channels[int(c)]
+        if (channel.joint, channel.turns, t.frame(at)) in explained or (
+            channel.turns and abs(t.physical(channel, size)) > FLIP_DEG
+        ):
+            continue
+        if near_spike[int(c), max(first - 1, 0) : last + 2].any():
+            continue  # the jumps into and out of a spike
+        if channel.turns:
+            if channel.joint in t.triples and at > 1 and at < rows - 1:
+                q = t.quaternions(channel.joint, np.array([at - 2, at - 1, at, at + 1]))
+                turn = _angle_deg(q[1:], q[:-1])
+                jump = float(turn[1] - 0.5 * (turn[0] + turn[2]))
+                if not jump > max(JUMP_DEG, limits[int(c)] * t.degrees):
+                    continue
+            else:
+                jump = abs(t.physical(channel, size))
+            severity = "high" if jump > 90 else "medium" if jump > 30 else "low"
+            out.append(
+                Finding(
+                    t.name, "jump", (channel.joint,), t.frame(at), t.frame(at), severity, round(jump, 6), "deg",
+                    f"{channel.joint} turns {jump:.3g} deg more in one frame than in the frames beside it, and stays",
+                    channel.name,
+                )
+            )  # fmt: skip
+        elif channel.joint == t.root:
+            distance = abs(t.physical(channel, size))
+            out.append(
+                Finding(
+                    t.name, "teleport", (channel.joint,), t.frame(at), t.frame(at), "high", round(distance, 6), "m",
+                    f"the root jumps {distance:.3g} m in one frame ({distance * t.rate:.3g} m/s) and stays there",
+                    channel.name,
+                )
+            )  # fmt: skip
+    return out
+
+
+def _deviations(t: _Take, joint: str, turns: bool, first: int, last: int) -> np.ndarray | None:
+    """How far each of rows first..last lies off the path between the rows around them: the
+    joint's rotation in degrees from the SLERP between them (its angles, unwrapped, from the line
+    between them where it has fewer than three), or its position in metres from the line
+    between them.  None at an end of the take or where a value is missing."""
+    if first < 1 or last > t.motion.frames - 2:
+        return None
+    around = np.arange(first - 1, last + 2)
+    share = (around[1:-1] - around[0]) / (around[-1] - around[0])
+    if turns and joint in t.triples:
+        q = t.quaternions(joint, around)
+        if np.isnan(q).any():
+            return None
+        between = slerp(np.broadcast_to(q[0], (len(share), 4)), np.broadcast_to(q[-1], (len(share), 4)), share)
+        return _angle_deg(q[1:-1], between)
+    columns = [c.index for c in t.channels if c.joint == joint and c.turns == turns]
+    block = t.motion.values[np.ix_(around, np.array(columns, dtype=np.intp))]
+    if np.isnan(block).any():
+        return None
+    if turns:
+        block = np.unwrap(block, axis=0, period=t.motion.skeleton.period)
+    block = block * (t.degrees if turns else t.meters)
+    line = block[0] + share[:, None] * (block[-1] - block[0])
+    off = block[1:-1] - line
+    return np.abs(off).max(axis=1) if turns else np.linalg.norm(off, axis=1)
+
+
+def _trimmed(t: _Take, joint: str, turns: bool, first: int, last: int, limit: float) -> tuple[int, int, float | None]:
+    """The run without the rows at its ends that lie on the path between the rows around them
+    (the median of five beside a large spike can leave a fast-moving neighbour), and its largest
+    deviation (None where :func:`_deviations` has none)."""
+    while True:
+        off = _deviations(t, joint, turns, first, last)
+        if off is None:
+            return first, last, None
+        if first < last and off[0] <= limit:
+            first += 1
+        elif first < last and off[-1] <= limit:
+            last -= 1
+        else:
+            return first, last, float(off.max())
+
+
+def _jitter(t: _Take, roughness: np.ndarray, counts: np.ndarray) -> list[Finding]:
+    smooth = SMOOTH_ACCELERATION_DEG * t.dt**2 / 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        noise = np.sqrt(roughness / counts / 1.5)
+    worst: dict[str, tuple[float, int]] = {}
+    for channel in t.channels:
+        level = t.physical(channel, float(noise[channel.index]))
+        limit = max(JITTER_DEG, smooth) if channel.turns else JITTER_M
+        if level > limit and level / limit > worst.get(channel.joint, (0.0, 0))[0]:
+            worst[channel.joint] = (level / limit, channel.index)
+    out = []
+    for joint, (ratio, c) in sorted(worst.items()):
+        channel = t.channels[c]
+        level = t.physical(channel, float(noise[c]))
+        severity = "medium" if ratio > 2 else "low"
+        out.append(
+            Finding(
+                t.name, "jitter", (joint,), t.motion.first_frame, t.motion.last_frame, severity, round(level, 6),
+                t.unit(channel), f"{channel.name} jitters by about {level:.3g} {t.unit(channel)} frame to frame",
+                channel.name,
+                (("butterworth", {"joints": [joint]}),) if severity == "medium" else (),
+            )
+        )  # fmt: skip
+    return out
+
+
+def _bones(t: _Take) -> list[Finding]:
+    out = []
+    skeleton = t.motion.skeleton
+    above = set(_chain_to(skeleton, t.root))  # the body's joint and those above it carry no bone
+    for joint in skeleton.joint_names:
+        if joint in above:
+            continue
+        columns = t.motion.columns(joint, TRANSLATIONS) if set(TRANSLATIONS) <= set(skeleton.dofs(joint)) else []
+        if len(columns) != 3:
+            continue
+        length = np.linalg.norm(t.motion.values[:, columns], axis=1) * t.meters
+        if not np.isfinite(length).any():
+            continue
+        middle = float(np.nanmedian(length))
+        off = np.abs(length - middle)
+        bad = np.nan_to_num(off) > max(BONE_DRIFT_M, BONE_DRIFT_SHARE * middle)
+        for first, last in _runs(bad):
+            size = float(np.nanmax(off[first : last + 1]))
+            out.append(
+                Finding(
+                    t.name, "bone", (joint,), t.frame(first), t.frame(last), "medium", round(size, 6), "m",
+                    f"the bone to {joint} is {size:.3g} m off its usual {middle:.3g} m",
+                    f"{joint} tx",
+                )
+            )  # fmt: skip
+    return out
+
+
+def _chain_to(skeleton, joint: str) -> list[str]:
+    chain = [joint]
+    while not skeleton.is_root(chain[-1]):
+        chain.append(skeleton.parent(chain[-1]))
+    return chain
+
+
+def _speed(t: _Take) -> list[Finding]:
+    columns = t.motion.columns(t.root, TRANSLATIONS) if t.motion.frames > 1 else []
+    if len(columns) != 3:
+        return []
+    window = max(1, round(0.25 * t.rate))
+    steps = np.linalg.norm(np.diff(t.motion.values[:, columns], axis=0), axis=1) * t.meters * t.rate
+    # the median over 0.25 s: a teleport of a few frames is not a speed
+    typical = median_filter1d(np.nan_to_num(steps), window | 1, mode="nearest")
+    out = []
+    for first, last in _runs(typical > RUN_SPEED):
+        speed = float(typical[first : last + 1].max())
+        out.append(
+            Finding(
+                t.name, "speed", (t.root,), t.frame(first), t.frame(last + 1), "high", round(speed, 6), "m/s",
+                f"the root moves at {speed:.3g} m/s for 0.25 s or more, faster than anyone runs: "
+                "is the length unit or the frame rate wrong?",
+                f"{t.root} tx",
+            )
+        )  # fmt: skip
+    return out
+
+
+UNIT_FACTORS = (10.0, 0.1, 100.0, 0.01, 1000.0, 0.001, 2.54, 1 / 2.54, 25.4, 1 / 25.4)
+"""The factors a length unit is usually off by (a named unit for another)."""
+HUMAN_JOINTS = 10
+"""A skeleton with fewer joints may be no person: its size suggests no unit."""
+TYPICAL_HEIGHT_M = 1.75
+"""Metres: of the factors that make the character human-sized, the recipe takes the one that
+makes it nearest this."""
+
+
+def _unit(t: _Take) -> list[Finding]:
+    sizing = t.motion.skeleton.sizing()
+    height = sizing.told_by * t.meters
+    if HUMAN_HEIGHT[0] <= height < HUMAN_HEIGHT[1] or height == 0:
+        return []
+    human = len(t.motion.skeleton.joint_names) >= HUMAN_JOINTS
+    fits = [f for f in UNIT_FACTORS if human and HUMAN_HEIGHT[0] <= height * f < HUMAN_HEIGHT[1]]
+    fits.sort(key=lambda f: abs(math.log(height * f / TYPICAL_HEIGHT_M)))  # the likeliest first
+    unit = t.motion.skeleton.length_unit or "inch"
+    return [
+        Finding(
+            t.name, "unit", (), t.motion.first_frame, t.motion.last_frame, "high", round(height, 6), "m",
+            f"the character is {height:.3g} m {'tall' if sizing.axis in (None, sizing.up) else 'wide'} "
+            f"in the length unit in effect ({unit}, {t.motion.skeleton.length_source})"
+            + (f": lengths {fits[0]:g} times as long make it {height * fits[0]:.3g} m" if fits else ""),
+            fix=(("scale", {"factor": fits[0]}),) if fits else (),
+        )
+    ]  # fmt: skip
+
+
+def recipe(findings: Iterable[Finding], severities: tuple[str, ...] = ("medium", "high")) -> Pipeline:
+    """The steps that fix the findings of ``severities`` (those with a fix): unit first, then
+    flips, then the frames filled, then smoothing, each confined to its frames and joints."""
+    order = ("scale", "unroll", "fill_gaps", "butterworth")
+    entries = [step for f in findings if f.severity in severities for step in f.fix]
+    entries.sort(key=lambda e: order.index(e[0]) if e[0] in order else len(order))
+    pipeline = Pipeline()
+    seen = []
+    for name, options in entries:
+        if (name, options) in seen:
+            continue
+        seen.append((name, options))
+        pipeline = pipeline.then(name, **options)
+    return pipeline

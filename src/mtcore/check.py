@@ -1,0 +1,96 @@
+"""The take check's channel pass: gaps, frozen runs, spikes, steps and repeated rows in one pass
+(the kernel ``mt_check_channels``).  What the events mean for a take, in its units and joints,
+is :mod:`motiontheater.databases.check`'s."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _checks
+from ._cdata import c_array
+from ._mtcore import ffi, lib
+from ._status import check
+
+__all__ = ["FROZEN", "GAP", "KINDS", "REPEAT", "SPIKE", "STEP", "ChannelEvents", "channel_events"]
+
+GAP, FROZEN, SPIKE, STEP, REPEAT = (
+    lib.MT_CHECK_GAP,
+    lib.MT_CHECK_FROZEN,
+    lib.MT_CHECK_SPIKE,
+    lib.MT_CHECK_STEP,
+    lib.MT_CHECK_REPEAT,
+)
+KINDS = {GAP: "gap", FROZEN: "frozen", SPIKE: "spike", STEP: "step", REPEAT: "repeat"}
+"""The kind codes of the events, named."""
+
+
+@dataclass(frozen=True)
+class ChannelEvents:
+    """What the pass found.  ``events`` (n, 5) intp rows of channel, first row, last row
+    (inclusive), kind and the row where ``sizes`` peaks, sorted by channel, first row and kind;
+    repeated rows have channel ``channels``.  ``roughness`` and ``smooth_rows`` per channel: the
+    sum of squared residuals from the mean of the two neighbours over the rows where that stays
+    within the spike limit, and how many rows that was."""
+
+    events: np.ndarray
+    sizes: np.ndarray
+    roughness: np.ndarray
+    smooth_rows: np.ndarray
+
+
+def channel_events(
+    values: ArrayLike,
+    spike_limit: ArrayLike,
+    step_limit: ArrayLike,
+    min_run: int,
+    begin: int = 0,
+    end: int | None = None,
+) -> ChannelEvents:
+    """The events of the (rows, channels) values' rows ``begin`` .. ``end - 1`` (the others are
+    read as neighbours): runs of NaN, runs of at least ``min_run`` equal values, samples farther
+    than ``spike_limit`` (one per channel, or one for all) from the median of the five around
+    them, changes farther than ``step_limit`` from both changes beside them, and rows that repeat
+    the row before in every channel.  The kinds and sizes are those of ``mt_check_channels``
+    (csrc/mtcore.h)."""
+    x = np.ascontiguousarray(values, dtype=np.float64)
+    if x.ndim != 2:
+        raise ValueError(f"values must be two-dimensional (rows, channels), got shape {x.shape}")
+    rows, channels = x.shape
+    spikes = _limits(spike_limit, channels, "spike_limit")
+    steps = _limits(step_limit, channels, "step_limit")
+    min_run = _checks.integer(min_run, "min_run", 1)
+    begin = _checks.integer(begin, "begin", 0, rows)
+    end = rows if end is None else _checks.integer(end, "end", begin, rows)
+    roughness = np.zeros(channels)
+    smooth = np.zeros(channels, dtype=np.uintp)
+    count = ffi.new("size_t *")
+    capacity = 64
+    while True:
+        events = np.zeros((capacity, 5), dtype=np.uintp)
+        sizes = np.zeros(capacity)
+        status = lib.mt_check_channels(
+            c_array(x), rows, channels, channels, begin, end, c_array(spikes), c_array(steps), min_run,
+            c_array(events, "size_t[]"), c_array(sizes), capacity, count, c_array(roughness),
+            c_array(smooth, "size_t[]"),
+        )  # fmt: skip
+        check(status, "mt_check_channels")
+        if count[0] <= capacity:
+            break
+        capacity = count[0]
+    events, sizes = events[: count[0]].astype(np.intp), sizes[: count[0]]
+    order = np.lexsort((events[:, 3], events[:, 1], events[:, 0]))
+    return ChannelEvents(events[order], sizes[order], roughness, smooth.astype(np.intp))
+
+
+def _limits(limit: ArrayLike, channels: int, name: str) -> np.ndarray:
+    a = np.asarray(limit, dtype=np.float64)
+    if a.ndim == 0:
+        a = np.full(channels, float(a))
+    if a.shape != (channels,):
+        raise ValueError(f"{name} must be a number or one per channel ({channels}), got shape {a.shape}")
+    if np.isnan(a).any() or (a < 0).any():
+        raise ValueError(f"{name} must be non-negative numbers, got {a[np.isnan(a) | (a < 0)][0]}")
+    return np.ascontiguousarray(a)

@@ -1,0 +1,156 @@
+"""The take check on real takes of every producer and rig: artifacts put in at random frames and
+joints are found (precision and recall of at least 0.95 per kind), the recipes it writes remove
+them and touch no other frame, and what it says of the clean takes holds together."""
+
+import collections
+import math
+
+import numpy as np
+import pytest
+
+import motiontheater as mt
+from artifacts import KINDS, hits, inject
+from corpus import real_files
+from motiontheater.databases.check import check_motion, recipe
+from motiontheater.databases.findings import KINDS as FINDING_KINDS
+from motiontheater.databases.findings import SEVERITIES
+from variants import with_offset_channels, with_static_root
+
+TAKES = real_files("*/*.amc") + real_files("*/*.bvh")
+BVHS = [p for p in TAKES if p.suffix == ".bvh"]
+VARIANTS = {
+    "as found": lambda take: take,
+    "game rig": lambda take: with_static_root(with_offset_channels(take), shift=(250.0, 0.0, -400.0)),
+    "z-up": lambda take: with_static_root(take, turn=(90.0, 0.0, 0.0), keep_world=False),
+    "in mm": lambda take: take.with_units(length_factor=1000 * take.skeleton.meters_per_unit, length="mm"),
+}
+TRIALS = 3  # injections of each kind per take and variant
+UNITS = {"deg", "m", "m/s", "s", ""}
+
+
+def _variant(path, name, tmp_path):
+    """The take as the variant's producer would write it: through a BVH file, read back."""
+    take = mt.read_take(path)
+    if name == "as found":
+        return take
+    target = tmp_path / f"{path.stem}.bvh"
+    mt.write_bvh(VARIANTS[name](take), target)
+    return mt.read_take(target)
+
+
+def _before(finding, base) -> bool:
+    """Whether the clean take already had this finding (same kind and joints, frames overlapping)."""
+    return any(
+        b.kind == finding.kind and b.joints == finding.joints and b.first <= finding.last and finding.first <= b.last
+        for b in base
+    )
+
+
+def _touched(motion, steps) -> np.ndarray:
+    """The cells (frames, channels) that a recipe's steps may change."""
+    mask = np.zeros(motion.values.shape, bool)
+    skeleton = motion.skeleton
+    for name, options in steps:
+        if name == "scale":
+            mask[:] = True
+            continue
+        columns = skeleton.columns_of(options.get("joints"))
+        first, last = options.get("frames") or (motion.first_frame, motion.last_frame)
+        mask[first - motion.first_frame : last - motion.first_frame + 1, columns] = True
+    return mask
+
+
+@pytest.fixture(scope="module", params=list(VARIANTS))
+def injected(request, tmp_path_factory):
+    """Per kind: found, missed, false findings, fixed, and frames changed outside the fixes."""
+    if not TAKES:
+        pytest.skip("the real-file corpus (../shared/data) is absent")
+    name = request.param
+    tally = collections.defaultdict(collections.Counter)
+    rng = np.random.default_rng(26)
+    folder = tmp_path_factory.mktemp("variants")
+    for path in TAKES if name == "as found" else BVHS:
+        take = _variant(path, name, folder)
+        base = check_motion(take, str(path))
+        for kind in KINDS:
+            for _ in range(TRIALS):
+                made = inject(take, kind, rng)
+                if made is None:
+                    continue
+                motion, truth = made
+                found = check_motion(motion, str(path))
+                hit = any(hits(f, truth) for f in found)
+                tally[kind]["found" if hit else "missed"] += 1
+                for f in found:
+                    if not hits(f, truth) and not _before(f, base) and f.kind in KINDS:
+                        tally[f.kind]["false"] += 1
+                chosen = [f for f in found if f.severity in ("medium", "high")]
+                steps = [s for f in chosen for s in f.fix]
+                fixed = recipe(found).apply(motion)
+                # an artifact that joins a finding the take had (a hold beside a hold) is not the
+                # injection's alone to fix
+                if hit and not any(hits(f, truth) and _before(f, base) for f in found):
+                    kept = any(hits(f, truth) for f in check_motion(fixed, str(path)))
+                    tally[kind]["kept" if kept else "fixed"] += 1
+                outside = ~_touched(motion, steps)
+                same = np.array_equal(fixed.values[outside], motion.values[outside], equal_nan=True)
+                tally[kind]["untouched" if same else "touched"] += 1
+    return name, tally
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_injected_artifacts_are_found_with_precision_and_recall_of_095(injected, kind):
+    variant, tally = injected
+    counts = tally[kind]
+    found, missed, false = counts["found"], counts["missed"], counts["false"]
+    assert found + missed > 0, f"{variant}: no take had a place for a {kind}"
+    recall = found / (found + missed)
+    precision = found / (found + false) if found + false else 1.0
+    assert recall >= 0.95 and precision >= 0.95, (variant, kind, dict(counts))
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_recipes_remove_the_injected_findings_and_change_no_frame_outside_them(injected, kind):
+    variant, tally = injected
+    counts = tally[kind]
+    assert counts["fixed"] >= 0.95 * (counts["fixed"] + counts["kept"]), (variant, kind, dict(counts))
+    assert counts["touched"] == 0, (variant, kind, dict(counts))
+
+
+@pytest.mark.parametrize("path", TAKES, ids=[p.name for p in TAKES])
+def test_every_finding_on_a_real_take_names_its_frames_joints_and_units(path):
+    take = mt.read_take(path)
+    findings = check_motion(take, str(path))
+    joints = set(take.skeleton.joint_names)
+    for f in findings:
+        assert f.take == str(path)
+        assert f.kind in FINDING_KINDS and f.severity in SEVERITIES
+        assert set(f.joints) <= joints, f
+        assert take.first_frame <= f.first <= f.last <= take.last_frame, f
+        assert f.unit in UNITS and math.isfinite(f.size), f
+        if f.channel is not None:
+            joint, dof = f.channel.rsplit(" ", 1)
+            assert dof in take.skeleton.dofs(joint), f
+        for name, options in f.fix:
+            mt.Pipeline.of(name, **options)  # each fix is a step with options it takes
+    assert recipe(findings).apply(take).frames == take.frames
+
+
+def test_a_clean_synthetic_take_has_no_finding_above_low():
+    """Smooth motion at 120 Hz and 30 Hz: nothing a person would call a problem."""
+    for rate in (120.0, 30.0):
+        take = _smooth_take(rate)
+        assert [f for f in check_motion(take) if f.severity != "low"] == []
+
+
+def _smooth_take(rate: float) -> mt.Motion:
+    cmu = real_files("cmu/01_01.amc")
+    if not cmu:
+        pytest.skip("the real-file corpus (../shared/data) is absent")
+    skeleton = mt.read_take(cmu[0]).skeleton
+    t = np.arange(int(4 * rate))[:, None] / rate
+    channels = len(skeleton.channels)
+    phase = np.linspace(0, 2 * np.pi, channels)[None, :]
+    values = 20 * np.sin(2 * np.pi * 0.8 * t + phase)
+    values[:, :3] = np.hstack([t * 10, np.full_like(t, 17.0), t * 5])  # a walk at 1 m/s in inch/0.45
+    return mt.Motion(skeleton, values, frame_rate=rate)

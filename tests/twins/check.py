@@ -1,0 +1,96 @@
+"""The take check's channel pass (mt_check_channels), from its contract, one channel at a time."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mtcore.check import FROZEN, GAP, REPEAT, SPIKE, STEP
+
+
+def _runs(flags: list[bool]) -> list[tuple[int, int]]:
+    """(first, last) of each run of True."""
+    out, start = [], None
+    for t, f in enumerate([*flags, False]):
+        if f and start is None:
+            start = t
+        elif not f and start is not None:
+            out.append((start, t - 1))
+            start = None
+    return out
+
+
+def _peak(scores: list[float], first: int, last: int) -> tuple[float, int]:
+    """The score of largest magnitude in first..last (the first such) and its row."""
+    at = max(range(first, last + 1), key=lambda t: (abs(scores[t]), -t))
+    return scores[at], at
+
+
+def _mirror(i: int, n: int) -> int:
+    if i < 0:
+        i = -i
+    if i > n - 1:
+        i = 2 * (n - 1) - i
+    return min(max(i, 0), n - 1)
+
+
+def check_channels_twin(values, spike_limit, step_limit, min_run, begin=0, end=None):
+    x = np.asarray(values, dtype=float)
+    rows, channels = x.shape
+    end = rows if end is None else end
+    spike_limit = np.broadcast_to(np.asarray(spike_limit, float), (channels,))
+    step_limit = np.broadcast_to(np.asarray(step_limit, float), (channels,))
+    checked = range(begin, end)
+    events: list[tuple[int, int, int, int, int, float]] = []
+    roughness, smooth = np.zeros(channels), np.zeros(channels, dtype=np.intp)
+    for k in range(channels):
+        v = x[:, k]
+        nan = [math.isnan(v[t]) if t in checked else False for t in range(rows)]
+        for first, last in _runs(nan):
+            events.append((k, first, last, GAP, first, 0.0))
+        # frozen: rows equal to the row before, each run joined to the row it repeats
+        same = [t in checked and t > 0 and v[t] == v[t - 1] for t in range(rows)]
+        for first, last in _runs(same):
+            first -= 1
+            if last - first + 1 >= min_run or first < begin or last + 1 >= end:
+                events.append((k, first, last, FROZEN, first, float(v[first])))
+        deviation = [0.0] * rows
+        jump = [0.0] * rows
+        for t in checked:
+            if math.isnan(v[t]):
+                continue
+            before = v[t - 1] if t > 0 else v[t]
+            after = v[t + 1] if t + 1 < rows else v[t]
+            r = v[t] - 0.5 * (before + after)
+            if 0 < t < rows - 1 and abs(r) <= spike_limit[k]:
+                roughness[k] += r * r
+                smooth[k] += 1
+            if rows >= 3:
+                window = [v[_mirror(t + d, rows)] for d in (-2, -1, 0, 1, 2)]
+                if not any(math.isnan(w) for w in window):
+                    d = v[t] - float(np.median(window))
+                    if abs(d) > spike_limit[k]:
+                        deviation[t] = d
+            if t > 0:
+                change = v[t] - v[t - 1]
+                beside = []
+                if t > 1:
+                    beside.append(v[t - 1] - v[t - 2])
+                if t + 1 < rows:
+                    beside.append(v[t + 1] - v[t])
+                if beside and all(abs(change - b) > step_limit[k] for b in beside):
+                    j = change - sum(beside) / len(beside)
+                    if abs(j) > step_limit[k]:
+                        jump[t] = j
+        for kind, scores in ((SPIKE, deviation), (STEP, jump)):
+            for first, last in _runs([s != 0.0 for s in scores]):
+                size, at = _peak(scores, first, last)
+                events.append((k, first, last, kind, at, size))
+    repeats = [t in checked and t > 0 and bool(np.all(x[t] == x[t - 1])) and channels > 0 for t in range(rows)]
+    for first, last in _runs(repeats):
+        events.append((channels, first, last, REPEAT, first, 0.0))
+    events.sort(key=lambda e: (e[0], e[1], e[3]))
+    table = np.array([e[:5] for e in events], dtype=np.intp).reshape(-1, 5)
+    sizes = np.array([e[5] for e in events], dtype=float)
+    return table, sizes, roughness, smooth
