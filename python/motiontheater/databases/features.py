@@ -28,13 +28,14 @@ from mtcore.search import hysteresis, pack_bits
 from ..characters.rigs import recognise
 from ..feet.upright import take_up
 from ..model.motion import Motion
+from ..model.rig import body_joint
 
 FEATURE_RATE = 10.0
 """Hz: the rate features are kept at (Müller et al. use 10 Hz: motion classes differ in
 seconds, not in hundredths)."""
 
 POINTS = (
-    ("hips", ("hips",)),
+    ("hips", ()),  # the joint that carries the body (a static root above it is no body)
     ("left_hip", ("left_thigh",)),
     ("right_hip", ("right_thigh",)),
     ("left_knee", ("left_shin",)),
@@ -49,10 +50,11 @@ POINTS = (
     ("right_elbow", ("right_forearm",)),
     ("left_wrist", ("left_wrist", "left_hand")),
     ("right_wrist", ("right_wrist", "right_hand")),
-    ("neck", ("neck", "head")),
-    ("head", ("head",)),
+    ("neck", ("neck", "spine-", "head")),
+    ("head", ("head", "neck-")),
 )
-"""Each point of the body, and the rig parts whose joint sits there (the first the rig has)."""
+"""Each point of the body, and the rig parts whose joint sits there (the first the rig has; of a
+chain its first joint, or with "-" its last: a rig without a head joint has its neck's top)."""
 _AT = {name: i for i, (name, _) in enumerate(POINTS)}
 SPEED_WEIGHT = 0.5
 """How much the hips' speed over the floor (leg lengths per second) counts against the pose."""
@@ -125,10 +127,12 @@ def body(motion: Motion, rate: float = FEATURE_RATE) -> Body:
 
 def _joints(motion: Motion) -> list[int]:
     parts = recognise(motion.skeleton).parts
-    names = motion.skeleton.joint_names
-    out, missing = [], []
-    for point, tried in POINTS:
-        joint = next((parts[p][0] for p in tried if p in parts), None)
+    names = motion.skeleton.point_names  # the rig tables name the root as the file does
+    out, missing = [motion.skeleton.joint_names.index(body_joint(motion))], []  # the hips: the body's joint
+    for point, tried in POINTS[1:]:
+        joint = next(
+            (parts[p.rstrip("-")][-1 if p.endswith("-") else 0] for p in tried if p.rstrip("-") in parts), None
+        )
         if joint is None:
             missing.append(point)
         else:

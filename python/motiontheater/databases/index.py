@@ -28,19 +28,24 @@ from ..model.errors import FormatError
 from .batch import Progress, find_takes, run_each
 from .features import FEATURE_RATE, body, pose_features, words
 
-FORMAT = "motiontheater search database 1"
+FORMAT = "motiontheater search database 2"
+
+
+class OtherVersion(ValueError):
+    """A search database of another version of this format: indexing again replaces it."""
 
 
 @dataclass(frozen=True)
 class Entry:
     """One take of a database: ``take`` its path as indexed, ``size`` and ``mtime_ns`` as it was
-    when indexed, ``first_frame`` and ``frame_rate`` as the file numbers and times its frames,
+    when indexed, ``first_frame``, ``last_frame`` and ``frame_rate`` as the file numbers and times its frames,
     and its rows ``start`` .. ``start + rows`` of the database's arrays."""
 
     take: str
     size: int
     mtime_ns: int
     first_frame: int
+    last_frame: int
     frame_rate: float
     start: int
     rows: int
@@ -66,6 +71,7 @@ class Indexed:
     words: np.ndarray | None = None
     frames: np.ndarray | None = None
     first_frame: int = 1
+    last_frame: int = 0
     frame_rate: float = 0.0
     error: str | None = None
     bytes: int = 0
@@ -85,6 +91,7 @@ def index_job(job: IndexJob) -> Indexed:
         words(b),
         b.frames.astype(np.int64),
         motion.first_frame,
+        motion.last_frame,
         motion.frame_rate,
         bytes=job.bytes,
     )
@@ -148,14 +155,20 @@ class Database:
             with np.load(path, allow_pickle=False) as data:
                 meta = json.loads(str(data["meta"]))
                 if meta.get("format") != FORMAT:
-                    raise ValueError(f"{path}: not a search database of this version ({meta.get('format')!r})")
+                    raise OtherVersion(
+                        f"{path}: a search database of another version ({meta.get('format')!r}, this is "
+                        f"{FORMAT!r}): index the takes again"
+                    )
                 entries = [Entry(**e) for e in meta["entries"]]
                 return cls(entries, data["poses"], data["words"], data["frames"])
-        except (OSError, KeyError, ValueError, json.JSONDecodeError) as e:
-            if isinstance(e, ValueError) and str(path) in str(e):
+        except FileNotFoundError:
+            raise ValueError(f"{path}: no such database (motiontheater index writes one)") from None
+        except (OSError, KeyError, TypeError, ValueError) as e:
+            if isinstance(e, OtherVersion):
                 raise
+            why = f": {e.strerror}" if isinstance(e, OSError) and e.strerror else ""
             raise ValueError(
-                f"{path}: not a motiontheater search database (motiontheater index writes one): {e}"
+                f"{path}: not a motiontheater search database (motiontheater index writes one){why}"
             ) from None
 
 
@@ -214,16 +227,16 @@ def build(
             if r.error is not None or r.poses is None or r.words is None or r.frames is None:
                 failed.append((path, r.error or "no features"))
                 continue
-            piece, first_frame, rate = (r.poses, r.words, r.frames), r.first_frame, r.frame_rate
+            piece, frames, rate = (r.poses, r.words, r.frames), (r.first_frame, r.last_frame), r.frame_rate
         else:
             assert previous is not None
             old = known[path]
             rows = previous.rows_of(old)
             piece = (previous.poses[rows], previous.words[rows], previous.frames[rows])
-            first_frame, rate = old.first_frame, old.frame_rate
+            frames, rate = (old.first_frame, old.last_frame), old.frame_rate
         assert stat is not None
         n = len(piece[1])
-        entries.append(Entry(path, stat.st_size, stat.st_mtime_ns, first_frame, rate, start, n))
+        entries.append(Entry(path, stat.st_size, stat.st_mtime_ns, *frames, rate, start, n))
         pieces.append(piece)
         start += n
     dims = pieces[0][0].shape[1] if pieces else (previous.poses.shape[1] if previous is not None else 0)
@@ -244,5 +257,11 @@ def build(
 
 
 def open_or_empty(path: str | os.PathLike) -> Database | None:
-    """The database at ``path`` if there is a file there, else None."""
-    return Database.load(path) if Path(path).exists() else None
+    """The database at ``path`` if there is one, else None (nothing there, or a database of
+    another version, which indexing replaces); ValueError for a file that is not a database."""
+    if not Path(path).exists():
+        return None
+    try:
+        return Database.load(path)
+    except OtherVersion:
+        return None

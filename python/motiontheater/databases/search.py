@@ -23,7 +23,7 @@ from mtcore.search import dtw, dtw_search, segments
 
 from ..model.motion import Motion
 from .features import body, pose_features, words
-from .index import Database
+from .index import Database, Entry
 
 BAND = 0.2
 """The DTW band's radius as a share of the query's length (Sakoe and Chiba's 10-20 %)."""
@@ -69,9 +69,11 @@ def search(
     *,
     band: float = BAND,
     exclude: Callable[[str], bool] | None = None,
+    use_index: bool = True,
 ) -> Found:
     """The ``k`` takes of ``database`` (those ``exclude`` does not exclude) whose windows are
-    nearest the query clip by DTW, one hit per take, best first (see the module docstring)."""
+    nearest the query clip by DTW, one hit per take, best first (see the module docstring);
+    ``use_index=False`` ranks every window, as the index's filter does when it finds too few."""
     if isinstance(k, bool) or not isinstance(k, int) or k < 1:
         raise ValueError(f"k must be a whole number >= 1, got {k!r}")
     if not (isinstance(band, (int, float)) and 0 <= band <= 1):
@@ -88,7 +90,7 @@ def search(
     searched = [i for i, e in enumerate(database.entries) if exclude is None or not exclude(e.take)]
     takes = [i for i in searched if database.entries[i].rows >= m]
     every = _windows(database, takes, m)
-    chosen = _filtered(database, words(b), takes, m, radius, k)
+    chosen = _filtered(database, words(b), takes, m, radius, k) if use_index else None
     starts = chosen if chosen is not None else every
     hits, warped = _longer(database, q, starts, radius, k)
     for i in searched:  # a take shorter than the query: the whole of it against the whole query
@@ -96,7 +98,7 @@ def search(
         if e.rows < m:
             rows = database.series()[database.rows_of(e)]
             distance = dtw(q, rows, m - e.rows + radius) / m
-            hits[i] = Hit(e.take, int(database.frames[e.start]), int(database.frames[e.start + e.rows - 1]), distance)
+            hits[i] = Hit(e.take, *_span(database, e, e.start, e.rows), distance)
             warped += 1
     ranked = sorted(hits.values(), key=lambda h: (h.distance, h.take))[:k]
     return Found(tuple(ranked), len(starts), len(every), chosen is not None, int(warped))
@@ -114,12 +116,19 @@ def _longer(database: Database, q: np.ndarray, starts: np.ndarray, radius: int, 
         for start, distance, take in zip(found.starts, found.distances, database.owner(found.starts)):
             if int(take) not in hits:
                 e = database.entries[int(take)]
-                first, last = int(database.frames[start]), int(database.frames[start + m - 1])
-                hits[int(take)] = Hit(e.take, first, last, float(distance) / m)
+                hits[int(take)] = Hit(e.take, *_span(database, e, start, m), float(distance) / m)
         if len(hits) >= k or want >= len(starts):
             break
         want *= 4  # a take's neighbouring windows crowd the list: ask for more
     return hits, warped
+
+
+def _span(database: Database, entry: Entry, start: int, rows: int) -> tuple[int, int]:
+    """The take's frames that rows start .. start + rows - 1 stand for: each row its frame and
+    those up to the next row's (the last row of a take, up to its last frame)."""
+    end = start + rows
+    last = database.frames[end] - 1 if end < entry.start + entry.rows else entry.last_frame
+    return int(database.frames[start]), int(last)
 
 
 def _windows(database: Database, takes: list[int], m: int) -> np.ndarray:
