@@ -12,9 +12,9 @@ import pytest
 import motiontheater as mt
 from corpus import real_files
 from motiontheater.cli import main
-from motiontheater.databases.features import body, pose_features
+from motiontheater.databases.features import body, moves, pose_features
 from motiontheater.databases.index import Database, build
-from motiontheater.databases.search import search
+from motiontheater.databases.search import nearest_frames, search
 from mtcore.search import dtw
 from variants import with_offset_channels, with_static_root
 
@@ -183,3 +183,20 @@ def test_bad_databases_and_queries_are_told_in_a_sentence(tmp_path, capsys):
     assert main(["index", str(HDM[0]), "-o", str(db), "--quiet"]) == 0
     assert main(["search", str(db), str(HDM[0]), "--frames", "1:10"]) != 0
     assert "at least 0.3 s" in capsys.readouterr().err
+
+
+def test_frame_search_equals_brute_force_and_finds_the_frame_itself(hdm05):
+    for query_path in (HDM[1], HDM[12], HDM[30]):
+        take = mt.read_take(query_path)
+        frame = take.first_frame + 24  # a frame the database keeps a row of (every 12th at 120 Hz)
+        hits = nearest_frames(hdm05, take, frame, 8)
+        q = moves(body(take))[2].astype(np.float64)
+        d = np.sum((hdm05.moves.astype(np.float64) - q) ** 2, axis=1)
+        order = np.lexsort((np.arange(len(d)), d))[:8]
+        assert [(h.take, h.first) for h in hits] == [
+            (hdm05.entries[int(hdm05.owner(np.array([r]))[0])].take, int(hdm05.frames[r])) for r in order
+        ]
+        np.testing.assert_allclose([h.distance for h in hits], d[order], rtol=0, atol=1e-12)
+        assert hits[0].take == str(query_path) and hits[0].first == frame and hits[0].distance < 1e-12
+    others = nearest_frames(hdm05, take, frame, 3, exclude=lambda t: t == str(query_path))
+    assert len(others) == 3 and all(h.take != str(query_path) for h in others)

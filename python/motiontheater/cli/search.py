@@ -57,7 +57,14 @@ def _index(args: argparse.Namespace) -> int:
 def _search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("database", metavar="DB", help="a database that 'motiontheater index' wrote")
     parser.add_argument("query", metavar="QUERY", help="the take (AMC or BVH) holding the motion to find")
-    parser.add_argument("-k", type=int, default=10, help="how many takes to list (default 10)")
+    parser.add_argument("-k", type=int, default=10, help="how many takes (or frames) to list (default 10)")
+    parser.add_argument(
+        "--frame",
+        type=int,
+        metavar="N",
+        help="frame search (motion matching): the frames whose feet, hips and path ahead are nearest the query's "
+        "at frame N",
+    )
     parser.add_argument("--json", action="store_true", help="print the hits as JSON (a list of objects)")
     parser.add_argument("--view", metavar="PAGE", help="write a viewer page of the query and the hits side by side")
     add_take_options(parser, frames=True)
@@ -65,38 +72,62 @@ def _search_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _search(args: argparse.Namespace) -> int:
     from ..databases.index import Database
-    from ..databases.search import search
+    from ..databases.search import nearest_frames, search
 
     db = Database.load(args.database)
     query = take_of(args, args.query)
     if args.frames is not None:
         query = query.crop(*args.frames)
+    if args.frame is not None and args.frames is not None:
+        raise ValueError("give --frame N (frame search) or --frames A:B (a clip to find), not both")
     start = time.perf_counter()
-    found = search(db, query, args.k)
+    if args.frame is not None:
+        hits = nearest_frames(db, query, args.frame, args.k)
+        how = f"frame search: the {len(hits)} nearest of {len(db.frames)} frames"
+    else:
+        found = search(db, query, args.k)
+        hits = found.hits
+        how = (
+            f"{len(hits)} of {len(db)} takes, "
+            + ("the index's candidates" if found.filtered else "every window")
+            + f": {found.windows} of {found.total} windows, {found.warped} warped"
+        )
     seconds = time.perf_counter() - start
     if args.json:
-        json.dump([h.as_dict() for h in found.hits], sys.stdout, indent=1)
+        json.dump([h.as_dict() for h in hits], sys.stdout, indent=1)
         sys.stdout.write("\n")
     else:
-        for rank, hit in enumerate(found.hits, 1):
-            print(f"{rank:3d}  {hit.distance:10.4g}  frames {hit.first}-{hit.last:<8d} {hit.take}")
-    how = "the index's candidates" if found.filtered else "every window"
-    last = (
-        f"search: {len(found.hits)} of {len(db)} takes in {seconds * 1000:.0f} ms ({how}: {found.windows} of "
-        f"{found.total} windows, {found.warped} warped)"
-    )
+        for rank, hit in enumerate(hits, 1):
+            where = f"frame {hit.first}" if hit.first == hit.last else f"frames {hit.first}-{hit.last}"
+            print(f"{rank:3d}  {hit.distance:10.4g}  {where:<17} {hit.take}")
+    last = f"search: {how}, in {seconds * 1000:.0f} ms"
     if args.view:
-        from ..formats.table import read_take
-        from ..views.viewer import write_page
-
-        takes = [query] + [
-            read_take(h.take, args.asf, args.frame_rate, args.unit).crop(h.first, h.last) for h in found.hits
-        ]
-        names = ["query"] + [f"{i}. {h.take} {h.first}-{h.last}" for i, h in enumerate(found.hits, 1)]
-        write_page(takes, args.view, names=names, title=f"search: {args.query}")
+        _view(args, query, hits)
         last += f"; wrote {args.view}"
     print(last, file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+AHEAD = 1.5
+"""Seconds of each frame search hit that the viewer page shows: the frame and what follows it."""
+
+
+def _view(args: argparse.Namespace, query, hits) -> None:
+    """The viewer page of the query and the hits, each from its first frame (a frame search's:
+    the frame and AHEAD seconds after it), so that they play aligned."""
+    from ..formats.table import read_take
+    from ..views.viewer import write_page
+
+    def piece(take, first: int, last: int):
+        if args.frame is not None:
+            last = min(take.last_frame, first + round(AHEAD * take.frame_rate))
+        return take.crop(first, last)
+
+    start = args.frame if args.frame is not None else query.first_frame
+    takes = [piece(query, start, query.last_frame)]
+    takes += [piece(read_take(h.take, args.asf, args.frame_rate, args.unit), h.first, h.last) for h in hits]
+    names = ["query"] + [f"{i}. {h.take} from {h.first}" for i, h in enumerate(hits, 1)]
+    write_page(takes, args.view, names=names, title=f"search: {args.query}")
 
 
 INDEX = Verb(
@@ -123,11 +154,14 @@ SEARCH = Verb(
         "List the -k takes of the database whose windows are nearest the query (the whole take, or --frames A:B "
         "of it) by dynamic time warping of the body features, one window per take, nearest first: the distance "
         "(per query row, 0 for the query itself), the frames as the file numbers them, and the take. The index "
-        "of relational features chooses the windows to warp where it finds enough; every window is warped "
-        "otherwise, so the order is exact either way."
+        "of relational features chooses the windows to warp where it finds windows in -k takes or more, every "
+        "window is warped otherwise; the windows warped are ranked exactly. With --frame N, frame search (motion "
+        "matching): the -k frames whose feet, hips' velocity and path over the next second are nearest the "
+        "query's at frame N (features are kept at 10 Hz: a hit is one of every tenth of a second)."
     ),
     epilog=(
         "Example: motiontheater search captures.npz 01_01.amc --frames 100:340 -k 5 --view hits.html\n"
-        "Example: motiontheater search captures.npz kick.bvh --json"
+        "Example: motiontheater search captures.npz kick.bvh --json\n"
+        "Example: motiontheater search captures.npz walk.bvh --frame 200 -k 5"
     ),
 )

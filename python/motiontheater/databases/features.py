@@ -66,7 +66,8 @@ class Body:
     body's left, y up, z forward; ``height`` (frames,) the hips above the floor and ``speed``
     (frames,) the hips' speed over it, in leg lengths (per second), ``turning`` (frames,) how
     fast the hips turn about up, degrees per second; at ``rate`` Hz, the frame at row i being
-    the take's frame ``frames[i]``."""
+    the take's frame ``frames[i]``; ``place`` (frames, 2) where the hips stand on the floor
+    (world x and z, leg lengths) and ``facing`` (frames, 2) the unit vector they face, in x, z."""
 
     points: np.ndarray
     height: np.ndarray
@@ -74,6 +75,8 @@ class Body:
     turning: np.ndarray
     rate: float
     frames: np.ndarray
+    place: np.ndarray
+    facing: np.ndarray
 
     def at(self, name: str) -> np.ndarray:
         """The point ``name`` (one of POINTS) over the frames, (frames, 3)."""
@@ -122,7 +125,10 @@ def body(motion: Motion, rate: float = FEATURE_RATE) -> Body:
         speed = np.linalg.norm(speed, axis=1) / tick / leg
         heading = np.unwrap(np.arctan2(forward[:, 0], forward[:, 2]))
         turning = np.degrees(np.gradient(heading)) / tick
-    return Body(points, (hips[:, 1] - floor) / leg, speed, turning, 1 / tick, rows + motion.first_frame)
+    return Body(
+        points, (hips[:, 1] - floor) / leg, speed, turning, 1 / tick, rows + motion.first_frame,
+        hips[:, [0, 2]] / leg, forward[:, [0, 2]],
+    )  # fmt: skip
 
 
 def _joints(motion: Motion) -> list[int]:
@@ -164,6 +170,45 @@ def pose_features(b: Body) -> np.ndarray:
     """(frames, dims): every point but the hips in the body's frame, the hips' height and their
     speed over the floor (weighted by SPEED_WEIGHT)."""
     return np.hstack([b.points[:, 1:].reshape(len(b.points), -1), b.height[:, None], SPEED_WEIGHT * b.speed[:, None]])
+
+
+FUTURE = (0.3, 0.7, 1.0)
+"""Seconds ahead at which a frame's future path is compared (motion matching's trajectory)."""
+MOVE_WEIGHTS = {"feet": 1.0, "feet speed": 0.1, "hips speed": 0.2, "path": 0.5, "facing": 0.5}
+"""How much each part of a frame's move counts (positions in leg lengths, speeds in leg lengths
+per second, facing as unit vectors), as motion matching weights them."""
+
+
+def moves(b: Body) -> np.ndarray:
+    """(frames, 27) what motion matching compares at each frame, in the hips' frame at that frame:
+    the ankles where they are and how fast they move (12), the hips' velocity (3), and the path
+    ahead: where the hips will stand and face after each of FUTURE (12; the take's last frame
+    where it ends sooner), each part weighted by MOVE_WEIGHTS."""
+    n = len(b.frames)
+    ankles = np.hstack([b.at("left_ankle"), b.at("right_ankle")])
+    velocity = np.gradient(ankles, axis=0) * b.rate if n > 1 else np.zeros_like(ankles)
+    side = np.stack([b.facing[:, 1], -b.facing[:, 0]], axis=1)  # the body's left, (x, z)
+
+    def local(v: np.ndarray) -> np.ndarray:  # world (x, z) vectors as (to the left, ahead) at each frame
+        return np.stack([np.sum(v * side, 1), np.sum(v * b.facing, 1)], axis=1)
+
+    hips = np.gradient(b.place, axis=0) * b.rate if n > 1 else np.zeros_like(b.place)
+    path, facing = [], []
+    for seconds in FUTURE:
+        ahead = np.minimum(np.arange(n) + round(seconds * b.rate), n - 1)
+        path.append(local(b.place[ahead] - b.place))
+        facing.append(local(b.facing[ahead]))
+    w = MOVE_WEIGHTS
+    return np.hstack(
+        [
+            w["feet"] * ankles,
+            w["feet speed"] * velocity,
+            w["hips speed"]
+            * np.hstack([local(hips), np.gradient(b.height)[:, None] * b.rate if n > 1 else np.zeros((n, 1))]),
+            w["path"] * np.hstack(path),
+            w["facing"] * np.hstack(facing),
+        ]
+    )
 
 
 def _angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:

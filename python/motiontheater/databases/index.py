@@ -5,8 +5,9 @@ A database is one ``.npz`` file (numpy's zip of arrays, written whole or not at 
 take its path as indexed, size and modification time (what tells a changed take), its frame
 numbering and rate, and where its rows lie in three arrays that hold every take's rows one
 after the other at FEATURE_RATE: ``poses`` (rows, dims) float32 (:func:`.features.pose_features`),
-``words`` (rows,) uint64 (:func:`.features.words`) and ``frames`` (rows,) the take's frame number
-of each row.  Reading it builds the inverted index of the words' segments in C
+``moves`` (rows, 27) float32 (:func:`.features.moves`, what frame search compares), ``words``
+(rows,) uint64 (:func:`.features.words`) and ``frames`` (rows,) the take's frame number of each
+row.  Reading it builds the inverted index of the words' segments in C
 (:class:`mtcore.search.FeatureIndex`).
 """
 
@@ -20,15 +21,15 @@ from pathlib import Path
 
 import numpy as np
 
-from mtcore.search import FeatureIndex
+from mtcore.search import FeatureIndex, KDTree
 
 from .._io import output
 from ..formats.table import read_take
 from ..model.errors import FormatError
 from .batch import Progress, find_takes, run_each
-from .features import FEATURE_RATE, body, pose_features, words
+from .features import FEATURE_RATE, body, moves, pose_features, words
 
-FORMAT = "motiontheater search database 2"
+FORMAT = "motiontheater search database 3"
 
 
 class OtherVersion(ValueError):
@@ -68,6 +69,7 @@ class Indexed:
 
     take: str
     poses: np.ndarray | None = None
+    moves: np.ndarray | None = None
     words: np.ndarray | None = None
     frames: np.ndarray | None = None
     first_frame: int = 1
@@ -88,6 +90,7 @@ def index_job(job: IndexJob) -> Indexed:
     return Indexed(
         job.take,
         pose_features(b).astype(np.float32),
+        moves(b).astype(np.float32),
         words(b),
         b.frames.astype(np.int64),
         motion.first_frame,
@@ -100,19 +103,29 @@ def index_job(job: IndexJob) -> Indexed:
 class Database:
     """A search database (see the module docstring): ``entries`` and the rows of every take."""
 
-    def __init__(self, entries: list[Entry], poses: np.ndarray, words: np.ndarray, frames: np.ndarray):
+    def __init__(
+        self, entries: list[Entry], poses: np.ndarray, moves: np.ndarray, words: np.ndarray, frames: np.ndarray
+    ):
         self.entries = entries
         self.poses = poses
+        self.moves = moves
         self.words = words
         self.frames = frames
         self.starts = np.array([e.start for e in entries], dtype=np.intp)
         self._index: FeatureIndex | None = None
         self._series: np.ndarray | None = None
+        self._tree: KDTree | None = None
 
     @classmethod
     def empty(cls, dims: int = 0) -> Database:
         """A database of no take, its poses of ``dims`` dimensions."""
-        return cls([], np.empty((0, dims), np.float32), np.empty(0, np.uint64), np.empty(0, np.int64))
+        return cls(
+            [],
+            np.empty((0, dims), np.float32),
+            np.empty((0, 27), np.float32),
+            np.empty(0, np.uint64),
+            np.empty(0, np.int64),
+        )
 
     def __len__(self) -> int:
         return len(self.entries)
@@ -123,6 +136,13 @@ class Database:
         if self._index is None:
             self._index = FeatureIndex([self.words[e.start : e.start + e.rows] for e in self.entries])
         return self._index
+
+    @property
+    def tree(self) -> KDTree:
+        """The k-d tree of every row's move (frame search), built on first use."""
+        if self._tree is None:
+            self._tree = KDTree(self.moves)
+        return self._tree
 
     def series(self) -> np.ndarray:
         """The pose rows as float64, what DTW compares (made on first use)."""
@@ -146,7 +166,7 @@ class Database:
         """Write the database to ``path`` (.npz), whole or not at all."""
         meta = json.dumps({"format": FORMAT, "rate": FEATURE_RATE, "entries": [asdict(e) for e in self.entries]})
         with output(path) as f:
-            np.savez(f, meta=np.array(meta), poses=self.poses, words=self.words, frames=self.frames)
+            np.savez(f, meta=np.array(meta), poses=self.poses, moves=self.moves, words=self.words, frames=self.frames)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Database:
@@ -160,7 +180,7 @@ class Database:
                         f"{FORMAT!r}): index the takes again"
                     )
                 entries = [Entry(**e) for e in meta["entries"]]
-                return cls(entries, data["poses"], data["words"], data["frames"])
+                return cls(entries, data["poses"], data["moves"], data["words"], data["frames"])
         except FileNotFoundError:
             raise ValueError(f"{path}: no such database (motiontheater index writes one)") from None
         except (OSError, KeyError, TypeError, ValueError) as e:
@@ -219,34 +239,29 @@ def build(
         done[job.take] = result
         progress.advance(result)  # type: ignore[arg-type]
     progress.close()
-    pieces: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    pieces: list[tuple[np.ndarray, ...]] = []
     entries, failed, start = [], [], 0
     for path, stat in takes:
         if path in done:
             r = done[path]
-            if r.error is not None or r.poses is None or r.words is None or r.frames is None:
+            if r.error is not None or r.poses is None or r.moves is None or r.words is None or r.frames is None:
                 failed.append((path, r.error or "no features"))
                 continue
-            piece, frames, rate = (r.poses, r.words, r.frames), (r.first_frame, r.last_frame), r.frame_rate
+            piece, frames, rate = (r.poses, r.moves, r.words, r.frames), (r.first_frame, r.last_frame), r.frame_rate
         else:
             assert previous is not None
             old = known[path]
             rows = previous.rows_of(old)
-            piece = (previous.poses[rows], previous.words[rows], previous.frames[rows])
+            piece = (previous.poses[rows], previous.moves[rows], previous.words[rows], previous.frames[rows])
             frames, rate = (old.first_frame, old.last_frame), old.frame_rate
         assert stat is not None
-        n = len(piece[1])
+        n = len(piece[2])
         entries.append(Entry(path, stat.st_size, stat.st_mtime_ns, *frames, rate, start, n))
         pieces.append(piece)
         start += n
     dims = pieces[0][0].shape[1] if pieces else (previous.poses.shape[1] if previous is not None else 0)
     database = (
-        Database(
-            entries,
-            np.concatenate([p[0] for p in pieces]),
-            np.concatenate([p[1] for p in pieces]),
-            np.concatenate([p[2] for p in pieces]),
-        )
+        Database(entries, *(np.concatenate([p[i] for p in pieces]) for i in range(4)))
         if pieces
         else Database.empty(dims)
     )

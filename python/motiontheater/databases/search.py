@@ -22,7 +22,7 @@ import numpy as np
 from mtcore.search import dtw, dtw_search, segments
 
 from ..model.motion import Motion
-from .features import body, pose_features, words
+from .features import body, moves, pose_features, words
 from .index import Database, Entry
 
 BAND = 0.2
@@ -157,3 +157,39 @@ def _filtered(database: Database, query_words: np.ndarray, takes: list[int], m: 
         if len(np.unique(database.owner(rows))) >= k:
             return rows
     return None
+
+
+def nearest_frames(
+    database: Database, query: Motion, frame: int, k: int = 10, *, exclude: Callable[[str], bool] | None = None
+) -> tuple[Hit, ...]:
+    """Frame search (motion matching): the ``k`` rows of ``database`` whose moves
+    (:func:`.features.moves`: the feet, the hips' velocity and the path ahead, in the hips' frame)
+    are nearest the query take's at ``frame`` (a frame number of the take), by squared Euclidean
+    distance, exactly (a k-d tree prunes, :class:`mtcore.search.KDTree`), nearest first; each hit
+    is one frame (``first`` = ``last``) of a take ``exclude`` does not exclude."""
+    if isinstance(k, bool) or not isinstance(k, int) or k < 1:
+        raise ValueError(f"k must be a whole number >= 1, got {k!r}")
+    if not query.first_frame <= frame <= query.last_frame:
+        raise ValueError(f"frame {frame} is not one of the query's frames {query.first_frame}..{query.last_frame}")
+    b = body(query)
+    row = int(np.argmin(np.abs(b.frames - frame)))
+    q = moves(b)[row].astype(np.float64)
+    tree = database.tree
+    want = k
+    while True:
+        found = tree.query(q, min(want, tree.n))
+        rows = found.indices[found.indices >= 0]
+        owners = database.owner(rows)
+        keep = [i for i, o in enumerate(owners) if exclude is None or not exclude(database.entries[int(o)].take)]
+        if len(keep) >= k or want >= tree.n:
+            break
+        want *= 4
+    return tuple(
+        Hit(
+            database.entries[int(owners[i])].take,
+            int(database.frames[rows[i]]),
+            int(database.frames[rows[i]]),
+            float(found.distances[i]),
+        )
+        for i in keep[:k]
+    )
