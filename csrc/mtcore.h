@@ -22,6 +22,7 @@
 #define MTCORE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 /* MT_CDEF_BEGIN */
 enum mt_status {
@@ -821,6 +822,178 @@ struct mt_retarget_plan {
  */
 int mt_retarget(const double *values, size_t frames, const struct mt_tree *source, const struct mt_tree *target,
                 const struct mt_retarget_plan *plan, size_t begin, size_t end, double *out);
+/*
+ * Search by example (dtw.c, knn.c, features.c).
+ *
+ * Sequences and point sets are (rows, dims) row-major float64.  Every value
+ * searched must be finite: a NaN or an infinity in a sequence, a point or a
+ * query is MT_EINVAL (a NaN orders nothing).  Distances are squared Euclidean,
+ * sum_k (a_k - b_k)^2 over the dims, and no square root is taken anywhere: a
+ * bound and a distance then compare exactly (see dtw.c and knn.c for why the
+ * pruning loses nothing after rounding either).
+ *
+ * Dynamic time warping of a (m x dims) and b (n x dims): the least sum of
+ * cost(i, j) = |a_i - b_j|^2 over a warping path from (0, 0) to (m-1, n-1) of
+ * steps (1, 0), (0, 1), (1, 1) within the Sakoe-Chiba band |i - j| <= radius
+ * (a radius >= max(m, n) is no band; 0 with m = n is the squared Euclidean
+ * distance).  No path: +inf (|m - n| > radius, or one of them empty; two empty
+ * sequences are at 0).
+ */
+
+/*
+ * The LB_Keogh envelope of x (n x dims) for a band of `radius`: upper and
+ * lower (n x dims) are the maximum and minimum of x over frames t - radius ..
+ * t + radius (within 0 .. n-1), dimension by dimension.  O(n dims) for any
+ * radius; scratch for min(n, 2 radius + 2) frame indices.
+ */
+int mt_lb_envelope(const double *x, size_t n, size_t dims, size_t radius, double *upper, double *lower);
+
+/*
+ * LB_Keogh of a candidate (n x dims) against a query's envelope (upper, lower
+ * as mt_lb_envelope gives them for the query's n frames): the sum over frames
+ * and dims of the squared distance from the candidate's sample to the interval
+ * [lower, upper] there; at most the DTW distance of query and candidate of the
+ * same length within the same radius.  The sum stops as soon as it exceeds
+ * threshold (+inf: never), and *bound is then that partial sum, above the
+ * threshold and still a lower bound.  A NaN threshold is MT_EINVAL.
+ */
+int mt_lb_keogh(const double *candidate, const double *upper, const double *lower, size_t n, size_t dims,
+                double threshold, double *bound);
+
+/*
+ * The DTW distance of a (m x dims) and b (n x dims) within `radius`, into
+ * *distance; +inf where every cell of some row i (frame i of a) exceeds
+ * threshold (the distance then does, too), +inf for no threshold.  O(m (2
+ * radius + 1) dims); scratch for 2 n doubles.  A NaN threshold is MT_EINVAL.
+ */
+int mt_dtw(const double *a, size_t m, const double *b, size_t n, size_t dims, size_t radius, double threshold,
+           double *distance);
+
+/* What mt_dtw_search did with its candidates: each is counted once. */
+struct mt_dtw_stats {
+    size_t warped;    /* DTW computed to the end (the first k candidates among them) */
+    size_t abandoned; /* DTW stopped at a row above the k-th best distance found so far */
+    size_t pruned;    /* never warped: the lower bound was above the k-th best distance */
+};
+
+/*
+ * The k windows of series (n x dims) nearest to query (m x dims) by DTW within
+ * radius: the candidates are the windows of m frames at starts[0 .. count-1]
+ * (strictly increasing, each at most n - m).  hits and distances (k each)
+ * receive their starts and distances, nearest first, a tie to the lower start;
+ * *found = min(k, count) of them.  This is exactly what computing mt_dtw for
+ * every candidate and sorting (distance, start) gives: the search only skips
+ * windows that could not be among those k.
+ *
+ * It warps k seeds (the candidates of least LB_Keogh among about max(1024,
+ * 4k) spread evenly over them), computes LB_Keogh of every candidate against
+ * the query's envelope (bounds, count doubles: each candidate's bound, or
+ * where it passed the k-th distance of the seeds, the partial sum that did;
+ * never above the candidate's distance), then warps the others in the order of
+ * their bounds (then starts), each abandoned above the k-th best found so far,
+ * until the next bound is above it.  order (count) is the caller's scratch for
+ * that order.  stats may be NULL.  k >= 1; count 0 finds nothing.  Scratch: 2
+ * m dims + 2 m doubles and min(k, count) indices.
+ */
+int mt_dtw_search(const double *query, size_t m, const double *series, size_t n, size_t dims, size_t radius,
+                  const size_t *starts, size_t count, size_t k, double *bounds, size_t *order, size_t *hits,
+                  double *distances, size_t *found, struct mt_dtw_stats *stats);
+
+/*
+ * A k-d tree over the rows of points (n x dims, dims >= 1), in buffers the
+ * caller allocates and owns.  leaf_size >= 1 rows at most in a leaf; depth
+ * from mt_kdtree_depth; index (n): the rows, each node's a contiguous range;
+ * rows (n x dims): row index[i] of points at row i, so that a leaf is read
+ * from contiguous memory; split_dim and split_value (2^depth - 1 each, none
+ * for depth 0): the internal nodes in heap order (node i's children are 2i+1
+ * and 2i+2).  points is read by mt_kdtree_build only (queries read rows), and
+ * may be NULL for them.
+ */
+struct mt_kdtree {
+    const double *points;
+    size_t n, dims, leaf_size, depth;
+    size_t *index;
+    double *rows;
+    size_t *split_dim;
+    double *split_value;
+};
+
+/* The depth of the tree of n rows in leaves of at most leaf_size (>= 1): the least d with ceil(n / 2^d) <= leaf_size. */
+int mt_kdtree_depth(size_t n, size_t leaf_size, size_t *depth);
+
+/*
+ * Fills the tree's index, rows, split_dim and split_value from its points, n,
+ * dims, leaf_size and depth (which must be mt_kdtree_depth's).  O(n log n);
+ * scratch for 2 dims doubles.
+ */
+int mt_kdtree_build(struct mt_kdtree *tree);
+
+/*
+ * The k nearest rows to each of queries (count x tree->dims), exactly: row i
+ * of indices and distances (count x k each) receives the rows nearest query i
+ * and their squared distances, sorted by distance then row, found[i] (count)
+ * of them (min(k, the rows not excluded)); the slots past found[i] get
+ * SIZE_MAX and +inf.  exclude (count x 2) or NULL: query i ignores the rows
+ * exclude[2i] .. exclude[2i+1]-1 (a frame and its neighbours).  Exactly what
+ * sorting every row's distance gives, ties included.  MT_EINVAL also where
+ * the tree's buffers hold a dimension or row out of range.  Scratch: dims doubles.
+ */
+int mt_kdtree_query(const struct mt_kdtree *tree, const double *queries, size_t count, size_t k,
+                    const size_t *exclude, size_t *indices, double *distances, size_t *found);
+
+/*
+ * Relational features (Müller, Röder and Clausen 2005), frames x features.
+ *
+ * Hysteresis: feature f turns on in a frame whose value is above high[f] and
+ * off in one below low[f] (low[f] <= high[f], else MT_EINVAL); in between, and
+ * for NaN, it keeps the state of the frame before, initial[f] before the first
+ * (initial NULL: off).  on (n x features) receives 1 or 0.
+ */
+int mt_hysteresis(const double *values, size_t n, size_t features, const double *low, const double *high,
+                  const unsigned char *initial, unsigned char *on);
+
+/* Bit f of words[t] (n) is whether bits[t * features + f] is non-zero; features <= 64. */
+int mt_pack_bits(const unsigned char *bits, size_t n, size_t features, uint64_t *words);
+
+/*
+ * The runs of equal words (n) as segments: the first `capacity` of them into
+ * first (their first frames) and values (their words); *count receives how
+ * many there are (at most n; first and values may be NULL for capacity 0).
+ */
+int mt_segments(const uint64_t *words, size_t n, size_t *first, uint64_t *values, size_t capacity, size_t *count);
+
+/*
+ * An inverted index over the segments of many takes, in buffers the caller
+ * allocates.  words (segments): the word of each segment, the takes' one
+ * after another; take_first (takes + 1): take t holds segments take_first[t]
+ * .. take_first[t+1]-1 (0 first, segments last, non-decreasing).  Built by
+ * mt_feature_index_build (CSR): keys (capacity segments) the distinct words
+ * ascending, nkeys of them; offsets (capacity segments + 1): the segments of
+ * keys[i] are ids[offsets[i] .. offsets[i+1]-1] (ids: segments), ascending.
+ */
+struct mt_feature_index {
+    const uint64_t *words;
+    const size_t *take_first;
+    size_t segments, takes;
+    uint64_t *keys;
+    size_t *offsets;
+    size_t *ids;
+    size_t nkeys;
+};
+
+/* Fills keys, offsets, ids and nkeys from words and take_first; in place, O(segments log segments). */
+int mt_feature_index_build(struct mt_feature_index *index);
+
+/*
+ * Where the query (length >= 1 words) occurs: the segments s, ascending, with
+ * words[s + j] == query[j] for j < length and all of s .. s + length - 1 in one
+ * take (an exact match of consecutive segments; a query made by mt_segments has
+ * no two equal words in a row, nor has any take).  The first `capacity` into
+ * hits; *count receives how many there are.  Reads the posting list of the
+ * query's rarest word only.
+ */
+int mt_feature_index_find(const struct mt_feature_index *index, const uint64_t *query, size_t length, size_t *hits,
+                          size_t capacity, size_t *count);
 /*
  * The take check (check.c): what is wrong with the channels of a take, in one pass.
  *

@@ -48,7 +48,8 @@ def stub(declarations: str) -> str:
     """The text of ``_mtcore.pyi`` for the declarations of the cdef region."""
     # cffi knows the standard integer types; plain pycparser needs them declared
     tree = c_parser.CParser().parse(
-        "typedef unsigned long size_t; typedef long ptrdiff_t;\n" + DEFINE.sub("", declarations)
+        "typedef unsigned long size_t; typedef long ptrdiff_t; typedef unsigned long long uint64_t;\n"
+        + DEFINE.sub("", declarations)
     )
     constants, functions = [f"    {name}: int" for name in DEFINE.findall(declarations)], []
     for node in tree.ext:

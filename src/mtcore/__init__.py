@@ -10,10 +10,12 @@ and frame text (AMC bodies) scanned into arrays and written back exactly
 angles, matrices, quaternions, rotation vectors) in :mod:`mtcore.rotations`;
 signal processing (a band equaliser, zero-phase Butterworth filtering,
 polyphase resampling, gap filling; scipy.signal's signatures) in
-:mod:`mtcore.signal`.
+:mod:`mtcore.signal`; search by example (dynamic time warping with LB_Keogh pruning,
+exact k nearest neighbours, relational features and their inverted index) in
+:mod:`mtcore.search`.
 """
 
-from . import errors, signal
+from . import errors, search, signal
 from ._parallel import cpu_count, share_cores
 from .filters import MODES, binomial_filter1d, filter_block, median_filter1d, pascal_weights, uniform_filter1d
 from .text import format_frames, format_number, scan_frames
@@ -29,6 +31,7 @@ __all__ = [
     "median_filter1d",
     "pascal_weights",
     "scan_frames",
+    "search",
     "share_cores",
     "signal",
     "uniform_filter1d",

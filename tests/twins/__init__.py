@@ -24,6 +24,7 @@ import numpy as np
 import mtcore
 from mtcore import footskate as fs
 from mtcore import rotations as rot
+from mtcore import search as mt_search
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
 from mtcore.check import channel_events
@@ -32,6 +33,7 @@ from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
 from mtcore.retarget import RetargetPlan, retarget_rotations
 
 from . import check, combine, filters, footskate, kinematics, retarget, rotations
+from . import search as search_twins
 from . import signal as signal_twins
 from . import text as text_twins  # binds twins.text too: mtcore's is mt_text
 
@@ -838,7 +840,13 @@ def plant_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
-# --- the registry ---------------------------------------------------------------------------
+# --- search by example ----------------------------------------------------------------------
+
+
+def fast_feature_index(takes):
+    index = mt_search.FeatureIndex(takes)
+    return index.keys, index.offsets.astype(np.intp), index.ids.astype(np.intp)
+
 
 # --- the take check ---------------------------------------------------------------------------
 
@@ -876,6 +884,8 @@ def fast_check(x, spike, step, min_run, begin, end):
     found = channel_events(x, spike, step, min_run, begin, end)
     return found.events, found.sizes, found.roughness, found.smooth_rows
 
+
+# --- the registry ---------------------------------------------------------------------------
 
 TWINS: dict[str, Twin] = {
     "mt_filter1d": Twin(fast_filter, slow_filter, filter_cases, filter_same),
@@ -983,6 +993,44 @@ TWINS: dict[str, Twin] = {
         speed_cases,
         exact,
     ),
+    "mt_lb_envelope": Twin(
+        lambda x, r: tuple(mt_search.lb_envelope(x, r)), search_twins.lb_envelope, search_twins.envelope_cases, exact
+    ),
+    "mt_lb_keogh": Twin(
+        lambda c, u, lo, t: mt_search.lb_keogh(c, (u, lo), t),
+        search_twins.lb_keogh,
+        search_twins.keogh_cases,
+        close(1e-12),
+    ),
+    "mt_dtw": Twin(mt_search.dtw, search_twins.dtw, search_twins.dtw_cases, close(1e-12)),
+    "mt_dtw_search": Twin(
+        lambda *case: tuple(mt_search.dtw_search(*case)[:2]),
+        search_twins.dtw_search,
+        search_twins.dtw_search_cases,
+        lambda got, want: (exact(got[0], want[0]), close(1e-12)(got[1], want[1])),
+    ),
+    "mt_kdtree_query": Twin(
+        lambda points, leaf, queries, k, exclude: tuple(
+            mt_search.KDTree(points, leaf).query(queries, k, exclude=exclude, workers=1)
+        ),
+        lambda points, leaf, queries, k, exclude: search_twins.knn(points, queries, k, exclude),
+        search_twins.knn_cases,
+        lambda got, want: (exact(got[0], want[0]), close(1e-12)(got[1], want[1])),
+    ),
+    "mt_hysteresis": Twin(mt_search.hysteresis, search_twins.hysteresis, search_twins.hysteresis_cases, exact),
+    "mt_pack_bits": Twin(mt_search.pack_bits, search_twins.pack_bits, search_twins.pack_cases, exact),
+    "mt_segments": Twin(
+        lambda w: tuple(mt_search.segments(w)), search_twins.segments, search_twins.segment_cases, exact
+    ),
+    "mt_feature_index_build": Twin(
+        fast_feature_index, search_twins.feature_index, search_twins.feature_index_cases, exact
+    ),
+    "mt_feature_index_find": Twin(
+        lambda takes, query: mt_search.FeatureIndex(takes).find(query),
+        search_twins.feature_find,
+        search_twins.feature_find_cases,
+        exact,
+    ),
 }
 
 EXEMPT = {
@@ -993,4 +1041,6 @@ EXEMPT = {
     "mt_guard_install": "installs a signal handler once; test_hardening shrinks mapped files under the scanners",
     "mt_number_code": "names the number writer's code on this processor; test_numbers runs each code against the portable",
     "mt_number_code_runs": "whether this processor runs a number writer's code; test_numbers checks it with the writers",
+    "mt_kdtree_depth": "a size for the buffers of mt_kdtree_build (test_search_kernels checks the leaves it makes)",
+    "mt_kdtree_build": "builds what mt_kdtree_query searches, no result of its own; test_search_kernels checks its splits",
 }

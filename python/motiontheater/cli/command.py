@@ -22,6 +22,7 @@ from .check import CHECK
 from .combine import COMBINE
 from .demo import DEMO
 from .info import INFO
+from .search import INDEX, SEARCH
 from .steps import APPLY, FILTER, LISTING, step_verbs
 from .timing import BENCH
 from .verb import Verb, VerbParser
@@ -29,7 +30,22 @@ from .verb import Verb, VerbParser
 
 def verbs() -> list[Verb]:
     """Every verb: those of the modules here and one per registered step (as registered now)."""
-    return [DEMO, LISTING, INFO, FILTER, APPLY, *step_verbs(), BATCH, CHECK, COMBINE, *feet.VERBS, BENCH, *views.VERBS]
+    return [
+        DEMO,
+        LISTING,
+        INFO,
+        FILTER,
+        APPLY,
+        *step_verbs(),
+        BATCH,
+        CHECK,
+        INDEX,
+        SEARCH,
+        COMBINE,
+        *feet.VERBS,
+        BENCH,
+        *views.VERBS,
+    ]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,202 @@
+"""Search by example over real takes: HDM05 classes found across actors (leave one actor out),
+features that no rig, unit or up axis changes, ranks equal to warping every window, an index
+brought up to date take by take, and the verbs as a user runs them."""
+
+import json
+import os
+import shutil
+
+import numpy as np
+import pytest
+
+import motiontheater as mt
+from corpus import real_files
+from motiontheater.cli import main
+from motiontheater.databases.features import body, moves, pose_features
+from motiontheater.databases.index import Database, build
+from motiontheater.databases.search import nearest_frames, search
+from mtcore.search import dtw
+from variants import with_offset_channels, with_static_root
+
+HDM = real_files("hdm05/*.amc")
+VARIANTS = {
+    "game rig": lambda take: with_static_root(with_offset_channels(take), shift=(250.0, 0.0, -400.0)),
+    "z-up": lambda take: with_static_root(take, turn=(90.0, 0.0, 0.0), keep_world=False),
+    "in mm": lambda take: take.with_units(length_factor=1000 * take.skeleton.meters_per_unit, length="mm"),
+}
+
+
+def _actor(path) -> str:
+    return os.path.basename(path).split("_")[1]
+
+
+def _motion_class(path) -> str:
+    return os.path.basename(path).split("_")[2]
+
+
+@pytest.fixture(scope="module")
+def hdm05():
+    if not HDM:
+        pytest.skip("the real-file corpus (../shared/data/hdm05) is absent")
+    built = build([str(HDM[0].parent)], workers=1)
+    assert not built.failed and len(built.database) == len(HDM)
+    return built.database
+
+
+def _ranked(db, query_path, k, clip=None):
+    take = mt.read_take(query_path)
+    if clip is not None:
+        middle, half = take.first_frame + take.frames // 2, round(clip * take.frame_rate / 2)
+        take = take.crop(max(take.first_frame, middle - half), min(take.last_frame, middle + half))
+    return search(db, take, k, exclude=lambda t: _actor(t) == _actor(query_path)).hits
+
+
+@pytest.mark.parametrize("clip", [None, 2.0], ids=["whole takes", "2 s clips"])
+def test_hdm05_classes_are_found_across_actors(hdm05, clip):
+    """Each take of one actor queries the other actors' takes: a hit is a take of its class."""
+    p1 = p2 = p5 = average = 0.0
+    for entry in hdm05.entries:
+        relevant = [_motion_class(h.take) == _motion_class(entry.take) for h in _ranked(hdm05, entry.take, 22, clip)]
+        assert len(relevant) == 22 and sum(relevant) == 2  # every other actor's take, ranked
+        p1 += relevant[0]
+        p2 += sum(relevant[:2]) / 2
+        p5 += sum(relevant[:5]) / 5
+        found = np.flatnonzero(relevant) + 1
+        average += np.mean(np.arange(1, len(found) + 1) / found)
+    n = len(hdm05.entries)
+    figures = {"P@1": p1 / n, "P@2": p2 / n, "P@5": p5 / n, "mAP": average / n}
+    print(clip, figures)
+    assert figures["P@2"] >= 0.90 and figures["mAP"] >= 0.90, figures
+
+
+@pytest.mark.parametrize("variant", list(VARIANTS))
+def test_features_do_not_depend_on_the_rig_unit_or_up_axis(variant, tmp_path):
+    """A take written as another producer's BVH (a static root above the hips, position channels on
+    every joint, z up, millimetres) and read back has the same features."""
+    bvh = real_files("cmu/16_15.bvh")
+    if not bvh:
+        pytest.skip("the real-file corpus (../shared/data) is absent")
+    take = mt.read_take(bvh[0])
+    path = tmp_path / "variant.bvh"
+    mt.write_bvh(VARIANTS[variant](take), path)
+    other = mt.read_take(path)
+    np.testing.assert_allclose(pose_features(body(other)), pose_features(body(take)), atol=1e-4)
+
+
+def test_a_cmu_query_finds_itself_in_every_rig(tmp_path):
+    cmu, bvh = real_files("cmu/16_15.amc"), real_files("cmu/16_15.bvh")
+    if not cmu or not bvh:
+        pytest.skip("the real-file corpus (../shared/data) is absent")
+    take = mt.read_take(bvh[0])
+    for name, make in VARIANTS.items():
+        mt.write_bvh(make(take), tmp_path / f"{name.replace(' ', '_')}.bvh")
+    shutil.copy(cmu[0].with_name("16.asf"), tmp_path)
+    shutil.copy(cmu[0], tmp_path)  # the ASF/AMC it was converted from
+    db = build([str(tmp_path)], workers=1).database
+    hits = search(db, take.crop(60, 240), 4).hits
+    # every rig the same distance (not 0: the query's frames fall between the database's 10 Hz
+    # rows); the AMC that CMU converted a little farther (neck, head and hands placed apart)
+    assert len(hits) == 4 and hits[3].take.endswith("16_15.amc"), hits
+    assert np.ptp([h.distance for h in hits[:3]]) < 1e-9 and hits[3].distance < 0.01, hits
+    assert all(abs(h.first - 60) <= 12 and abs(h.last - 240) <= 12 for h in hits), hits
+
+
+def test_the_ranking_equals_warping_every_window(hdm05):
+    """Unfiltered, the hits and their distances are what DTW of every window of every take gives."""
+    for query_path in (HDM[0], HDM[7], HDM[20]):
+        take = mt.read_take(query_path).crop(*_middle(mt.read_take(query_path), 1.5))
+        hits = search(hdm05, take, 5, use_index=False).hits
+        q = pose_features(body(take))
+        m = len(q)
+        radius = max(1, int(np.ceil(0.2 * m)))
+        best = {}
+        for e in hdm05.entries:
+            rows = hdm05.series()[e.start : e.start + e.rows]
+            if e.rows >= m:
+                d = min(dtw(q, rows[s : s + m], radius) for s in range(e.rows - m + 1)) / m
+            else:
+                d = dtw(q, rows, m - e.rows + radius) / m
+            best[e.take] = d
+        brute = sorted(best.items(), key=lambda kv: (kv[1], kv[0]))[:5]
+        assert [h.take for h in hits] == [t for t, _ in brute]
+        np.testing.assert_allclose([h.distance for h in hits], [d for _, d in brute], rtol=0, atol=1e-12)
+
+
+def _middle(take, seconds):
+    middle, half = take.first_frame + take.frames // 2, round(seconds * take.frame_rate / 2)
+    return max(take.first_frame, middle - half), min(take.last_frame, middle + half)
+
+
+def test_indexing_again_reads_only_new_and_changed_takes(tmp_path):
+    if len(HDM) < 3:
+        pytest.skip("the real-file corpus (../shared/data/hdm05) is absent")
+    folder = tmp_path / "takes"
+    folder.mkdir()
+    for path in HDM[:3]:
+        shutil.copy(path, folder)
+        shutil.copy(path.with_name(path.name.split("_")[0] + "_" + _actor(path) + ".asf"), folder)
+    first = build([str(folder)], workers=1)
+    assert len(first.indexed) == 3 and not first.kept
+    target = tmp_path / "db.npz"
+    first.database.save(target)
+    takes = sorted(folder.glob("*.amc"))
+    os.utime(takes[0], ns=(1, 1))  # changed
+    takes[1].unlink()  # gone
+    again = build([str(folder)], Database.load(target), workers=1)
+    assert again.indexed == (str(takes[0]),) and again.kept == (str(takes[2]),) and again.dropped == (str(takes[1]),)
+    same = {e.take: e for e in first.database.entries}[str(takes[2])]
+    kept = {e.take: e for e in again.database.entries}[str(takes[2])]
+    np.testing.assert_array_equal(
+        again.database.poses[again.database.rows_of(kept)], first.database.poses[first.database.rows_of(same)]
+    )
+
+
+def test_index_and_search_verbs(tmp_path, capsys):
+    if not HDM:
+        pytest.skip("the real-file corpus (../shared/data/hdm05) is absent")
+    db = tmp_path / "hdm05.npz"
+    assert main(["index", str(HDM[0].parent), "-o", str(db), "--quiet"]) == 0
+    assert "33 takes" in capsys.readouterr().out
+    kick = next(p for p in HDM if "kickLFront" in p.name)
+    page = tmp_path / "hits.html"
+    assert main(["search", str(db), str(kick), "-k", "3", "--json", "--view", str(page)]) == 0
+    out = capsys.readouterr()
+    hits = json.loads(out.out)
+    assert [set(h) >= {"take", "first", "last", "distance"} for h in hits] == [True] * 3
+    assert hits[0]["take"] == str(kick) and hits[0]["distance"] < 1e-9
+    assert all("kickLFront" in h["take"] for h in hits), hits
+    assert page.stat().st_size > 0 and "wrote" in out.err
+
+
+def test_bad_databases_and_queries_are_told_in_a_sentence(tmp_path, capsys):
+    if not HDM:
+        pytest.skip("the real-file corpus (../shared/data/hdm05) is absent")
+    other = tmp_path / "other.npz"
+    np.savez(other, x=np.arange(3))
+    before = other.read_bytes()
+    assert main(["index", str(HDM[0]), "-o", str(other)]) != 0
+    assert "not a motiontheater search database" in capsys.readouterr().err
+    assert other.read_bytes() == before  # a file that is not ours is never overwritten
+    assert main(["search", str(tmp_path / "none.npz"), str(HDM[0])]) != 0
+    assert "no such database" in capsys.readouterr().err
+    db = tmp_path / "db.npz"
+    assert main(["index", str(HDM[0]), "-o", str(db), "--quiet"]) == 0
+    assert main(["search", str(db), str(HDM[0]), "--frames", "1:10"]) != 0
+    assert "at least 0.3 s" in capsys.readouterr().err
+
+
+def test_frame_search_equals_brute_force_and_finds_the_frame_itself(hdm05):
+    for query_path in (HDM[1], HDM[12], HDM[30]):
+        take = mt.read_take(query_path)
+        frame = take.first_frame + 24  # a frame the database keeps a row of (every 12th at 120 Hz)
+        hits = nearest_frames(hdm05, take, frame, 8)
+        q = moves(body(take))[2].astype(np.float64)
+        d = np.sum((hdm05.moves.astype(np.float64) - q) ** 2, axis=1)
+        order = np.lexsort((np.arange(len(d)), d))[:8]
+        assert [(h.take, h.first) for h in hits] == [
+            (hdm05.entries[int(hdm05.owner(np.array([r]))[0])].take, int(hdm05.frames[r])) for r in order
+        ]
+        np.testing.assert_allclose([h.distance for h in hits], d[order], rtol=0, atol=1e-12)
+        assert hits[0].take == str(query_path) and hits[0].first == frame and hits[0].distance < 1e-12
+    others = nearest_frames(hdm05, take, frame, 3, exclude=lambda t: t == str(query_path))
+    assert len(others) == 3 and all(h.take != str(query_path) for h in others)
