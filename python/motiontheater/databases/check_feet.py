@@ -15,7 +15,8 @@ import math
 import warnings
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
+
+from mtcore.search import lb_envelope
 
 from ..feet.contacts import runs
 from ..feet.footskate import prepare
@@ -184,9 +185,12 @@ class _Legs:
 
 
 def _lowest_around(x: np.ndarray, half: int) -> np.ndarray:
-    """The least of x over the ``half`` samples before and after each (NaN ignored)."""
-    padded = np.pad(np.where(np.isnan(x), np.inf, x), half, mode="edge")
-    return sliding_window_view(padded, 2 * half + 1).min(axis=1)
+    """The least of x over the ``half`` samples before and after each (NaN ignored): the lower
+    LB_Keogh envelope, a running minimum in C."""
+    finite = np.isfinite(x)
+    if not finite.any():
+        return np.full_like(x, np.nan)
+    return lb_envelope(np.where(finite, x, np.max(x[finite])), half).lower[:, 0]
 
 
 def _cosine(a: np.ndarray, b: np.ndarray) -> np.ndarray:
