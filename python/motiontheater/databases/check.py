@@ -294,6 +294,8 @@ def _frozen(
         if first == 0 and last == rows - 1:
             dead.setdefault(channel.joint, []).append(int(c))
             continue
+        if np.count_nonzero(values[:, c] == values[first, c]) * 2 >= rows:
+            continue  # where the channel rests most of the take (a hinge's off-axis, a joint limit)
         around = [values[max(first - window, 0) : first + 1, c], values[last : last + window + 1, c]]
         changes = [np.abs(np.diff(a)) for a in around if len(a) > 2]
         if not changes:
@@ -441,7 +443,12 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
         if deviation <= limit:
             continue  # the angles swing (near gimbal lock) or the frames around move fast: no spike
         if channel.turns:
-            severity = "high" if deviation > 30 else "medium" if deviation > 10 else "low"
+            # high: farther out than smooth motion could go at six times the peak acceleration
+            # (30 deg at 120 Hz; 67 deg at 30 Hz, where a fast wrist leaves its neighbours by 30)
+            # and farther than the joint turns per frame just before and after: a joint that turns
+            # as fast around it shakes (a waving hand at 30 Hz), which a person may not call a spike
+            high = deviation > max(30, 6 * limit) and deviation > 2 * _pace(t, joint, first, last)
+            severity = "high" if high else "medium" if deviation > 10 else "low"
             out.append(
                 Finding(
                     t.name, "spike", (joint,), t.frame(first), t.frame(last), severity, round(deviation, 6), "deg",
@@ -538,6 +545,21 @@ def _deviations(t: _Take, joint: str, turns: bool, first: int, last: int) -> np.
     line = block[0] + share[:, None] * (block[-1] - block[0])
     off = block[1:-1] - line
     return np.abs(off).max(axis=1) if turns else np.linalg.norm(off, axis=1)
+
+
+PACE_FRAMES = 3
+
+
+def _pace(t: _Take, joint: str, first: int, last: int) -> float:
+    """The most the joint turns from one frame to the next over the PACE_FRAMES frames before
+    rows first..last and after them, in degrees (0 where it has no three rotation channels)."""
+    if joint not in t.triples:
+        return 0.0
+    rows = [r for r in (*range(first - PACE_FRAMES, first), *range(last + 1, last + 1 + PACE_FRAMES))]
+    rows = [r for r in rows if 0 <= r < t.motion.frames]
+    q = t.quaternions(joint, np.array(rows, dtype=np.intp))
+    steps = [_angle_deg(q[i], q[i + 1]) for i in range(len(rows) - 1) if rows[i + 1] == rows[i] + 1]
+    return float(np.nanmax(steps)) if steps else 0.0
 
 
 def _trimmed(t: _Take, joint: str, turns: bool, first: int, last: int, limit: float) -> tuple[int, int, float | None]:
