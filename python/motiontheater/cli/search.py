@@ -23,7 +23,6 @@ def _index_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress bar, only the last line")
     parser.add_argument("--asf", help="the AMCs' skeleton (default: the ASF beside each, by the CMU/HDM05 naming)")
     parser.add_argument("--frame-rate", type=float, metavar="HZ", help="frames per second when an AMC does not say")
-    parser.add_argument("--unit", metavar="UNIT", help="the takes' length unit (default: told from each take)")
 
 
 def _index(args: argparse.Namespace) -> int:
@@ -38,7 +37,7 @@ def _index(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     progress = Progress(0, 0, enabled=False) if args.quiet else None
     built = build(
-        args.inputs, previous, asf=args.asf, frame_rate=args.frame_rate, unit=args.unit, workers=args.jobs,
+        args.inputs, previous, asf=args.asf, frame_rate=args.frame_rate, workers=args.jobs,
         scheduler=args.scheduler, dask_local=args.dask, progress=progress,
     )  # fmt: skip
     built.database.save(args.output)
@@ -67,7 +66,7 @@ def _search_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print the hits as JSON (a list of objects)")
     parser.add_argument("--view", metavar="PAGE", help="write a viewer page of the query and the hits side by side")
-    add_take_options(parser, frames=True)
+    add_take_options(parser, frames=True, unit=False)
 
 
 def _search(args: argparse.Namespace) -> int:
@@ -160,8 +159,9 @@ SEARCH = Verb(
         "query's at frame N (features are kept at 10 Hz: a hit is one of every tenth of a second)."
     ),
     epilog=(
-        "Example: motiontheater search captures.npz 01_01.amc --frames 100:340 -k 5 --view hits.html\n"
-        "Example: motiontheater search captures.npz kick.bvh --json\n"
-        "Example: motiontheater search captures.npz walk.bvh --frame 200 -k 5"
+        "Example: motiontheater index captures/ -o db.npz && motiontheater search db.npz 01_01.amc "
+        "--frames 100:340 -k 3 --view hits.html\n"
+        "Example: motiontheater index captures/ -o db.npz && motiontheater search db.npz 02_01.amc --json\n"
+        "Example: motiontheater index captures/ -o db.npz && motiontheater search db.npz 02_01.amc --frame 200 -k 5"
     ),
 )

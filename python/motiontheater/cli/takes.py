@@ -16,17 +16,21 @@ from ..model.rig import choose_body
 from ..model.units import UNIT_HELP
 
 
-def add_take_options(parser: argparse.ArgumentParser, *, frames: bool = False) -> None:
+def add_take_options(parser: argparse.ArgumentParser, *, frames: bool = False, unit: bool = True) -> None:
     """How a take is read (``--asf``, ``--frame-rate``, ``--unit``, ``--body``) and, with ``frames``, the
-    ``--frames A:B`` of a verb that works on a range of the take's frames."""
+    ``--frames A:B`` of a verb that works on a range of the take's frames; without ``unit``, no
+    ``--unit`` (a verb whose result no length unit changes: search measures in leg lengths)."""
     parser.add_argument("--asf", help="the AMC's skeleton (default: the ASF beside it, by the CMU/HDM05 naming)")
     parser.add_argument("--frame-rate", type=float, metavar="HZ", help="frames per second when the AMC does not say")
-    parser.add_argument(
-        "--unit",
-        metavar="UNIT",
-        help=f"the takes' length unit: {UNIT_HELP} "
-        "(default: a BVH's is told from its size, an ASF's is its :units length)",
-    )
+    if unit:
+        parser.add_argument(
+            "--unit",
+            metavar="UNIT",
+            help=f"the takes' length unit: {UNIT_HELP} "
+            "(default: a BVH's is told from its size, an ASF's is its :units length)",
+        )
+    else:
+        parser.set_defaults(unit=None)
     parser.add_argument(
         "--body",
         metavar="JOINT",
