@@ -26,7 +26,7 @@ def _index_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _index(args: argparse.Namespace) -> int:
-    from ..databases.batch import Progress, find_takes
+    from ..databases.batch import find_takes
     from ..databases.index import build, open_or_empty
 
     if not args.output.lower().endswith(".npz"):
@@ -35,10 +35,9 @@ def _index(args: argparse.Namespace) -> int:
         raise ValueError(f"no AMC or BVH take under {' '.join(args.inputs)}")
     previous = open_or_empty(args.output)
     start = time.perf_counter()
-    progress = Progress(0, 0, enabled=False) if args.quiet else None
     built = build(
         args.inputs, previous, asf=args.asf, frame_rate=args.frame_rate, workers=args.jobs,
-        scheduler=args.scheduler, dask_local=args.dask, progress=progress,
+        scheduler=args.scheduler, dask_local=args.dask, progress=not args.quiet,
     )  # fmt: skip
     built.database.save(args.output)
     seconds = time.perf_counter() - start

@@ -214,11 +214,12 @@ def build(
     workers: int = 0,
     scheduler: str | None = None,
     dask_local: bool = False,
-    progress: Progress | None = None,
+    progress: bool = False,
 ) -> Built:
     """The database of every AMC and BVH take under ``inputs``: the rows of ``previous`` for the
     takes whose size and modification time are as it recorded, the others indexed on
-    ``workers`` processes (0: every core), the Dask cluster at ``scheduler`` or a local one."""
+    ``workers`` processes (0: every core), the Dask cluster at ``scheduler`` or a local one;
+    ``progress``: a progress bar on a terminal's standard error."""
     known = {e.take: e for e in previous.entries} if previous is not None else {}
     takes, jobs, kept = [], [], []
     for take, _ in find_takes(inputs):
@@ -233,12 +234,14 @@ def build(
             kept.append(path)
         else:
             jobs.append(IndexJob(path, asf, frame_rate, unit, stat.st_size if stat else 0))
-    progress = progress or Progress(len(jobs), sum(j.bytes for j in jobs), enabled=False)
+    bar = Progress(len(jobs), sum(j.bytes for j in jobs), enabled=None if progress else False)
     done: dict[str, Indexed] = {}
-    for job, result in run_each(jobs, index_job, workers, scheduler=scheduler, dask_local=dask_local):
-        done[job.take] = result
-        progress.advance(result)  # type: ignore[arg-type]
-    progress.close()
+    try:
+        for job, result in run_each(jobs, index_job, workers, scheduler=scheduler, dask_local=dask_local):
+            done[job.take] = result
+            bar.advance(result)  # type: ignore[arg-type]
+    finally:
+        bar.close()
     pieces: list[tuple[np.ndarray, ...]] = []
     entries, failed, start = [], [], 0
     for path, stat in takes:
