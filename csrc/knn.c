@@ -199,6 +199,17 @@ static int after(double da, size_t ra, double db, size_t rb)
     return da > db || (da == db && ra > rb);
 }
 
+/* Exchange entries a and b of the heap. */
+static void heap_swap(size_t *rows, double *d, size_t a, size_t b)
+{
+    const size_t row = rows[a];
+    const double distance = d[a];
+    rows[a] = rows[b];
+    d[a] = d[b];
+    rows[b] = row;
+    d[b] = distance;
+}
+
 static void heap_down(size_t *rows, double *d, size_t size, size_t i)
 {
     for (;;) {
@@ -210,12 +221,7 @@ static void heap_down(size_t *rows, double *d, size_t size, size_t i)
             top = r;
         if (top == i)
             return;
-        const size_t tr = rows[i];
-        const double td = d[i];
-        rows[i] = rows[top];
-        d[i] = d[top];
-        rows[top] = tr;
-        d[top] = td;
+        heap_swap(rows, d, i, top);
         i = top;
     }
 }
@@ -226,12 +232,7 @@ static void heap_up(size_t *rows, double *d, size_t i)
         const size_t parent = (i - 1) / 2;
         if (!after(d[i], rows[i], d[parent], rows[parent]))
             return;
-        const size_t tr = rows[i];
-        const double td = d[i];
-        rows[i] = rows[parent];
-        d[i] = d[parent];
-        rows[parent] = tr;
-        d[parent] = td;
+        heap_swap(rows, d, i, parent);
         i = parent;
     }
 }
