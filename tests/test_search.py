@@ -200,3 +200,35 @@ def test_frame_search_equals_brute_force_and_finds_the_frame_itself(hdm05):
         assert hits[0].take == str(query_path) and hits[0].first == frame and hits[0].distance < 1e-12
     others = nearest_frames(hdm05, take, frame, 3, exclude=lambda t: t == str(query_path))
     assert len(others) == 3 and all(h.take != str(query_path) for h in others)
+
+
+def test_the_view_page_plays_the_query_and_the_hits_in_chromium(hdm05, tmp_path, capsys):
+    browsers = pytest.importorskip("test_view_browser", reason="selenium is not installed")
+    if browsers.BROWSER is None or browsers.DRIVER is None:
+        pytest.skip("no Chromium with chromedriver here (Debian: apt-get install chromium chromium-driver)")
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    db = tmp_path / "hdm05.npz"
+    hdm05.save(db)
+    squat = next(p for p in HDM if "squat" in p.name)
+    page = tmp_path / "hits.html"
+    assert main(["search", str(db), str(squat), "-k", "3", "--json", "--view", str(page)]) == 0
+    hits = json.loads(capsys.readouterr().out)
+    options = webdriver.ChromeOptions()
+    options.binary_location = browsers.BROWSER
+    for flag in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1280,800"):
+        options.add_argument(flag)
+    driver = webdriver.Chrome(service=Service(browsers.DRIVER), options=options)
+    try:
+        driver.get(page.as_uri())
+        WebDriverWait(driver, 30).until(lambda d: d.execute_script("return document.body.dataset.ready === '1'"))
+        shown = driver.execute_script("return window.mtView.state.takes.map(t => [t.name, t.frames])")
+        assert [name for name, _ in shown] == ["query"] + [
+            f"{i}. {h['take']} from {h['first']}" for i, h in enumerate(hits, 1)
+        ]
+        assert [frames for _, frames in shown][1:] == [h["last"] - h["first"] + 1 for h in hits]  # each its window
+        assert not browsers.console_errors(driver)
+    finally:
+        driver.quit()
