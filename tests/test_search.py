@@ -202,6 +202,21 @@ def test_frame_search_equals_brute_force_and_finds_the_frame_itself(hdm05):
     assert len(others) == 3 and all(h.take != str(query_path) for h in others)
 
 
+def test_a_searched_database_holds_one_copy_of_its_rows_and_saves_them_unchanged(hdm05, tmp_path):
+    hdm05.save(tmp_path / "before.npz")
+    db = Database.load(tmp_path / "before.npz")
+    poses, moves_ = db.poses.copy(), db.moves.copy()
+    search(db, mt.read_take(HDM[3]), 2), nearest_frames(db, mt.read_take(HDM[3]), 30, 2)
+    kept = [v for v in vars(db).values() if isinstance(v, np.ndarray) and v.ndim == 2]
+    assert len(kept) == 1 and kept[0].dtype == np.float64  # DTW's series; the tree keeps the moves
+    np.testing.assert_array_equal(db.poses, poses)
+    np.testing.assert_array_equal(db.moves, moves_)
+    db.save(tmp_path / "after.npz")
+    again = Database.load(tmp_path / "after.npz")
+    np.testing.assert_array_equal(again.poses, poses)
+    np.testing.assert_array_equal(again.moves, moves_)
+
+
 def test_the_view_page_plays_the_query_and_the_hits_in_chromium(hdm05, tmp_path, capsys):
     browsers = pytest.importorskip("test_view_browser", reason="selenium is not installed")
     if browsers.BROWSER is None or browsers.DRIVER is None:
