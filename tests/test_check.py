@@ -196,3 +196,20 @@ def test_feet_in_the_floor_and_a_floor_away_from_zero_are_found_in_metres():
     values[:, ty] += 0.5 * metre
     (floor,) = _legs_found(take.replace(values=values), "floor")
     assert floor.severity == "low" and floor.size == pytest.approx(0.5, abs=0.06) and floor.unit == "m"
+
+
+def test_a_fast_smooth_turn_is_no_high_spike_and_a_pop_as_far_is():
+    """LAFAN1's hands at 30 Hz turn 1,800 deg/s through excursions of 100 deg that a person sees
+    as a fast wrist: medium at most; the same hand popping 150 deg for two frames (4,500 deg/s) is high."""
+    lafan = real_files("bvh-producers/bvhTools_test2_lafan1.bvh")
+    if not lafan:
+        pytest.skip("the real-file corpus (../shared/data/bvh-producers) is absent")
+    take = mt.read_take(lafan[0])
+    hands = [f for f in check_motion(take) if f.kind == "spike" and f.joints[0] in ("LeftHand", "RightHand")]
+    assert hands and max(f.size for f in hands) > 70  # the excursions are found, as big as they are
+    assert [f for f in hands if f.severity == "high"] == []
+    values = take.values.copy()
+    columns = take.columns("LeftHand", take.skeleton.dofs("LeftHand"))
+    values[600:602, columns[0]] += 150.0
+    popped = [f for f in check_motion(take.replace(values=values)) if f.kind == "spike" and f.first in (601, 602)]
+    assert [(f.joints, f.severity) for f in popped if f.joints == ("LeftHand",)] == [(("LeftHand",), "high")]

@@ -74,6 +74,9 @@ STEP_PAIR_SECONDS = 0.05
 POP_FRAMES = 3
 TELEPORT_M = 0.25
 """Metres: a root that leaves its neighbours by this for a few frames has teleported, however slow."""
+SPIKE_TURN_DEG_S = 3_000.0
+"""deg/s: a high spike turns faster than this between two frames, into it or out of it (a fast
+wrist at 30 Hz turns 1,800 deg/s through a smooth excursion; a pop turns 170 deg in one frame)."""
 
 
 @dataclass(frozen=True)
@@ -444,10 +447,14 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
             continue  # the angles swing (near gimbal lock) or the frames around move fast: no spike
         if channel.turns:
             # high: farther out than smooth motion could go at six times the peak acceleration
-            # (30 deg at 120 Hz; 67 deg at 30 Hz, where a fast wrist leaves its neighbours by 30)
-            # and farther than the joint turns per frame just before and after: a joint that turns
-            # as fast around it shakes (a waving hand at 30 Hz), which a person may not call a spike
-            high = deviation > max(30, 6 * limit) and deviation > 2 * _pace(t, joint, first, last)
+            # (30 deg at 120 Hz; 67 deg at 30 Hz, where a fast wrist leaves its neighbours by 30),
+            # farther than the joint turns per frame just before and after (a joint that turns as
+            # fast around it shakes: a waving hand at 30 Hz), and in a turn no joint makes
+            high = (
+                deviation > max(30, 6 * limit)
+                and deviation > 2 * _pace(t, joint, first, last)
+                and _fastest(t, joint, first, last) > SPIKE_TURN_DEG_S
+            )
             severity = "high" if high else "medium" if deviation > 10 else "low"
             out.append(
                 Finding(
@@ -553,13 +560,25 @@ PACE_FRAMES = 3
 def _pace(t: _Take, joint: str, first: int, last: int) -> float:
     """The most the joint turns from one frame to the next over the PACE_FRAMES frames before
     rows first..last and after them, in degrees (0 where it has no three rotation channels)."""
-    if joint not in t.triples:
+    return max(_turns(t, joint, first - PACE_FRAMES, first - 1), _turns(t, joint, last + 1, last + PACE_FRAMES))
+
+
+def _fastest(t: _Take, joint: str, first: int, last: int) -> float:
+    """The fastest the joint turns from one frame to the next from the row before rows
+    first..last to the row after them, in degrees per second (inf without three rotation
+    channels, where the check has no other measure than the channel's own)."""
+    return _turns(t, joint, first - 1, last + 1) * t.rate if joint in t.triples else math.inf
+
+
+def _turns(t: _Take, joint: str, first: int, last: int) -> float:
+    """The most the joint turns from one frame to the next over rows first..last of the take, in
+    degrees (0 where it has no three rotation channels or fewer than two of those rows)."""
+    rows = np.arange(max(first, 0), min(last, t.motion.frames - 1) + 1)
+    if joint not in t.triples or len(rows) < 2:
         return 0.0
-    rows = [r for r in (*range(first - PACE_FRAMES, first), *range(last + 1, last + 1 + PACE_FRAMES))]
-    rows = [r for r in rows if 0 <= r < t.motion.frames]
-    q = t.quaternions(joint, np.array(rows, dtype=np.intp))
-    steps = [_angle_deg(q[i], q[i + 1]) for i in range(len(rows) - 1) if rows[i + 1] == rows[i] + 1]
-    return float(np.nanmax(steps)) if steps else 0.0
+    q = t.quaternions(joint, rows)
+    steps = _angle_deg(q[1:], q[:-1])
+    return float(np.nanmax(steps)) if not np.isnan(steps).all() else 0.0
 
 
 def _trimmed(t: _Take, joint: str, turns: bool, first: int, last: int, limit: float) -> tuple[int, int, float | None]:
