@@ -4,6 +4,7 @@ game studio, a z-up exporter or a MotionBuilder rig would write it."""
 import numpy as np
 
 import motiontheater as mt
+from motiontheater.editing.convert import to_bvh
 from motiontheater.model.skeleton import TRANSLATIONS, Bone, Root, canonical_hierarchy
 
 
@@ -15,7 +16,9 @@ def with_static_root(
     the old root's channels are exactly the same numbers).  ``keep_world``: the old root's channels
     are made relative to the static joint, so that every point stays where it was; else they stay
     as they were and the whole take turns and moves with the static joint (``turn=(90, 0, 0)``:
-    a y-up take stands along z, as a z-up exporter writes it)."""
+    a y-up take stands along z, as a z-up exporter writes it).  An ASF/AMC take is made BVH
+    first (:func:`to_bvh`): its bones' axes are no BVH joint's."""
+    motion = to_bvh(motion)
     skeleton = motion.skeleton
     old = skeleton.root
     turn = (0.0, 0.0, 0.0) if turn is None else turn
@@ -48,7 +51,9 @@ def with_static_root(
 
 def with_offset_channels(motion: mt.Motion) -> mt.Motion:
     """A BVH take with position channels on every joint (not the end sites) that hold its OFFSET in
-    every frame, as LAFAN-style and many MotionBuilder exports write them."""
+    every frame, as LAFAN-style and many MotionBuilder exports write them (an ASF/AMC take made
+    BVH first)."""
+    motion = to_bvh(motion)
     skeleton = motion.skeleton
     bones, columns = [], [motion.values[:, motion.columns("root")]]
     for bone in skeleton.bones:
