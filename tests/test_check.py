@@ -12,6 +12,7 @@ import motiontheater as mt
 from artifacts import KINDS, hits, inject
 from corpus import real_files
 from motiontheater.databases.check import check_motion, recipe
+from motiontheater.databases.check_feet import STRIDE_SPEED_RANGE, STRIDE_SPEED_SHARE
 from motiontheater.databases.findings import KINDS as FINDING_KINDS
 from motiontheater.databases.findings import SEVERITIES
 from motiontheater.feet.footskate import prepare
@@ -26,12 +27,13 @@ VARIANTS = {
     "in mm": lambda take: take.with_units(length_factor=1000 * take.skeleton.meters_per_unit, length="mm"),
 }
 TRIALS = 3  # injections of each kind per take and variant
-UNITS = {"deg", "m", "m/s", "s", ""}
+UNITS = {"deg", "m", "m/s", "s", "Hz", ""}
 
 
-def _variant(path, name, tmp_path):
-    """The take as the variant's producer would write it: through a BVH file, read back."""
-    take = mt.read_take(path)
+def _variant(path, name, tmp_path, take=None):
+    """The take at ``path`` (or ``take``, read from it) as the variant's producer would write it:
+    through a BVH file, read back."""
+    take = mt.read_take(path) if take is None else take
     if name == "as found":
         return take
     target = tmp_path / f"{path.stem}.bvh"
@@ -157,11 +159,15 @@ def _smooth_take(rate: float) -> mt.Motion:
     return mt.Motion(skeleton, values, frame_rate=rate)
 
 
-def _walk():
+def _walk_path():
     cmu = real_files("cmu/02_01.amc")
     if not cmu:
         pytest.skip("the real-file corpus (../shared/data) is absent")
-    return mt.read_take(cmu[0])
+    return cmu[0]
+
+
+def _walk():
+    return mt.read_take(_walk_path())
 
 
 def _legs_found(take, kind):
@@ -213,3 +219,50 @@ def test_a_fast_smooth_turn_is_no_high_spike_and_a_pop_as_far_is():
     values[600:602, columns[0]] += 150.0
     popped = [f for f in check_motion(take.replace(values=values)) if f.kind == "spike" and f.first in (601, 602)]
     assert [(f.joints, f.severity) for f in popped if f.joints == ("LeftHand",)] == [(("LeftHand",), "high")]
+
+
+@pytest.mark.parametrize("variant", ["as found", "game rig", "z-up"])
+def test_an_elbow_bent_backwards_is_found_where_it_is(variant, tmp_path):
+    """CMU's elbow is a hinge of one channel (rx); in the game rig and z-up BVH written from it,
+    three channels whose axes the check must find for itself."""
+    assert _legs_found(_variant(_walk_path(), variant, tmp_path), "elbow") == []
+    take = _walk()
+    values = take.values.copy()
+    (column,) = take.columns("lradius", ("rx",))
+    forward = np.sign(np.median(values[:, column]))
+    values[100:112, column] = -forward * 35.0
+    bent = _variant(_walk_path(), variant, tmp_path, take.replace(values=values))
+    (finding,) = _legs_found(bent, "elbow")
+    assert finding.joints == ("lradius",) and (finding.first, finding.last) == (101, 112)
+    assert 30 < finding.size < 40 and finding.unit == "deg" and finding.severity == "medium"
+
+
+def test_a_frame_time_written_for_another_rate_is_found_from_the_strides():
+    """Every real take as found has no rate finding; written at a quarter or four times its rate,
+    each steady walk or run has one in both directions, its range holding the true rate."""
+    if not TAKES:
+        pytest.skip("the real-file corpus (../shared/data) is absent")
+    found = 0
+    for path in TAKES:
+        take = mt.read_take(path)
+        assert [f for f in check_motion(take) if f.kind == "rate"] == [], path
+        named = []
+        for factor in (0.25, 4.0):
+            named += [f for f in check_motion(take.replace(frame_rate=take.frame_rate * factor)) if f.kind == "rate"]
+        if named:
+            assert len(named) == 2, (path, named)
+            for f in named:
+                low, high = (f.size * share / STRIDE_SPEED_SHARE for share in STRIDE_SPEED_RANGE)
+                assert f.unit == "Hz" and 0.95 * low < take.frame_rate < 1.05 * high, (path, f)  # 2 digits
+                assert "retime" in f.detail and f.fix == ()
+            found += 1
+    assert found >= 10  # the walks and runs of CMU, HDM05, DeepMimic, the BVH sites
+
+
+def test_retime_sets_the_rate_and_keeps_every_frame():
+    take = _walk()
+    again = mt.Pipeline.of("retime", rate=30).apply(take)
+    assert again.frame_rate == 30.0 and again.frames == take.frames
+    np.testing.assert_array_equal(again.values, take.values)
+    with pytest.raises(ValueError, match="positive number of frames per second"):
+        mt.Pipeline.of("retime", rate=0).apply(take)

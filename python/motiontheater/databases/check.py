@@ -8,7 +8,8 @@ rotation does not); a jump of the angles with no jump of the rotation is a flip;
 root that no runner makes is a teleport; a held value is frozen only where the channel moves
 around it.  Every limit is stated in degrees, metres, seconds and Hz below and converted with
 the skeleton's length unit and the take's frame rate.  The legs (skating and sinking feet, the
-floor, knees bent backwards) are judged in :mod:`.check_feet`.
+floor, knees bent backwards) are judged in :mod:`.check_feet`, elbows bent backwards in
+:mod:`.check_arms`.
 
 Each finding carries the steps that fix it, confined to its frames and joints (see
 :func:`recipe`): missing, spiked, frozen and repeated frames are dropped and filled from the
@@ -34,6 +35,7 @@ from ..model.motion import Motion
 from ..model.rig import body_joint
 from ..model.skeleton import ROTATIONS, TRANSLATIONS
 from ..model.units import HUMAN_HEIGHT
+from .check_arms import arm_findings
 from .check_feet import leg_findings
 from .findings import Finding
 
@@ -184,6 +186,7 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         findings += _bones(t)
         findings += _speed(t)
         findings += leg_findings(motion, take, t.meters)
+        findings += arm_findings(motion, take)
     return sorted(findings, key=lambda f: (f.first, -f.rank, f.kind, f.joints))
 
 
@@ -711,10 +714,10 @@ def _unit(t: _Take) -> list[Finding]:
 
 
 def recipe(findings: Iterable[Finding], severities: tuple[str, ...] = ("medium", "high")) -> Pipeline:
-    """The steps that fix the findings of ``severities`` (those with a fix): unit first, then
+    """The steps that fix the findings of ``severities`` (those with a fix): rate and unit first, then
     flips, then the frames filled, then smoothing, then the feet, each confined to its frames and
     joints."""
-    order = ("scale", "unroll", "fill_gaps", "butterworth", "cleanup")
+    order = ("retime", "scale", "unroll", "fill_gaps", "butterworth", "cleanup")
     entries = [step for f in findings if f.severity in severities for step in f.fix]
     entries.sort(key=lambda e: order.index(e[0]) if e[0] in order else len(order))
     pipeline = Pipeline()

@@ -1,5 +1,6 @@
 """The take check's findings on the legs: planted feet that slide (skate), feet below the floor
-(penetration), a floor away from level zero, and knees bent backwards.
+(penetration), a floor away from level zero, knees bent backwards, and a frame rate that a
+steady walk's strides disagree with (rate).
 
 The legs, the floor and the footplants are found as footskate cleanup finds them
 (:mod:`motiontheater.feet`), so that what the check calls a skate is what the cleanup fixes, and
@@ -46,6 +47,20 @@ backwards; 45 is high.  Bends the other way deeper than 90 degrees are not count
 knee's hinge turns with the thigh and says nothing of which way the knee bends."""
 FOOT_ACROSS = math.cos(math.radians(45))
 """A foot within 45 degrees of square to the shin tells which way the knee bends."""
+STRIDE_ALIKE = 0.75
+"""How alike the legs' alternation must be from one stride to the next (its autocorrelation at
+the stride) for the stride to tell the take's rate: a steady walk or run."""
+STRIDE_HIPS = 0.6
+"""Hip heights a stride must cover (a step on the spot tells no speed)."""
+STRIDE_SPEED_SHARE = 0.8
+"""The walkers and runners of the real takes here go at 0.5-1.7 (median 0.8) times the speed
+Alexander's relation gives for their stride, lambda / h = 2.3 (v^2 / g h)^0.3 (h the hip
+height; Alexander 1984): the check takes 0.8, and names the rates 0.45-1.8 would give."""
+STRIDE_SPEED_RANGE = (0.45, 1.8)
+RATE_FACTOR = 2.0
+"""A rate the stride puts this many times off the file's is reported (the real takes lie within
+1.7 of it; a Frame Time written for another rate is off by 2 or 4).  It is reported, not fixed:
+only the capture's notes can say which rate it was; ``retime`` is the step that sets it."""
 BLEND_SECONDS = 0.2 + 0.1
 """The cleanup's fades (its blend) and root smoothing: a recipe's cleanup range reaches this far
 beyond the frames it fixes, so that the adjustments fade within it."""
@@ -62,7 +77,7 @@ def leg_findings(motion: Motion, take: str, meters: float) -> list[Finding]:
     except ValueError:
         return []  # no legs, or none that are numbers: nothing to judge here
     context = _Legs(motion, take, arrays, ground, mpu)
-    return context.skates() + context.penetrations() + context.floor() + context.knees()
+    return context.skates() + context.penetrations() + context.floor() + context.knees() + context.rhythm()
 
 
 class _Legs:
@@ -182,6 +197,59 @@ class _Legs:
                     )
                 )  # fmt: skip
         return out
+
+    def rhythm(self) -> list[Finding]:
+        """The rate a steady walk or run's stride gives, where it is RATE_FACTOR off the file's:
+        the frames of a stride and the ground it covers do not depend on the rate; the speed
+        they make does, and a person striding that far goes at a known speed."""
+        ankles = self.arrays.points[:, :, 1]
+        if len(ankles) != 2 or not np.isfinite(ankles).all():
+            return []
+        heights = ankles @ self.up
+        frames = _stride(heights[0] - heights[1])
+        if frames is None:
+            return []
+        hips = self.arrays.hips.mean(axis=0)
+        ground = hips - (hips @ self.up)[:, None] * self.up
+        stride = float(np.median(np.linalg.norm(ground[frames:] - ground[:-frames], axis=1))) * self.mpu
+        hip = float(np.median(hips @ self.up - heights.min(axis=0))) * self.mpu
+        if not (hip > 0 and stride > STRIDE_HIPS * hip):
+            return []
+        expected = STRIDE_SPEED_SHARE * math.sqrt(9.81 * hip) * (stride / (2.3 * hip)) ** (1 / 0.6)
+        rate = self.motion.frame_rate
+        speed = stride * rate / frames
+        likely = expected * frames / stride  # the rate at which the stride takes that speed
+        if 1 / RATE_FACTOR < likely / rate < RATE_FACTOR:
+            return []
+        low, high = (likely * share / STRIDE_SPEED_SHARE for share in STRIDE_SPEED_RANGE)
+        return [
+            Finding(
+                self.take, "rate", (), self.motion.first_frame, self.motion.last_frame, "medium",
+                float(f"{likely:.2g}"), "Hz",
+                f"strides of {stride:.2g} m take {frames / rate:.2g} s at {rate:g} Hz, {speed:.2g} m/s; people who "
+                f"stride that far go at about {expected:.2g} m/s: the take was likely recorded at about "
+                f"{likely:.2g} Hz ({low:.2g}-{high:.2g} Hz, as walkers' speeds for a stride vary), not {rate:g}; "
+                "where its capture notes say so, the retime step sets the rate",
+            )
+        ]  # fmt: skip
+
+
+def _stride(alternation: np.ndarray) -> int | None:
+    """The frames of one stride: the first peak of the autocorrelation of the left foot's height
+    less the right's, where it is STRIDE_ALIKE or more and the take holds two strides."""
+    n = len(alternation)
+    x = alternation - alternation.mean()
+    energy = float(x @ x)
+    if n < 8 or not energy > 0:
+        return None
+    spectrum = np.fft.rfft(x, 2 * n)
+    alike = np.fft.irfft(spectrum * np.conj(spectrum))[:n] / energy
+    alike /= 1 - np.arange(n) / n  # the share of the take each lag compares
+    below = np.flatnonzero(alike[: n // 2] < 0)
+    if not len(below):
+        return None
+    lag = int(below[0] + np.argmax(alike[below[0] : n // 2]))
+    return lag if alike[lag] >= STRIDE_ALIKE else None
 
 
 def _lowest_around(x: np.ndarray, half: int) -> np.ndarray:

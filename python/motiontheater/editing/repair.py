@@ -1,5 +1,6 @@
 """Repairs that the take check's recipes call for, besides the filters: Euler angles made
-continuous again (``unroll``) and lengths rescaled (``scale``)."""
+continuous again (``unroll``), lengths rescaled (``scale``) and a frame rate set right
+(``retime``)."""
 
 from __future__ import annotations
 
@@ -70,3 +71,15 @@ def scale(
     if not (np.isfinite(factor) and factor > 0):
         raise ValueError(f"factor must be a positive number, got {factor!r}")
     return motion.with_units(length_factor=factor)
+
+
+@step("retime", "set the frame rate, the frames kept as they are: a Frame Time written for another rate")
+def retime(
+    motion: Motion, *, rate: Annotated[float, "the rate the take was recorded at, in Hz (frames per second)"]
+) -> Motion:
+    """A new motion of the same frames at ``rate`` Hz: the repair for a take whose file gives
+    another rate than it was recorded at (its motion too slow or too fast).  ``resample``
+    changes the frames to keep the motion's timing instead."""
+    if isinstance(rate, bool) or not (isinstance(rate, (int, float)) and np.isfinite(rate) and rate > 0):
+        raise ValueError(f"rate must be a positive number of frames per second, got {rate!r}")
+    return motion.replace(frame_rate=float(rate))

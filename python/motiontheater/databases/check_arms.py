@@ -1,0 +1,87 @@
+"""The take check's findings on the arms: elbows bent backwards.
+
+An elbow is a hinge: the forearm turns about one axis fixed in the upper arm, and one way.  Rigs
+differ in which axis that is and which way is forward, so both are the take's own: the mean turn
+from upper arm to forearm, in the upper arm's axes, over the frames where the elbow bends well.
+A frame whose forearm turns the other way about that axis, past ELBOW_BACK_DEG, is bent
+backwards.  A take whose elbows never bend, or turn about no one axis (an arm estimated from
+video, a rig the tables do not know), has no findings here.  They are reported, not fixed: which
+way the arm should have bent is not in the take.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..characters.rigs import recognise
+from ..feet.contacts import runs
+from ..model.motion import Motion
+from .findings import Finding
+
+ELBOW_BACK_DEG = 20.0
+"""Degrees an elbow may bend backwards (past straight; up to 10-15 degrees is human, more in
+the hypermobile) before it is bent backwards; 45 is high."""
+BENT_DEG = 30.0
+"""Frames whose elbow bends more than this tell its axis and which way it bends."""
+BENT_SECONDS = 0.25
+"""The least time the elbow must bend that far for the check to know its axis."""
+HINGE = 0.8
+"""How nearly the turns of those frames must share one axis (the length of their mean unit
+axis) for the elbow to be a hinge the check can judge."""
+
+
+def arm_findings(motion: Motion, take: str) -> list[Finding]:
+    """The elbows of the take bent backwards past ELBOW_BACK_DEG."""
+    skeleton = motion.skeleton
+    parts = recognise(skeleton).parts
+    names = list(skeleton.point_names)
+    arms: list[tuple[int, int, int, int]] = []  # shoulder, upper arm's turning joint, elbow, wrist
+    for side in ("left", "right"):
+        wrist = parts.get(f"{side}_wrist") or parts.get(f"{side}_hand")
+        if f"{side}_upper_arm" in parts and f"{side}_forearm" in parts and wrist:
+            forearm = parts[f"{side}_forearm"][0]
+            turning = skeleton.parent(forearm)  # the upper arm's last joint (a roll joint's, if any)
+            if turning in names:
+                arms.append((names.index(parts[f"{side}_upper_arm"][0]), names.index(turning), names.index(forearm),
+                             names.index(wrist[0])))  # fmt: skip
+    if not arms or motion.frames < 2:
+        return []
+    positions = motion.positions(start=skeleton.convention != "bvh")
+    rotations = motion.rotations()
+    out = []
+    for shoulder, upper, elbow, hand in arms:
+        bend = _signed_bends(positions, rotations, shoulder, upper, elbow, hand, motion.frame_rate)
+        if bend is None:
+            continue
+        for s, e in zip(*runs(bend < -ELBOW_BACK_DEG)):
+            worst = float(-bend[s:e].min())
+            out.append(
+                Finding(
+                    take, "elbow", (names[elbow],), motion.first_frame + int(s), motion.first_frame + int(e) - 1,
+                    "high" if worst > 45 else "medium", round(worst, 6), "deg",
+                    f"{names[elbow]} bends {worst:.3g} deg backwards, past what an elbow does",
+                )
+            )  # fmt: skip
+    return out
+
+
+def _signed_bends(
+    positions: np.ndarray, rotations: np.ndarray, shoulder: int, upper: int, elbow: int, hand: int, rate: float
+) -> np.ndarray | None:
+    """The elbow's bend per frame in degrees, forward positive and backwards negative; None where
+    the take does not tell its axis (see the module docstring)."""
+    arm = positions[:, elbow] - positions[:, shoulder]
+    forearm = positions[:, hand] - positions[:, elbow]
+    # the turn from upper arm to forearm, in the axes of the joint that turns the upper arm
+    turn = np.einsum("fji,fj->fi", rotations[:, upper], np.cross(arm, forearm))
+    straight = np.sum(arm * forearm, axis=-1)
+    length = np.linalg.norm(turn, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bent = np.degrees(np.arctan2(length, straight)) > BENT_DEG
+        if bent.sum() < max(2, BENT_SECONDS * rate):
+            return None
+        axis = np.nanmean(turn[bent] / length[bent, None], axis=0)
+    if not np.linalg.norm(axis) > HINGE:
+        return None
+    axis /= np.linalg.norm(axis)
+    return np.degrees(np.arctan2(turn @ axis, straight))
