@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from mtcore.kinematics import forward_kinematics
+
 from ..characters.rigs import recognise
 from ..feet.contacts import runs
 from ..model.motion import Motion
@@ -46,8 +48,11 @@ def arm_findings(motion: Motion, take: str) -> list[Finding]:
                              names.index(wrist[0])))  # fmt: skip
     if not arms or motion.frames < 2:
         return []
-    positions = motion.positions(start=skeleton.convention != "bvh")
-    rotations = motion.rotations()
+    tree = skeleton.tree
+    positions, rotations, _ = forward_kinematics(motion.values, tree, world=True)  # one pass for both
+    assert rotations is not None  # asked for
+    if skeleton.convention != "bvh":
+        positions = positions[:, np.maximum(tree.parent, 0)]  # a bone's start, as positions(start=True)
     out = []
     for shoulder, upper, elbow, hand in arms:
         bend = _signed_bends(positions, rotations, shoulder, upper, elbow, hand, motion.frame_rate)
