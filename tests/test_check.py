@@ -266,3 +266,19 @@ def test_retime_sets_the_rate_and_keeps_every_frame():
     np.testing.assert_array_equal(again.values, take.values)
     with pytest.raises(ValueError, match="positive number of frames per second"):
         mt.Pipeline.of("retime", rate=0).apply(take)
+
+
+def test_the_elbow_check_holds_a_block_of_frames_at_a_time(monkeypatch):
+    """Blocks of 7 frames (a take of any length is checked a block at a time) find what one
+    block of every frame finds."""
+    from motiontheater.databases import check_arms
+
+    take = _walk()
+    values = take.values.copy()
+    (column,) = take.columns("rradius", ("rx",))
+    values[200:230, column] = -np.sign(np.median(values[:, column])) * 50.0
+    bent = take.replace(values=values)
+    whole = check_arms.arm_findings(bent, "walk")
+    monkeypatch.setattr(check_arms, "BLOCK_FRAMES", 7)
+    assert check_arms.arm_findings(bent, "walk") == whole
+    assert [(f.joints, f.first, f.last, f.severity) for f in whole] == [(("rradius",), 201, 230, "high")]

@@ -1,8 +1,9 @@
 """The take check's findings on the arms: elbows bent backwards.
 
 An elbow is a hinge: the forearm turns about one axis fixed in the upper arm, and one way.  Rigs
-differ in which axis that is and which way is forward, so both are the take's own: the mean turn
-from upper arm to forearm, in the upper arm's axes, over the frames where the elbow bends well.
+differ in which axis that is and which way is forward, so both are the take's own: the axis
+the turns from upper arm to forearm share, in the upper arm's axes, over the frames where the
+elbow bends well, and the way most of them turn about it.
 A frame whose forearm turns the other way about that axis, past ELBOW_BACK_DEG, is bent
 backwards.  A take whose elbows never bend, or turn about no one axis (an arm estimated from
 video, a rig the tables do not know), has no findings here.  They are reported, not fixed: which
@@ -28,8 +29,8 @@ BENT_DEG = 30.0
 BENT_SECONDS = 0.25
 """The least time the elbow must bend that far for the check to know its axis."""
 HINGE = 0.8
-"""How nearly the turns of those frames must share one axis (the length of their mean unit
-axis) for the elbow to be a hinge the check can judge."""
+"""How nearly the turns of those frames must share one axis (the share of their unit axes'
+second moment along it) for the elbow to be a hinge the check can judge."""
 
 
 def arm_findings(motion: Motion, take: str) -> list[Finding]:
@@ -48,14 +49,12 @@ def arm_findings(motion: Motion, take: str) -> list[Finding]:
                              names.index(wrist[0])))  # fmt: skip
     if not arms or motion.frames < 2:
         return []
-    tree = skeleton.tree
-    positions, rotations, _ = forward_kinematics(motion.values, tree, world=True)  # one pass for both
-    assert rotations is not None  # asked for
-    if skeleton.convention != "bvh":
-        positions = positions[:, np.maximum(tree.parent, 0)]  # a bone's start, as positions(start=True)
+    turns = [_turns(motion, rows, arms) for rows in _blocks(motion.frames)]
     out = []
-    for shoulder, upper, elbow, hand in arms:
-        bend = _signed_bends(positions, rotations, shoulder, upper, elbow, hand, motion.frame_rate)
+    for i, (_, _, elbow, _) in enumerate(arms):
+        turn = np.concatenate([t[i][0] for t in turns])
+        straight = np.concatenate([t[i][1] for t in turns])
+        bend = _signed_bends(turn, straight, motion.frame_rate)
         if bend is None:
             continue
         for s, e in zip(*runs(bend < -ELBOW_BACK_DEG)):
@@ -70,23 +69,46 @@ def arm_findings(motion: Motion, take: str) -> list[Finding]:
     return out
 
 
-def _signed_bends(
-    positions: np.ndarray, rotations: np.ndarray, shoulder: int, upper: int, elbow: int, hand: int, rate: float
-) -> np.ndarray | None:
-    """The elbow's bend per frame in degrees, forward positive and backwards negative; None where
-    the take does not tell its axis (see the module docstring)."""
-    arm = positions[:, elbow] - positions[:, shoulder]
-    forearm = positions[:, hand] - positions[:, elbow]
-    # the turn from upper arm to forearm, in the axes of the joint that turns the upper arm
-    turn = np.einsum("fji,fj->fi", rotations[:, upper], np.cross(arm, forearm))
-    straight = np.sum(arm * forearm, axis=-1)
+BLOCK_FRAMES = 8192
+"""Frames whose joints' world rotations are held at once (18 MB for 31 joints): a take of any
+length is checked in blocks."""
+
+
+def _blocks(frames: int) -> list[slice]:
+    return [slice(a, min(a + BLOCK_FRAMES, frames)) for a in range(0, frames, BLOCK_FRAMES)]
+
+
+def _turns(motion: Motion, rows: slice, arms: list[tuple[int, int, int, int]]) -> list[tuple[np.ndarray, np.ndarray]]:
+    """For each arm over the rows: the turn from upper arm to forearm (the cross product of the
+    two, in the axes of the joint that turns the upper arm), and their dot product."""
+    tree = motion.skeleton.tree
+    positions, rotations, _ = forward_kinematics(motion.values[rows], tree, world=True)  # one pass for both
+    assert rotations is not None  # asked for
+    if motion.skeleton.convention != "bvh":
+        positions = positions[:, np.maximum(tree.parent, 0)]  # a bone's start, as positions(start=True)
+    out = []
+    for shoulder, upper, elbow, hand in arms:
+        arm = positions[:, elbow] - positions[:, shoulder]
+        forearm = positions[:, hand] - positions[:, elbow]
+        turn = np.einsum("fji,fj->fi", rotations[:, upper], np.cross(arm, forearm))
+        out.append((turn, np.sum(arm * forearm, axis=-1)))
+    return out
+
+
+def _signed_bends(turn: np.ndarray, straight: np.ndarray, rate: float) -> np.ndarray | None:
+    """The elbow's bend per frame in degrees, forward positive and backwards negative, from its
+    turns and dot products (:func:`_turns`); None where the take does not tell its axis (see the
+    module docstring)."""
     length = np.linalg.norm(turn, axis=-1)
     with np.errstate(invalid="ignore", divide="ignore"):
         bent = np.degrees(np.arctan2(length, straight)) > BENT_DEG
         if bent.sum() < max(2, BENT_SECONDS * rate):
             return None
-        axis = np.nanmean(turn[bent] / length[bent, None], axis=0)
-    if not np.linalg.norm(axis) > HINGE:
+        units = turn[bent] / length[bent, None]
+    # the axis the turns share, whichever way each turns (a long backwards bend is among them),
+    # forward the way most of them turn
+    shares, axes = np.linalg.eigh(units.T @ units / len(units))
+    if not shares[-1] > HINGE:
         return None
-    axis /= np.linalg.norm(axis)
+    axis = axes[:, -1] if np.sum(units @ axes[:, -1] > 0) * 2 >= len(units) else -axes[:, -1]
     return np.degrees(np.arctan2(turn @ axis, straight))

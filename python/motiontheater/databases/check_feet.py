@@ -225,13 +225,18 @@ class _Legs:
         return [
             Finding(
                 self.take, "rate", (), self.motion.first_frame, self.motion.last_frame, "medium",
-                float(f"{likely:.2g}"), "Hz",
+                _digits(likely), "Hz",
                 f"strides of {stride:.2g} m take {frames / rate:.2g} s at {rate:g} Hz, {speed:.2g} m/s; people who "
                 f"stride that far go at about {expected:.2g} m/s: the take was likely recorded at about "
-                f"{likely:.2g} Hz ({low:.2g}-{high:.2g} Hz, as walkers' speeds for a stride vary), not {rate:g}; "
-                "where its capture notes say so, the retime step sets the rate",
+                f"{_digits(likely):g} Hz ({_digits(low):g}-{_digits(high):g} Hz, as walkers' speeds for a stride "
+                f"vary), not {rate:g}; where the capture's notes agree, motiontheater retime --rate HZ sets it",
             )
         ]  # fmt: skip
+
+
+def _digits(x: float) -> float:
+    """x to two significant digits (140.0, not 1.4e+02 as :g would print it)."""
+    return float(f"{x:.2g}")
 
 
 def _stride(alternation: np.ndarray) -> int | None:

@@ -73,7 +73,7 @@ def scale(
     return motion.with_units(length_factor=factor)
 
 
-@step("retime", "set the frame rate, the frames kept as they are: a Frame Time written for another rate")
+@step("retime", "set the frame rate, the frames kept as they are: a Frame Time written for another rate", frames="none")
 def retime(
     motion: Motion, *, rate: Annotated[float, "the rate the take was recorded at, in Hz (frames per second)"]
 ) -> Motion:
