@@ -137,6 +137,8 @@ def test_every_finding_on_a_real_take_names_its_frames_joints_and_units(path):
         for name, options in f.fix:
             mt.Pipeline.of(name, **options)  # each fix is a step with options it takes
     assert recipe(findings).apply(take).frames == take.frames
+    rotations = [(f.kind, f.joints, f.first) for f in findings if f.unit == "deg" and f.kind in ("jump", "spike")]
+    assert len(rotations) == len(set(rotations))  # one finding of a joint's rotation, however many channels show it
 
 
 def test_a_clean_synthetic_take_has_no_finding_above_low():
@@ -282,3 +284,31 @@ def test_the_elbow_check_holds_a_block_of_frames_at_a_time(monkeypatch):
     monkeypatch.setattr(check_arms, "BLOCK_FRAMES", 7)
     assert check_arms.arm_findings(bent, "walk") == whole
     assert [(f.joints, f.first, f.last, f.severity) for f in whole] == [(("rradius",), 201, 230, "high")]
+
+
+@pytest.mark.parametrize("frames", [1, 10])
+def test_a_turn_over_and_back_whose_euler_angles_wrap_is_one_spike(frames):
+    """A BVH joint turned 170 degrees for one frame, or for 10 (0.42 s at 24 Hz): its Euler
+    angles jump by other amounts on the way out and back (they wrap), and the check still calls
+    it one spike of those frames, not flips or jumps, which the recipe fills."""
+    from scipy.spatial.transform import Rotation
+
+    walk = real_files("bvh/walk01.bvh")
+    if not walk:
+        pytest.skip("the real-file corpus (../shared/data/bvh) is absent")
+    take = mt.read_take(walk[0])
+    joint = "LeftForeArm"
+    columns = take.columns(joint, take.skeleton.dofs(joint)[-3:])
+    order = "".join(take.skeleton.dofs(joint)[-3:]).replace("r", "").upper()
+    values = take.values.copy()
+    rows = slice(60, 60 + frames)
+    turned = Rotation.from_euler(order, values[rows, columns], degrees=True) * Rotation.from_euler(
+        "x", 170, degrees=True
+    )
+    values[rows, columns] = turned.as_euler(order, degrees=True)
+    found = check_motion(take.replace(values=values))
+    near = [f for f in found if joint in f.joints and 58 <= f.first <= 62 + frames]
+    assert [(f.kind, f.first, f.last) for f in near] == [("spike", 61, 60 + frames)]
+    assert near[0].size == pytest.approx(170, abs=2) and near[0].severity == "high"
+    fixed = recipe(near).apply(take.replace(values=values))
+    assert [f for f in check_motion(fixed) if joint in f.joints and 58 <= f.first <= 62 + frames] == []

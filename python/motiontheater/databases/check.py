@@ -20,6 +20,7 @@ rescaled (``scale``), jitter low-passed (``butterworth`` at Winter's cut-off), s
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -383,6 +384,10 @@ def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
             shift = delta[beside] if inverted and beside < len(delta) else delta[first : last + 1]
             whole = bool(np.all(np.isclose(shift / 360, np.round(shift / 360), atol=1e-6)))
             edge = first if first > 0 else min(last + 1, len(angles) - 1)
+            if joint in t.triples and edge:
+                q = t.quaternions(joint, np.array([edge - 1, edge]))
+                if _angle_deg(q[0], q[1]) > FLIP_DEG / 2:
+                    continue  # the rotation jumps too (a pop that unrolling changes): spikes and jumps judge it
             jump = float(np.nan_to_num(np.abs(angles[edge] - angles[edge - 1])).max()) * t.degrees if edge else 0.0
             fixable = not whole and first > 0
             what = "wrap by whole turns" if whole else "flip to the other Euler triple of the same rotation"
@@ -449,23 +454,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
         if deviation <= limit:
             continue  # the angles swing (near gimbal lock) or the frames around move fast: no spike
         if channel.turns:
-            # high: farther out than smooth motion could go at six times the peak acceleration
-            # (30 deg at 120 Hz; 67 deg at 30 Hz, where a fast wrist leaves its neighbours by 30),
-            # farther than the joint turns per frame just before and after (a joint that turns as
-            # fast around it shakes: a waving hand at 30 Hz), and in a turn no joint makes
-            high = (
-                deviation > max(30, 6 * limit)
-                and deviation > 2 * _pace(t, joint, first, last)
-                and _fastest(t, joint, first, last) > SPIKE_TURN_DEG_S
-            )
-            severity = "high" if high else "medium" if deviation > 10 else "low"
-            out.append(
-                Finding(
-                    t.name, "spike", (joint,), t.frame(first), t.frame(last), severity, round(deviation, 6), "deg",
-                    f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s)",
-                    channel.name, _fill(t, first, last, [joint]),
-                )
-            )  # fmt: skip
+            out.append(_turning_spike(t, joint, channel.name, first, last, deviation, limit))
             continue
         speed = deviation * t.rate
         kind = "teleport" if joint == t.root and (speed > RUN_SPEED or deviation > TELEPORT_M) else "spike"
@@ -493,31 +482,51 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     for c, first, last, *_ in events:
         near_spike[c, first : last + 1] = True
     events, sizes = steps
+    seen, popped = set(), set()  # (joint, row): a joint's jump or pop shows in several of its channels
+    jumps: list[tuple[str, int, float, str, bool]] = []  # (joint, row, degrees, channel, not a spike's)
     for (c, first, last, _, at), size in zip(events[stay], sizes[stay]):
         channel = t.channels[int(c)]
         if (channel.joint, channel.turns, t.frame(at)) in explained or (
-            channel.turns and abs(t.physical(channel, size)) > FLIP_DEG
+            channel.turns and channel.joint not in t.triples and abs(t.physical(channel, size)) > FLIP_DEG
         ):
+            continue  # of a joint of three angles, the rotation tells a jump from a flip below
+        # the jumps into and out of a spike are the spike's (of a joint of three angles, they
+        # still tell how long a turn-over lasted, below)
+        quiet = bool(near_spike[int(c), max(first - 1, 0) : last + 2].any())
+        if quiet and not (channel.turns and channel.joint in t.triples):
             continue
-        if near_spike[int(c), max(first - 1, 0) : last + 2].any():
-            continue  # the jumps into and out of a spike
         if channel.turns:
+            if (channel.joint, at) in seen:
+                continue
             if channel.joint in t.triples and at > 1 and at < rows - 1:
                 q = t.quaternions(channel.joint, np.array([at - 2, at - 1, at, at + 1]))
                 turn = _angle_deg(q[1:], q[:-1])
+                limit = max(JUMP_DEG, limits[int(c)] * t.degrees)
+                # the rotation leaves for one frame and comes back: a pop of that frame (whose Euler
+                # angles jump by other amounts on the way out and back), found from either jump
+                pop = next(
+                    (
+                        row
+                        for row, k in ((at - 1, 0), (at, 1))
+                        if min(turn[k], turn[k + 1]) > limit
+                        and _angle_deg(q[k], q[k + 2]) < 0.5 * min(turn[k], turn[k + 1])
+                    ),
+                    None,
+                )
+                if pop is not None:
+                    if not quiet and (channel.joint, pop) not in popped:
+                        popped.add((channel.joint, pop))
+                        off = _deviations(t, channel.joint, True, pop, pop)
+                        if off is not None and float(off[0]) > limit:
+                            out.append(_turning_spike(t, channel.joint, channel.name, pop, pop, float(off[0]), limit))
+                    continue
                 jump = float(turn[1] - 0.5 * (turn[0] + turn[2]))
-                if not jump > max(JUMP_DEG, limits[int(c)] * t.degrees):
+                if not jump > limit:
                     continue
             else:
                 jump = abs(t.physical(channel, size))
-            severity = "high" if jump > 90 else "medium" if jump > 30 else "low"
-            out.append(
-                Finding(
-                    t.name, "jump", (channel.joint,), t.frame(at), t.frame(at), severity, round(jump, 6), "deg",
-                    f"{channel.joint} turns {jump:.3g} deg more in one frame than in the frames beside it, and stays",
-                    channel.name,
-                )
-            )  # fmt: skip
+            seen.add((channel.joint, at))
+            jumps.append((channel.joint, at, jump, channel.name, not quiet))
         elif channel.joint == t.root:
             distance = abs(t.physical(channel, size))
             out.append(
@@ -527,7 +536,68 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
                     channel.name,
                 )
             )  # fmt: skip
+    return _excursions(t, out, jumps, limits)
+
+
+def _excursions(
+    t: _Take, out: list[Finding], jumps: list[tuple[str, int, float, str, bool]], limits: np.ndarray
+) -> list[Finding]:
+    """The findings with the jumps added: a jump of a joint of three angles that a jump within
+    FILL_SECONDS brings back to where it left (a thigh turned over for a third of a second) is
+    a spike of the frames between, fixed by filling them, in place of the spikes found within
+    them; the others are jumps that stay, unless they lead into or out of a spike."""
+    paired: set[tuple[str, int]] = set()
+    longest = round(FILL_SECONDS * t.rate)
+    jumps = sorted(jumps)
+    for (joint, a, size_a, channel, _), (other, b, size_b, _, _) in itertools.pairwise(jumps):
+        if other != joint or joint not in t.triples or not 1 < b - a <= longest or (joint, a) in paired:
+            continue
+        q = t.quaternions(joint, np.array([a - 1, b]))
+        if _angle_deg(q[0], q[1]) >= 0.5 * min(size_a, size_b):
+            continue
+        off = _deviations(t, joint, True, a, b - 1)
+        if off is None:
+            continue
+        paired.update({(joint, a), (joint, b)})
+        worst = next(c for c in t.channels if c.name == channel)
+        out = [
+            f for f in out if not (f.kind == "spike" and f.joints == (joint,) and t.frame(a) <= f.first <= t.frame(b))
+        ]
+        limit = t.physical(worst, limits[worst.index])
+        out.append(_turning_spike(t, joint, channel, a, b - 1, float(off.max()), limit))
+    for joint, at, jump, channel, shown in jumps:
+        if (joint, at) in paired or not shown:
+            continue
+        severity = "high" if jump > 90 else "medium" if jump > 30 else "low"
+        out.append(
+            Finding(
+                t.name, "jump", (joint,), t.frame(at), t.frame(at), severity, round(jump, 6), "deg",
+                f"{joint} turns {jump:.3g} deg more in one frame than in the frames beside it, and stays", channel,
+            )
+        )  # fmt: skip
     return out
+
+
+def _turning_spike(
+    t: _Take, joint: str, channel: str, first: int, last: int, deviation: float, limit: float
+) -> Finding:
+    """The spike of a joint's rotation over rows first..last, ``deviation`` degrees off the path
+    between the rows around them (``limit`` the spike limit there)."""
+    # high: farther out than smooth motion could go at six times the peak acceleration (30 deg
+    # at 120 Hz; 67 deg at 30 Hz, where a fast wrist leaves its neighbours by 30), farther than the
+    # joint turns per frame just before and after (a joint that turns as fast around it shakes:
+    # a waving hand at 30 Hz), and in a turn no joint makes
+    high = (
+        deviation > max(30, 6 * limit)
+        and deviation > 2 * _pace(t, joint, first, last)
+        and _fastest(t, joint, first, last) > SPIKE_TURN_DEG_S
+    )
+    severity = "high" if high else "medium" if deviation > 10 else "low"
+    return Finding(
+        t.name, "spike", (joint,), t.frame(first), t.frame(last), severity, round(deviation, 6), "deg",
+        f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s)",
+        channel, _fill(t, first, last, [joint]),
+    )  # fmt: skip
 
 
 def _deviations(t: _Take, joint: str, turns: bool, first: int, last: int) -> np.ndarray | None:
