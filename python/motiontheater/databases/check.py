@@ -542,18 +542,18 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
 def _excursions(
     t: _Take, out: list[Finding], jumps: list[tuple[str, int, float, str, bool]], limits: np.ndarray
 ) -> list[Finding]:
-    """The findings with the jumps added: a jump of a joint of three angles that a jump within
-    FILL_SECONDS brings back to where it left (a thigh turned over for a third of a second) is
-    a spike of the frames between, fixed by filling them, in place of the spikes found within
-    them; the others are jumps that stay, unless they lead into or out of a spike."""
+    """The findings with the jumps added: a jump of a joint's rotation that a jump within
+    FILL_SECONDS brings back to where it left (a thigh turned over for a third of a second, and
+    the knee below it) is a spike of the frames between, fixed by filling them, in place of the
+    spikes found within them; the others are jumps that stay, unless they lead into or out of a
+    spike."""
     paired: set[tuple[str, int]] = set()
     longest = round(FILL_SECONDS * t.rate)
     jumps = sorted(jumps)
     for (joint, a, size_a, channel, _), (other, b, size_b, _, _) in itertools.pairwise(jumps):
-        if other != joint or joint not in t.triples or not 1 < b - a <= longest or (joint, a) in paired:
+        if other != joint or not 1 < b - a <= longest or (joint, a) in paired:
             continue
-        q = t.quaternions(joint, np.array([a - 1, b]))
-        if _angle_deg(q[0], q[1]) >= 0.5 * min(size_a, size_b):
+        if _apart(t, joint, a - 1, b) >= 0.5 * min(size_a, size_b):
             continue
         off = _deviations(t, joint, True, a, b - 1)
         if off is None:
@@ -576,6 +576,17 @@ def _excursions(
             )
         )  # fmt: skip
     return out
+
+
+def _apart(t: _Take, joint: str, first: int, last: int) -> float:
+    """How far the joint's rotation at row ``last`` lies from row ``first``'s, in degrees (of a
+    joint with fewer than three angles, its angles' largest change, unwrapped)."""
+    if joint in t.triples:
+        q = t.quaternions(joint, np.array([first, last]))
+        return float(_angle_deg(q[0], q[1]))
+    columns = np.array([c.index for c in t.channels if c.joint == joint and c.turns], dtype=np.intp)
+    block = np.unwrap(t.motion.values[first : last + 1, columns], axis=0, period=t.motion.skeleton.period)
+    return float(np.nan_to_num(np.abs(block[-1] - block[0]), nan=np.inf).max()) * t.degrees
 
 
 def _turning_spike(
