@@ -61,8 +61,11 @@ def _rate(entry) -> float:
     return amount / seconds
 
 
-def _amount(x: float) -> str:
-    """A rate in the table's millions: whole above 100, else three significant digits."""
+def _shown(entry) -> str:
+    """An entry's rate as the table shows it: in millions where its unit says so ("M values",
+    "MB"), else in its own unit (hours, queries, pages); whole above 100, else three significant
+    digits."""
+    x = _rate(entry) / (1e6 if entry[2] == "MB" or entry[2].startswith("M ") else 1.0)
     return f"{x:.0f}" if x >= 100 else f"{x:.3g}"
 
 
@@ -80,7 +83,7 @@ def pytest_terminal_summary(terminalreporter):
     for case, whos in RESULTS.items():
         if case in CEILING.values():
             entry = whos["copy"]
-            write(f"| {case} | {_time(entry[0])} | {_amount(_rate(entry) / 1e6)} {entry[2]}/s | 100% | - | ceiling |")
+            write(f"| {case} | {_time(entry[0])} | {_shown(entry)} {entry[2]}/s | 100% | - | ceiling |")
             continue
         ours = whos.get("mtcore")
         if ours is None:
@@ -89,7 +92,7 @@ def pytest_terminal_summary(terminalreporter):
         vs_copy = f"{_rate(ours) / _rate(ref):.0%}" if ref else "-"
         peers = ", ".join(f"{who} {_rate(ours) / _rate(e):.1f}x" for who, e in whos.items() if who != "mtcore")
         write(
-            f"| {case} | {_time(ours[0])} | {_amount(_rate(ours) / 1e6)} {ours[2]}/s | {vs_copy} | "
+            f"| {case} | {_time(ours[0])} | {_shown(ours)} {ours[2]}/s | {vs_copy} | "
             f"{peers or '-'} | {TARGETS.get(case, '')} |"
         )
     for note in NOTES:
