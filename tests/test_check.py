@@ -312,3 +312,22 @@ def test_a_turn_over_and_back_whose_euler_angles_wrap_is_one_spike(frames):
     assert near[0].size == pytest.approx(170, abs=2) and near[0].severity == "high"
     fixed = recipe(near).apply(take.replace(values=values))
     assert [f for f in check_motion(fixed) if joint in f.joints and 58 <= f.first <= 62 + frames] == []
+
+
+@pytest.mark.parametrize("path", TAKES, ids=lambda p: p.name)
+def test_a_take_of_nan_zeros_or_huge_values_is_checked_without_a_warning(path):
+    """What the check says of a broken take is in its findings, not in numpy's warnings."""
+    import warnings
+
+    take = mt.read_take(path)
+    rng = np.random.default_rng(0)
+    broken = {"some NaN": take.values.copy(), "all NaN": np.full_like(take.values, np.nan)}
+    broken["some NaN"][rng.random(take.values.shape) < 0.05] = np.nan
+    broken["zeros"] = np.zeros_like(take.values)
+    broken["huge"] = take.values.copy()
+    broken["huge"][: take.frames // 2] = 1e6
+    for name, values in broken.items():
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)
+            findings = check_motion(take.replace(values=values))
+        assert all(f.kind in FINDING_KINDS for f in findings), name

@@ -174,16 +174,17 @@ class _Legs:
 
     def knees(self) -> list[Finding]:
         arrays, legs = self.arrays, self.arrays.legs
-        bends = knee_bends(arrays)
         thigh = arrays.points[:, :, 0] - arrays.hips
         shin = arrays.points[:, :, 1] - arrays.points[:, :, 0]
         foot = arrays.points[:, :, 2] - arrays.points[:, :, 1]
+        with np.errstate(invalid="ignore", divide="ignore"):  # a frame of NaN, a leg of no length: no bend
+            bends = knee_bends(arrays)
+            across = np.abs(_cosine(shin, foot)) < FOOT_ACROSS
         # a knee bends the shin away from where the foot points: the turn from thigh to shin is
         # the other way round than the turn from shin to foot, at any bend and any hip; told only
         # where the foot stands across the shin (a pointed foot lies along it) and the knee is
         # not folded (where the turns' axes are of little length)
         turns = np.sum(np.cross(thigh, shin) * np.cross(shin, foot), axis=-1)
-        across = np.abs(_cosine(shin, foot)) < FOOT_ACROSS
         backwards = np.where((turns > 0) & across & (bends < 90), bends, 0.0)
         out = []
         for i, leg in enumerate(legs.legs):
