@@ -97,7 +97,8 @@ def _search(args: argparse.Namespace) -> int:
     else:
         for rank, hit in enumerate(hits, 1):
             where = f"frame {hit.first}" if hit.first == hit.last else f"frames {hit.first}-{hit.last}"
-            print(f"{rank:3d}  {hit.distance:10.4g}  {where:<17} {hit.take}")
+            # an exact match differs by rounding (1e-15): it prints as 0
+            print(f"{rank:3d}  {round(hit.distance, 6):10.4g}  {where:<17} {hit.take}")
     last = f"search: {how}, in {seconds * 1000:.0f} ms"
     if args.view:
         _view(args, query, hits)
