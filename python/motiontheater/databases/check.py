@@ -483,7 +483,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
         near_spike[c, first : last + 1] = True
     events, sizes = steps
     seen, popped = set(), set()  # (joint, row): a joint's jump or pop shows in several of its channels
-    jumps: list[tuple[str, int, float, str, bool]] = []  # (joint, row, degrees, channel, not a spike's)
+    jumps: list[tuple[str, int, float, int, bool]] = []  # (joint, row, degrees, channel, not a spike's)
     for (c, first, last, _, at), size in zip(events[stay], sizes[stay]):
         channel = t.channels[int(c)]
         if (channel.joint, channel.turns, t.frame(at)) in explained or (
@@ -526,7 +526,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
             else:
                 jump = abs(t.physical(channel, size))
             seen.add((channel.joint, at))
-            jumps.append((channel.joint, at, jump, channel.name, not quiet))
+            jumps.append((channel.joint, at, jump, int(c), not quiet))
         elif channel.joint == t.root:
             distance = abs(t.physical(channel, size))
             out.append(
@@ -540,7 +540,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
 
 
 def _excursions(
-    t: _Take, out: list[Finding], jumps: list[tuple[str, int, float, str, bool]], limits: np.ndarray
+    t: _Take, out: list[Finding], jumps: list[tuple[str, int, float, int, bool]], limits: np.ndarray
 ) -> list[Finding]:
     """The findings with the jumps added: a jump of a joint's rotation that a jump within
     FILL_SECONDS brings back to where it left (a thigh turned over for a third of a second, and
@@ -550,7 +550,7 @@ def _excursions(
     paired: set[tuple[str, int]] = set()
     longest = round(FILL_SECONDS * t.rate)
     jumps = sorted(jumps)
-    for (joint, a, size_a, channel, _), (other, b, size_b, _, _) in itertools.pairwise(jumps):
+    for (joint, a, size_a, c, _), (other, b, size_b, _, _) in itertools.pairwise(jumps):
         if other != joint or not 1 < b - a <= longest or (joint, a) in paired:
             continue
         if _apart(t, joint, a - 1, b) >= 0.5 * min(size_a, size_b):
@@ -559,20 +559,20 @@ def _excursions(
         if off is None:
             continue
         paired.update({(joint, a), (joint, b)})
-        worst = next(c for c in t.channels if c.name == channel)
         out = [
             f for f in out if not (f.kind == "spike" and f.joints == (joint,) and t.frame(a) <= f.first <= t.frame(b))
         ]
-        limit = t.physical(worst, limits[worst.index])
-        out.append(_turning_spike(t, joint, channel, a, b - 1, float(off.max()), limit))
-    for joint, at, jump, channel, shown in jumps:
+        limit = t.physical(t.channels[c], limits[c])
+        out.append(_turning_spike(t, joint, t.channels[c].name, a, b - 1, float(off.max()), limit))
+    for joint, at, jump, c, shown in jumps:
         if (joint, at) in paired or not shown:
             continue
         severity = "high" if jump > 90 else "medium" if jump > 30 else "low"
         out.append(
             Finding(
                 t.name, "jump", (joint,), t.frame(at), t.frame(at), severity, round(jump, 6), "deg",
-                f"{joint} turns {jump:.3g} deg more in one frame than in the frames beside it, and stays", channel,
+                f"{joint} turns {jump:.3g} deg more in one frame than in the frames beside it, and stays",
+                t.channels[c].name,
             )
         )  # fmt: skip
     return out
