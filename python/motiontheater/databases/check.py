@@ -795,10 +795,10 @@ def _unit(t: _Take) -> list[Finding]:
 
 
 def recipe(findings: Iterable[Finding], severities: tuple[str, ...] = ("medium", "high")) -> Pipeline:
-    """The steps that fix the findings of ``severities`` (those with a fix): rate and unit first, then
+    """The steps that fix the findings of ``severities`` (those with a fix): unit first, then
     flips, then the frames filled, then smoothing, then the feet, each confined to its frames and
     joints."""
-    order = ("retime", "scale", "unroll", "fill_gaps", "butterworth", "cleanup")
+    order = ("scale", "unroll", "fill_gaps", "butterworth", "cleanup")
     entries = [step for f in findings if f.severity in severities for step in f.fix]
     entries.sort(key=lambda e: order.index(e[0]) if e[0] in order else len(order))
     pipeline = Pipeline()
