@@ -146,14 +146,15 @@ int mt_lb_envelope(const double *x, size_t n, size_t dims, size_t radius, double
  * query's envelope there, summed.  It stops as soon as the sum passes
  * `threshold`, the partial sum being a lower bound too.
  */
-static double lb_keogh(const double *c, const double *upper, const double *lower, size_t n, size_t dims,
+static double lb_keogh(struct mt_rows c, size_t first, const double *upper, const double *lower, size_t n,
                        double threshold)
 {
+    const size_t dims = c.dims;
     double sum = 0;
     for (size_t t = 0; t < n; t++) {
-        const double *x = c + t * dims, *u = upper + t * dims, *l = lower + t * dims;
+        const double *u = upper + t * dims, *l = lower + t * dims;
         double term;
-        MT_SUM4(dims, k, x[k] > u[k] ? x[k] - u[k] : x[k] < l[k] ? l[k] - x[k] : 0.0, term);
+        MT_WITH_ROW(c, first + t, x, MT_SUM4(dims, k, x[k] > u[k] ? x[k] - u[k] : x[k] < l[k] ? l[k] - x[k] : 0.0, term));
         sum += term;
         if (sum > threshold)
             break;
@@ -172,7 +173,7 @@ int mt_lb_keogh(const double *candidate, const double *upper, const double *lowe
     if (candidate == NULL || upper == NULL || lower == NULL || !mt_all_finite(candidate, n * dims) ||
         !mt_all_finite(upper, n * dims) || !mt_all_finite(lower, n * dims))
         return MT_EINVAL;
-    *bound = lb_keogh(candidate, upper, lower, n, dims, threshold);
+    *bound = lb_keogh((struct mt_rows){MT_FLOAT64, candidate, dims}, 0, upper, lower, n, threshold);
     return MT_OK;
 }
 
@@ -191,7 +192,7 @@ int mt_lb_keogh(const double *candidate, const double *upper, const double *lowe
  * at most one a row), and above hi_{i-1} the cells are still the +inf they
  * start as (hi grows too, so no earlier row wrote them).
  */
-static double dtw(const double *a, size_t m, const double *b, size_t n, size_t dims, size_t r, double threshold,
+static double dtw(const double *a, size_t m, struct mt_rows b, size_t first, size_t n, size_t r, double threshold,
                   double *prev, double *cur)
 {
     if (m == 0 || n == 0)
@@ -200,10 +201,10 @@ static double dtw(const double *a, size_t m, const double *b, size_t n, size_t d
         return INFINITY;
     for (size_t j = 0; j < n; j++)
         prev[j] = cur[j] = INFINITY;
-    const size_t hi0 = n - 1 < r ? n - 1 : r;
-    double row_min = cur[0] = mt_squared_distance(a, b, dims);
+    const size_t dims = b.dims, hi0 = n - 1 < r ? n - 1 : r;
+    double row_min = cur[0] = mt_row_distance(a, b, first);
     for (size_t j = 1; j <= hi0; j++)
-        cur[j] = mt_squared_distance(a, b + j * dims, dims) + cur[j - 1];
+        cur[j] = mt_row_distance(a, b, first + j) + cur[j - 1];
     if (row_min > threshold)
         return INFINITY;
     for (size_t i = 1; i < m; i++) {
@@ -220,7 +221,7 @@ static double dtw(const double *a, size_t m, const double *b, size_t n, size_t d
                 best = prev[j - 1];
             if (left < best)
                 best = left;
-            left = cur[j] = mt_squared_distance(ai, b + j * dims, dims) + best;
+            left = cur[j] = mt_row_distance(ai, b, first + j) + best;
             if (left < row_min)
                 row_min = left;
         }
@@ -243,7 +244,8 @@ int mt_dtw(const double *a, size_t m, const double *b, size_t n, size_t dims, si
     double *rows = n ? malloc(2 * n * sizeof *rows) : NULL;
     if (n && rows == NULL)
         return MT_ENOMEM;
-    *distance = dtw(a, m, b, n, dims, radius < longer ? radius : longer, threshold, rows, rows + n);
+    *distance = dtw(a, m, (struct mt_rows){MT_FLOAT64, b, dims}, 0, n, radius < longer ? radius : longer, threshold,
+                    rows, rows + n);
     free(rows);
     return MT_OK;
 }
@@ -319,10 +321,13 @@ static void offer(struct best *b, size_t start, double distance)
     b->starts[i] = start;
 }
 
-int mt_dtw_search(const double *query, size_t m, const double *series, size_t n, size_t dims, size_t radius,
-                  const size_t *starts, size_t count, size_t k, double *bounds, size_t *order, size_t *hits,
-                  double *distances, size_t *found, struct mt_dtw_stats *stats)
+int mt_dtw_search(const double *query, size_t m, int dtype, const void *series, size_t n, size_t dims,
+                  size_t radius, const size_t *starts, size_t count, size_t k, double *bounds, size_t *order,
+                  size_t *hits, double *distances, size_t *found, struct mt_dtw_stats *stats)
 {
+    const struct mt_rows s = {dtype, series, dims};
+    if (mt_row_item(s) == 0)
+        return MT_EDTYPE;
     if (found == NULL || k == 0 || dims > SIZE_MAX / 8 || !mt_fits(m, 2 * dims + 2) || !mt_fits(n, dims))
         return MT_EINVAL;
     *found = 0;
@@ -336,7 +341,7 @@ int mt_dtw_search(const double *query, size_t m, const double *series, size_t n,
         if (starts[i] > n - m || (i > 0 && starts[i] <= starts[i - 1]))
             return MT_EINVAL;
     if ((m && dims && (query == NULL || !mt_all_finite(query, m * dims))) ||
-        (n && dims && (series == NULL || !mt_all_finite(series, n * dims))))
+        (n && dims && (series == NULL || !mt_rows_finite(s, n))))
         return MT_EINVAL;
 
     const size_t r = radius < m ? radius : m;
@@ -370,7 +375,7 @@ int mt_dtw_search(const double *query, size_t m, const double *series, size_t n,
     const size_t step = count > wanted ? count / wanted : 1;
     size_t sampled = 0;
     for (size_t i = 0; i < count; i += step) {
-        bounds[i] = m && dims ? lb_keogh(series + starts[i] * dims, upper, lower, m, dims, INFINITY) : 0.0;
+        bounds[i] = m && dims ? lb_keogh(s, starts[i], upper, lower, m, INFINITY) : 0.0;
         order[sampled++] = i;
     }
     for (size_t i = sampled / 2; i-- > 0;)
@@ -382,13 +387,12 @@ int mt_dtw_search(const double *query, size_t m, const double *series, size_t n,
     }
     qsort(seeds, nseeds, sizeof *seeds, by_value);
     for (size_t j = 0; j < nseeds; j++) {
-        const double *window = series + starts[seeds[j]] * dims;
-        offer(&best, starts[seeds[j]], dtw(query, m, window, m, dims, r, INFINITY, rows, rows + m));
+        offer(&best, starts[seeds[j]], dtw(query, m, s, starts[seeds[j]], m, r, INFINITY, rows, rows + m));
         counted.warped++;
     }
     const double first = kth(&best);
     for (size_t i = 0; i < count; i++) {
-        bounds[i] = m && dims ? lb_keogh(series + starts[i] * dims, upper, lower, m, dims, first) : 0.0;
+        bounds[i] = m && dims ? lb_keogh(s, starts[i], upper, lower, m, first) : 0.0;
         order[i] = i;
     }
     for (size_t i = count / 2; i-- > 0;)
@@ -402,7 +406,7 @@ int mt_dtw_search(const double *query, size_t m, const double *series, size_t n,
         if (bsearch(&i, seeds, nseeds, sizeof *seeds, by_value) != NULL)
             continue;
         const double threshold = kth(&best);
-        const double d = dtw(query, m, series + starts[i] * dims, m, dims, r, threshold, rows, rows + m);
+        const double d = dtw(query, m, s, starts[i], m, r, threshold, rows, rows + m);
         if (d == INFINITY && threshold < INFINITY) {
             counted.abandoned++;
             continue;

@@ -43,6 +43,12 @@ int mt_kdtree_depth(size_t n, size_t leaf_size, size_t *depth)
     return MT_OK;
 }
 
+/* The tree's rows, or its points, as the rows they are. */
+static struct mt_rows stored(const struct mt_kdtree *t, const void *data)
+{
+    return (struct mt_rows){t->dtype, data, t->dims};
+}
+
 /* Whether the tree's sizes and pointers are what its n, dims and leaf_size make them. */
 static int valid_tree(const struct mt_kdtree *t)
 {
@@ -62,29 +68,26 @@ static int valid_tree(const struct mt_kdtree *t)
 
 struct builder {
     const struct mt_kdtree *t;
+    struct mt_rows points;
     double *low, *high; /* dims each: the spread being measured */
     uint64_t random;    /* xorshift state of the pivots */
 };
 
 static double key(const struct builder *b, size_t row, size_t dim)
 {
-    return b->t->points[row * b->t->dims + dim];
+    return mt_row_value(b->points, row, dim);
 }
 
 /* The dimension in which index[lo .. hi-1] spread most (a sample of them), the first of equals. */
 static size_t widest(struct builder *b, size_t lo, size_t hi)
 {
     const size_t dims = b->t->dims, step = (hi - lo) / SPREAD_SAMPLE + 1;
-    const double *first = b->t->points + b->t->index[lo] * dims;
-    for (size_t k = 0; k < dims; k++)
-        b->low[k] = b->high[k] = first[k];
-    for (size_t i = lo + step; i < hi; i += step) {
-        const double *p = b->t->points + b->t->index[i] * dims;
-        for (size_t k = 0; k < dims; k++) {
+    MT_WITH_ROW(b->points, b->t->index[lo], first, for (size_t k = 0; k < dims; k++) b->low[k] = b->high[k] = first[k]);
+    for (size_t i = lo + step; i < hi; i += step)
+        MT_WITH_ROW(b->points, b->t->index[i], p, for (size_t k = 0; k < dims; k++) {
             b->low[k] = p[k] < b->low[k] ? p[k] : b->low[k];
             b->high[k] = p[k] > b->high[k] ? p[k] : b->high[k];
-        }
-    }
+        });
     size_t best = 0;
     for (size_t k = 1; k < dims; k++)
         if (b->high[k] - b->low[k] > b->high[best] - b->low[best])
@@ -158,23 +161,26 @@ static void build(struct builder *b, size_t node, size_t lo, size_t hi, size_t l
 
 int mt_kdtree_build(struct mt_kdtree *tree)
 {
+    if (tree != NULL && mt_row_item(stored(tree, NULL)) == 0)
+        return MT_EDTYPE;
     if (!valid_tree(tree))
         return MT_EINVAL;
     if (tree->n == 0)
         return MT_OK;
-    if (tree->points == NULL || !mt_all_finite(tree->points, tree->n * tree->dims) ||
-        tree->dims > SIZE_MAX / 2 / sizeof(double))
+    const struct mt_rows points = stored(tree, tree->points);
+    if (tree->points == NULL || !mt_rows_finite(points, tree->n) || tree->dims > SIZE_MAX / 2 / sizeof(double))
         return MT_EINVAL;
     for (size_t i = 0; i < tree->n; i++)
         tree->index[i] = i;
     double *spread = malloc(2 * tree->dims * sizeof *spread);
     if (spread == NULL)
         return MT_ENOMEM;
-    struct builder b = {.t = tree, .low = spread, .high = spread + tree->dims, .random = 0x9e3779b97f4a7c15u};
+    struct builder b = {.t = tree, .points = points, .low = spread, .high = spread + tree->dims, .random = 0x9e3779b97f4a7c15u};
     build(&b, 0, 0, tree->n, 0);
     free(spread);
+    const size_t row = tree->dims * mt_row_item(points);
     for (size_t i = 0; i < tree->n; i++)
-        memcpy(tree->rows + i * tree->dims, tree->points + tree->index[i] * tree->dims, tree->dims * sizeof(double));
+        memcpy((char *)tree->rows + i * row, (const char *)tree->points + tree->index[i] * row, row);
     return MT_OK;
 }
 
@@ -261,7 +267,7 @@ static void scan_leaf(struct query *s, size_t lo, size_t hi)
         }
         if (row >= s->skip_lo && row < s->skip_hi)
             continue;
-        offer(s, row, mt_squared_distance(s->q, t->rows + i * t->dims, t->dims));
+        offer(s, row, mt_row_distance(s->q, stored(t, t->rows), i));
     }
 }
 
@@ -299,6 +305,8 @@ static void visit(struct query *s, size_t node, size_t lo, size_t hi, size_t lev
 int mt_kdtree_query(const struct mt_kdtree *tree, const double *queries, size_t count, size_t k,
                     const size_t *exclude, size_t *indices, double *distances, size_t *found)
 {
+    if (tree != NULL && mt_row_item(stored(tree, NULL)) == 0)
+        return MT_EDTYPE;
     if (!valid_tree(tree) || k == 0 || !mt_fits(count, k) || !mt_fits(count, tree->dims))
         return MT_EINVAL;
     if (count == 0)

@@ -877,9 +877,11 @@ struct mt_dtw_stats {
 };
 
 /*
- * The k windows of series (n x dims) nearest to query (m x dims) by DTW within
- * radius: the candidates are the windows of m frames at starts[0 .. count-1]
- * (strictly increasing, each at most n - m).  hits and distances (k each)
+ * The k windows of series (n x dims, of element type dtype: float32 halves
+ * what a database holds, and is read as the doubles its values are) nearest
+ * to query (m x dims) by DTW within radius: the candidates are the windows
+ * of m frames at starts[0 .. count-1] (strictly increasing, each at most
+ * n - m).  hits and distances (k each)
  * receive their starts and distances, nearest first, a tie to the lower start;
  * *found = min(k, count) of them.  This is exactly what computing mt_dtw for
  * every candidate and sorting (distance, start) gives: the search only skips
@@ -895,25 +897,27 @@ struct mt_dtw_stats {
  * that order.  stats may be NULL.  k >= 1; count 0 finds nothing.  Scratch: 2
  * m dims + 2 m doubles and min(k, count) indices.
  */
-int mt_dtw_search(const double *query, size_t m, const double *series, size_t n, size_t dims, size_t radius,
-                  const size_t *starts, size_t count, size_t k, double *bounds, size_t *order, size_t *hits,
-                  double *distances, size_t *found, struct mt_dtw_stats *stats);
+int mt_dtw_search(const double *query, size_t m, int dtype, const void *series, size_t n, size_t dims,
+                  size_t radius, const size_t *starts, size_t count, size_t k, double *bounds, size_t *order,
+                  size_t *hits, double *distances, size_t *found, struct mt_dtw_stats *stats);
 
 /*
- * A k-d tree over the rows of points (n x dims, dims >= 1), in buffers the
- * caller allocates and owns.  leaf_size >= 1 rows at most in a leaf; depth
- * from mt_kdtree_depth; index (n): the rows, each node's a contiguous range;
- * rows (n x dims): row index[i] of points at row i, so that a leaf is read
- * from contiguous memory; split_dim and split_value (2^depth - 1 each, none
- * for depth 0): the internal nodes in heap order (node i's children are 2i+1
- * and 2i+2).  points is read by mt_kdtree_build only (queries read rows), and
- * may be NULL for them.
+ * A k-d tree over the rows of points (n x dims, dims >= 1, of element type
+ * dtype: float32 halves its memory, its values read as the doubles they are),
+ * in buffers the caller allocates and owns.  leaf_size >= 1 rows at most in
+ * a leaf; depth from mt_kdtree_depth; index (n): the rows, each node's a
+ * contiguous range; rows (n x dims, of dtype): row index[i] of points at row
+ * i, so that a leaf is read from contiguous memory; split_dim and split_value
+ * (2^depth - 1 each, none for depth 0): the internal nodes in heap order
+ * (node i's children are 2i+1 and 2i+2).  points is read by mt_kdtree_build
+ * only (queries read rows), and may be NULL for them.
  */
 struct mt_kdtree {
-    const double *points;
+    int dtype;
+    const void *points;
     size_t n, dims, leaf_size, depth;
     size_t *index;
-    double *rows;
+    void *rows;
     size_t *split_dim;
     double *split_value;
 };

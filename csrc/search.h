@@ -5,6 +5,8 @@
 #ifndef MT_SEARCH_H
 #define MT_SEARCH_H
 
+#include "mtcore.h"
+
 #include <stddef.h>
 #include <stdint.h>
 
@@ -54,6 +56,64 @@ static inline double mt_squared_distance(const double *a, const double *b, size_
     double s;
     MT_SUM4(dims, k, a[k] - b[k], s);
     return s;
+}
+
+/*
+ * Rows of dims values as a search stores them: float64, or float32 where half
+ * the memory matters more than the digits (a database's rows).  Every
+ * computation is in double from the stored values, so a float32 row is
+ * exactly the double it rounds to.
+ */
+struct mt_rows {
+    int dtype; /* MT_FLOAT64 or MT_FLOAT32 */
+    const void *data;
+    size_t dims;
+};
+
+/* Runs `body` with `x` the typed pointer to row i of rows (one branch per row, none per value). */
+#define MT_WITH_ROW(rows, i, x, body)                                                                                  \
+    do {                                                                                                               \
+        if ((rows).dtype == MT_FLOAT32) {                                                                              \
+            const float *x = (const float *)(rows).data + (i) * (rows).dims;                                           \
+            body;                                                                                                      \
+        } else {                                                                                                       \
+            const double *x = (const double *)(rows).data + (i) * (rows).dims;                                         \
+            body;                                                                                                      \
+        }                                                                                                              \
+    } while (0)
+
+/* The squared distance of a (dims doubles) and row i of rows. */
+static inline double mt_row_distance(const double *a, struct mt_rows rows, size_t i)
+{
+    double s;
+    MT_WITH_ROW(rows, i, x, MT_SUM4(rows.dims, k, a[k] - x[k], s));
+    return s;
+}
+
+/* Value k of row i. */
+static inline double mt_row_value(struct mt_rows rows, size_t i, size_t k)
+{
+    double v;
+    MT_WITH_ROW(rows, i, x, v = x[k]);
+    return v;
+}
+
+/* The bytes of one value of rows; 0 for a dtype that is not one of mt_dtype. */
+static inline size_t mt_row_item(struct mt_rows rows)
+{
+    return rows.dtype == MT_FLOAT32 ? sizeof(float) : rows.dtype == MT_FLOAT64 ? sizeof(double) : 0;
+}
+
+/* Whether every value of rows 0 .. n-1 is finite. */
+static inline int mt_rows_finite(struct mt_rows rows, size_t n)
+{
+    if (rows.dtype == MT_FLOAT64)
+        return mt_all_finite(rows.data, n * rows.dims);
+    unsigned char bad = 0;
+    const float *x = rows.data;
+    for (size_t i = 0; i < n * rows.dims; i++)
+        bad |= x[i] - x[i] != 0;
+    return !bad;
 }
 
 #endif /* MT_SEARCH_H */

@@ -111,7 +111,7 @@ def test_the_ranking_equals_warping_every_window(hdm05):
         radius = max(1, int(np.ceil(0.2 * m)))
         best = {}
         for e in hdm05.entries:
-            rows = hdm05.series()[e.start : e.start + e.rows]
+            rows = hdm05.poses[e.start : e.start + e.rows]
             if e.rows >= m:
                 d = min(dtw(q, rows[s : s + m], radius) for s in range(e.rows - m + 1)) / m
             else:
@@ -202,13 +202,14 @@ def test_frame_search_equals_brute_force_and_finds_the_frame_itself(hdm05):
     assert len(others) == 3 and all(h.take != str(query_path) for h in others)
 
 
-def test_a_searched_database_holds_one_copy_of_its_rows_and_saves_them_unchanged(hdm05, tmp_path):
+def test_a_searched_database_holds_one_float32_copy_of_its_rows_and_saves_them_unchanged(hdm05, tmp_path):
     hdm05.save(tmp_path / "before.npz")
     db = Database.load(tmp_path / "before.npz")
     poses, moves_ = db.poses.copy(), db.moves.copy()
     search(db, mt.read_take(HDM[3]), 2), nearest_frames(db, mt.read_take(HDM[3]), 30, 2)
     kept = [v for v in vars(db).values() if isinstance(v, np.ndarray) and v.ndim == 2]
-    assert len(kept) == 1 and kept[0].dtype == np.float64  # DTW's series; the tree keeps the moves
+    assert len(kept) == 1 and kept[0].dtype == np.float32  # DTW's series; the tree keeps the moves
+    assert db.tree.rows.dtype == np.float32
     np.testing.assert_array_equal(db.poses, poses)
     np.testing.assert_array_equal(db.moves, moves_)
     db.save(tmp_path / "after.npz")

@@ -126,10 +126,12 @@ def brute_force(query, series, k, radius, starts):
 
 @pytest.mark.parametrize("seed", SEEDS)
 @pytest.mark.parametrize("m", [1, 2, 7, 16])
-def test_search_equals_brute_force(seed, m):
+@pytest.mark.parametrize("stored", [np.float64, np.float32])
+def test_search_equals_brute_force(seed, m, stored):
+    """A float32 series is searched as the float64 of its values: the same sums, bit for bit."""
     rng = np.random.default_rng(seed)
     for n, dims in ((m, 1), (m + 1, 2), (40, 1), (131, 3)):
-        series = walk(rng, n, dims)
+        series = walk(rng, n, dims).astype(stored)
         start = int(rng.integers(0, n - m + 1))
         query = series[start : start + m] + rng.normal(0, 0.5, (m, dims))
         for k in (1, 2, 5, 1000):
@@ -137,7 +139,7 @@ def test_search_equals_brute_force(seed, m):
                 for starts in (None, np.flatnonzero(rng.random(n - m + 1) < 0.3)):
                     hits = ms.dtw_search(query, series, k, radius, starts)
                     candidates = range(n - m + 1) if starts is None else starts
-                    want_starts, want_distances = brute_force(query, series, k, radius, candidates)
+                    want_starts, want_distances = brute_force(query, series.astype(np.float64), k, radius, candidates)
                     assert hits.starts.tolist() == want_starts
                     assert hits.distances.tolist() == want_distances  # bit for bit: the same kernel's sums
                     assert hits.warped + hits.abandoned + hits.pruned == len(candidates)
@@ -258,10 +260,11 @@ def assert_neighbours(tree_points, leaf, queries, k, exclude=None, workers=1):
 
 @pytest.mark.parametrize("seed", SEEDS)
 @pytest.mark.parametrize("n", [0, 1, 2, 3, 10, 33, 64, 500])
-def test_knn_equals_brute_force(seed, n):
+@pytest.mark.parametrize("stored", [np.float64, np.float32])
+def test_knn_equals_brute_force(seed, n, stored):
     rng = np.random.default_rng(seed)
     for dims in (1, 2, 7, 30):
-        points = walk(rng, n, dims)
+        points = walk(rng, n, dims).astype(stored)
         queries = np.concatenate([points[:3], walk(rng, 5, dims), points[-2:] + 1e-3])
         for leaf in (1, 4, 32, 1000):
             for k in (1, 4, n + 3):
@@ -462,6 +465,7 @@ def test_dtypes_and_layouts_give_the_float64_results(rng):
     wide = np.zeros((200, 8))
     wide[:, ::2] = series  # every other column: a strided view
     variants = [series.astype(np.float32), series.astype(np.int32), wide[:, ::2], np.asfortranarray(series)]
+    variants.append(np.asfortranarray(variants[0]))
     want = ms.dtw_search(query, series, 3, 2)
     tree = ms.KDTree(series, 8)
     neighbours = tree.query(query, 4)
@@ -491,15 +495,17 @@ def test_c_refusals_become_value_errors():
               "mt_lb_envelope")  # fmt: skip
 
     series = np.zeros((10, 1))
-    starts = np.array([3, 2], dtype=np.uintp)
     out = np.empty(2, dtype=np.uintp)
     found = ffi.new("size_t *")
-    status = lib.mt_dtw_search(
-        c_array(series), 2, c_array(series), 10, 1, 1, c_array(starts, "size_t[]"), 2, 1, c_array(np.empty(2)),
-        c_array(out, "size_t[]"), c_array(out, "size_t[]"), c_array(np.empty(2)), found, ffi.NULL,
-    )  # fmt: skip
-    with pytest.raises(ValueError, match="mt_dtw_search"):
-        check(status, "mt_dtw_search")
+    unsorted, sorted_ = np.array([3, 2], dtype=np.uintp), np.arange(2, dtype=np.uintp)
+    for dtype, starts, error in ((lib.MT_FLOAT64, unsorted, ValueError), (7, sorted_, TypeError)):
+        status = lib.mt_dtw_search(
+            c_array(series), 2, dtype, c_array(series), 10, 1, 1, c_array(starts, "size_t[]"), 2, 1,
+            c_array(np.empty(2)), c_array(out, "size_t[]"), c_array(out, "size_t[]"), c_array(np.empty(2)), found,
+            ffi.NULL,
+        )  # fmt: skip
+        with pytest.raises(error, match="mt_dtw_search"):
+            check(status, "mt_dtw_search")
 
     words = np.zeros(3, np.uint64)
     with pytest.raises(ValueError, match="mt_pack_bits"):
@@ -522,4 +528,8 @@ def test_a_corrupt_tree_is_refused_not_followed(rng):
     tree = ms.KDTree(walk(rng, 100, 3), 4)
     tree._tree.depth = 2  # not the depth of 100 rows in leaves of 4
     with pytest.raises(ValueError, match="mt_kdtree_query"):
+        tree.query(np.zeros(3), 2)
+    tree = ms.KDTree(walk(rng, 100, 3), 4)
+    tree._tree.dtype = 7  # not an mt_dtype
+    with pytest.raises(TypeError, match="mt_kdtree_query"):
         tree.query(np.zeros(3), 2)

@@ -101,16 +101,18 @@ def output(a, name: str, shape: tuple, dtype=np.float64, *, contiguous: bool = T
     return a
 
 
-def real(a, name: str, shape: tuple) -> np.ndarray:
+def real(a, name: str, shape: tuple, keep: tuple = ()) -> np.ndarray:
     """``a`` as a C-contiguous float64 array of ``shape`` (None: any length there; a leading
-    ``...``: any leading axes; a string: any length, named so in messages).
+    ``...``: any leading axes; a string: any length, named so in messages), or of its own dtype
+    where that is one of ``keep``.
 
     TypeError for None or a dtype that is not bool, integer or float; ValueError for another shape.
     """
     array = _array(a, name)
     real_dtype(array.dtype, name)
     _shape(array, name, shape)
-    return np.asarray(array, dtype=np.float64, order="C")  # ascontiguousarray would make 0-d 1-d
+    dtype = array.dtype if array.dtype in keep else np.float64
+    return np.asarray(array, dtype=dtype, order="C")  # ascontiguousarray would make 0-d 1-d
 
 
 def integers(a, name: str, shape: tuple, low: int, high: int, dtype=np.int64) -> np.ndarray:

@@ -13,11 +13,14 @@ Three ways, each exact, each with the slow, obvious answer it must give spelled 
   segments that finds where a query's sequence of words occurs.
 
 Sequences and point sets are ``(frames, dims)`` arrays of any real dtype (a 1-D array is one
-dimension), computed in float64; inputs are never modified.  Every value searched must be
-finite: a NaN or an infinity is refused with a ValueError naming its place (a NaN orders
-nothing; fill gaps first, :func:`mtcore.signal.fill_gaps`).  Distances are *squared*
-Euclidean, and a DTW distance is the sum of the squared distances of the frames its path
-pairs: no square root is taken, so that bounds and distances compare exactly.
+dimension), computed in float64; inputs are never modified.  What a search stores (the series of
+:func:`dtw_search`, the rows of a :class:`KDTree`) stays float32 where it is given so, in half the
+memory: its values are read as the doubles they are, so that the results are exactly those of
+float64 arrays of the same values.  Every value searched must be finite: a NaN or an infinity
+is refused with a ValueError naming its place (a NaN orders nothing; fill gaps first,
+:func:`mtcore.signal.fill_gaps`).  Distances are *squared* Euclidean, and a DTW distance is
+the sum of the squared distances of the frames its path pairs: no square root is taken, so
+that bounds and distances compare exactly.
 """
 
 from __future__ import annotations
@@ -55,14 +58,24 @@ __all__ = [
 _PARALLEL_MIN_WORK = 1 << 22
 
 
-def _sequence(x: ArrayLike, name: str, dims: int | None = None) -> np.ndarray:
-    """``x`` as a C-contiguous float64 (frames, dims) array of finite values (1-D: one dimension)."""
+def _sequence(x: ArrayLike, name: str, dims: int | None = None, keep: tuple = ()) -> np.ndarray:
+    """``x`` as a C-contiguous float64 (frames, dims) array of finite values (1-D: one dimension),
+    or of its own dtype where that is one of ``keep``."""
     a = np.asarray(x) if x is not None else None
     if a is not None and a.ndim == 1:
         a = a[:, None]
-    array = _checks.real(a, name, (None, "dims" if dims is None else dims))
+    array = _checks.real(a, name, (None, "dims" if dims is None else dims), keep)
     _finite(array, name)
     return array
+
+
+# What a search stores (a series, a tree's rows) stays float32 where it is given so.
+_STORED = (np.dtype(np.float32),)
+
+
+def _dtype(stored: np.ndarray) -> int:
+    """The mt_dtype of an array :func:`_sequence` gave with ``keep=_STORED``."""
+    return lib.MT_FLOAT32 if stored.dtype == np.float32 else lib.MT_FLOAT64
 
 
 def _finite(a: np.ndarray, name: str) -> None:
@@ -172,7 +185,7 @@ def dtw_search(
     merged: the neighbours of a good window are usually good too.
     """
     q = _sequence(query, "query")
-    s = _sequence(series, "series", q.shape[1])
+    s = _sequence(series, "series", q.shape[1], _STORED)
     k = _checks.integer(k, "k", 1)
     m, n = len(q), len(s)
     r = _radius(radius, m)
@@ -194,7 +207,7 @@ def dtw_search(
     found = ffi.new("size_t *")
     stats: Any = ffi.new("struct mt_dtw_stats *")
     status = lib.mt_dtw_search(
-        c_array(q), m, c_array(s), n, q.shape[1], r, c_array(first, "size_t[]"), count, min(k, max(count, 1)),
+        c_array(q), m, _dtype(s), c_array(s, "char[]"), n, q.shape[1], r, c_array(first, "size_t[]"), count, min(k, max(count, 1)),
         c_array(bounds), c_array(order, "size_t[]"), c_array(hits, "size_t[]"), c_array(distances), found, stats,
     )  # fmt: skip
     check(status, "mt_dtw_search")
@@ -221,13 +234,13 @@ class KDTree:
 
     Leaves hold at most ``leaf_size`` rows; nodes split their rows at the median of the
     dimension they spread most in.  The tree keeps a copy of the points, in the order of its
-    leaves (``rows``; row i is row ``index[i]`` of ``points``).  Queries are exact, ties
-    included: what sorting every row's distance gives.
+    leaves (``rows``; row i is row ``index[i]`` of ``points``), float32 where the points are.
+    Queries are exact, ties included: what sorting every row's distance gives.
     """
 
     def __init__(self, points: ArrayLike, leaf_size: int = 64) -> None:
         a = np.asarray(points) if points is not None else None
-        source = _checks.real(a, "points", (None, "dims"))
+        source = _checks.real(a, "points", (None, "dims"), _STORED)
         _finite(source, "points")
         n, dims = source.shape
         if dims == 0:
@@ -243,14 +256,14 @@ class KDTree:
         # the struct points into the arrays; these cdata views keep them alive with it
         self._views = [
             c_array(self.index, "size_t[]"),
-            c_array(self.rows),
+            c_array(self.rows, "char[]"),
             c_array(self.split_dim, "size_t[]"),
             c_array(self.split_value),
         ]
         tree: Any = ffi.new("struct mt_kdtree *")
         tree.index, tree.rows, tree.split_dim, tree.split_value = self._views
-        tree.n, tree.dims, tree.leaf_size, tree.depth = n, dims, self.leaf_size, self.depth
-        tree.points = c_array(source)  # read by the build only
+        tree.n, tree.dims, tree.leaf_size, tree.depth, tree.dtype = n, dims, self.leaf_size, self.depth, _dtype(source)
+        tree.points = c_array(source, "char[]")  # read by the build only
         check(lib.mt_kdtree_build(tree), "mt_kdtree_build")
         tree.points = ffi.NULL
         self._tree = tree

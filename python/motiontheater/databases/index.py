@@ -107,13 +107,12 @@ class Database:
         self, entries: list[Entry], poses: np.ndarray, moves: np.ndarray, words: np.ndarray, frames: np.ndarray
     ):
         self.entries = entries
-        self._poses: np.ndarray | None = poses
+        self._poses = np.ascontiguousarray(poses, dtype=np.float32)
         self._moves: np.ndarray | None = moves
         self.words = words
         self.frames = frames
         self.starts = np.array([e.start for e in entries], dtype=np.intp)
         self._index: FeatureIndex | None = None
-        self._series: np.ndarray | None = None
         self._tree: KDTree | None = None
 
     @classmethod
@@ -137,15 +136,12 @@ class Database:
             self._index = FeatureIndex([self.words[e.start : e.start + e.rows] for e in self.entries])
         return self._index
 
-    # A database holds one copy of its rows: the float32 rows as read until a search needs them
-    # as float64 (DTW's series, the k-d tree's rows), then those; a 10 h database is 0.2 GB.
+    # A database holds one copy of its rows, float32 (the kernels read them as they are): the poses
+    # are DTW's series, and the moves are the k-d tree's rows once frame search has built it.
     @property
     def poses(self) -> np.ndarray:
-        """The pose rows (rows, dims) float32."""
-        if self._poses is not None:
-            return self._poses
-        assert self._series is not None
-        return self._series.astype(np.float32)
+        """The pose rows (rows, dims) float32, what DTW compares."""
+        return self._poses
 
     @property
     def moves(self) -> np.ndarray:
@@ -153,7 +149,7 @@ class Database:
         if self._moves is not None:
             return self._moves
         assert self._tree is not None
-        moves = np.empty(self._tree.rows.shape, np.float32)
+        moves = np.empty_like(self._tree.rows)
         moves[self._tree.index] = self._tree.rows
         return moves
 
@@ -164,13 +160,6 @@ class Database:
             self._tree = KDTree(self.moves)
             self._moves = None
         return self._tree
-
-    def series(self) -> np.ndarray:
-        """The pose rows as float64, what DTW compares (made on first use)."""
-        if self._series is None:
-            self._series = np.ascontiguousarray(self.poses, dtype=np.float64)
-            self._poses = None
-        return self._series
 
     def owner(self, rows: np.ndarray) -> np.ndarray:
         """The entry (its index) that each database row belongs to."""

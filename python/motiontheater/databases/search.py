@@ -96,7 +96,7 @@ def search(
     for i in searched:  # a take shorter than the query: the whole of it against the whole query
         e = database.entries[i]
         if e.rows < m:
-            rows = database.series()[database.rows_of(e)]
+            rows = database.poses[database.rows_of(e)]
             distance = dtw(q, rows, m - e.rows + radius) / m
             hits[i] = Hit(e.take, *_span(database, e, e.start, e.rows), distance)
             warped += 1
@@ -106,7 +106,7 @@ def search(
 
 def _longer(database: Database, q: np.ndarray, starts: np.ndarray, radius: int, k: int) -> tuple[dict, int]:
     """The best window of each of the k takes nearest the query among the windows at ``starts``."""
-    m, series = len(q), database.series()
+    m, series = len(q), database.poses
     hits: dict[int, Hit] = {}
     want, warped = k, 0
     while len(starts):
