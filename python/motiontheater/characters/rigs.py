@@ -79,6 +79,7 @@ class Rig:
     signature: tuple[str, ...] = ()
 
 
+@functools.lru_cache(maxsize=8192)  # the same few hundred names, over every take of a database
 def normal(name: str) -> str:
     """A joint name as the tables compare it: no namespace, case or separators
     ('mixamorig:Left_Up-Leg' -> 'leftupleg')."""
@@ -139,6 +140,10 @@ class Recognised:
 def recognise(skeleton: Skeleton) -> Recognised:
     """The rig of the tables whose names the skeleton has most of (at least three, and one of its
     signature names where it has some), with the skeleton's joint for each part it has."""
+    return skeleton.derived("rig", lambda: _recognise(skeleton))
+
+
+def _recognise(skeleton: Skeleton) -> Recognised:
     present = joints_by_name(skeleton)
     best: Recognised = Recognised(None, {})
     best_score = 2

@@ -34,7 +34,7 @@ from mtcore.rotations import euler_to_quaternions, slerp, unroll_euler
 from ..editing.pipeline import Pipeline
 from ..model.motion import Motion
 from ..model.rig import body_joint
-from ..model.skeleton import ROTATIONS, TRANSLATIONS
+from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 from ..model.units import HUMAN_HEIGHT
 from .check_arms import arm_findings
 from .check_feet import leg_findings
@@ -109,11 +109,7 @@ class _Take:
         self.meters = skeleton.meters_per_unit
         self.degrees = 1.0 if skeleton.angle_unit == "deg" else 180.0 / math.pi  # degrees per file unit
         self.root = body_joint(motion)  # the joint that carries the body (a static root above it is no body)
-        self.channels = [_Channel(i, j, d) for i, (j, d) in enumerate(motion.channels)]
-        self.triples = {}  # joint -> (order, extrinsic, columns) for joints with three rotation channels
-        for order, extrinsic, columns in skeleton.euler_groups():
-            for row in columns:
-                self.triples[motion.channels[int(row[0])][0]] = (order, extrinsic, row)
+        self.channels, self.triples = skeleton.derived("check channels", lambda: _channels(skeleton))
 
     def frame(self, row: int) -> int:
         return self.motion.first_frame + int(row)
@@ -133,6 +129,17 @@ class _Take:
         order, extrinsic, columns = self.triples[joint]
         angles = self.motion.values[np.ix_(rows, columns)]
         return euler_to_quaternions(angles, order, extrinsic=extrinsic, degrees=self.degrees == 1.0)
+
+
+def _channels(skeleton: Skeleton) -> tuple[list[_Channel], dict[str, tuple[str, bool, np.ndarray]]]:
+    """The channels, and the joints with three rotation channels: joint -> (order, extrinsic,
+    columns)."""
+    triples = {
+        skeleton.channels[int(row[0])][0]: (order, extrinsic, row)
+        for order, extrinsic, columns in skeleton.euler_groups()
+        for row in columns
+    }
+    return [_Channel(i, j, d) for i, (j, d) in enumerate(skeleton.channels)], triples
 
 
 def _angle_deg(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:

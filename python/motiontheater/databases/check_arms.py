@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtcore.kinematics import forward_kinematics
+from mtcore.kinematics import JointTree, forward_kinematics
 
 from ..characters.rigs import recognise
 from ..feet.contacts import runs
 from ..model.motion import Motion
+from ..model.skeleton import Skeleton
 from .findings import Finding
 
 ELBOW_BACK_DEG = 20.0
@@ -36,20 +37,11 @@ second moment along it) for the elbow to be a hinge the check can judge."""
 def arm_findings(motion: Motion, take: str) -> list[Finding]:
     """The elbows of the take bent backwards past ELBOW_BACK_DEG."""
     skeleton = motion.skeleton
-    parts = recognise(skeleton).parts
-    names = list(skeleton.point_names)
-    arms: list[tuple[int, int, int, int]] = []  # shoulder, upper arm's turning joint, elbow, wrist
-    for side in ("left", "right"):
-        wrist = parts.get(f"{side}_wrist") or parts.get(f"{side}_hand")
-        if f"{side}_upper_arm" in parts and f"{side}_forearm" in parts and wrist:
-            forearm = parts[f"{side}_forearm"][0]
-            turning = skeleton.parent(forearm)  # the upper arm's last joint (a roll joint's, if any)
-            if turning in names:
-                arms.append((names.index(parts[f"{side}_upper_arm"][0]), names.index(turning), names.index(forearm),
-                             names.index(wrist[0])))  # fmt: skip
-    if not arms or motion.frames < 2:
+    arms, kinematics = skeleton.derived("check arms", lambda: _arms(skeleton))
+    if not len(arms) or motion.frames < 2:
         return []
-    turns = [_turns(motion, rows, arms) for rows in _blocks(motion.frames)]
+    turns = [_turns(motion.values[rows], *kinematics) for rows in _blocks(motion.frames)]
+    names = skeleton.point_names
     out = []
     for i, (_, _, elbow, _) in enumerate(arms):
         turn = np.concatenate([t[i][0] for t in turns])
@@ -69,6 +61,31 @@ def arm_findings(motion: Motion, take: str) -> list[Finding]:
     return out
 
 
+def _arms(skeleton: Skeleton) -> tuple[np.ndarray, tuple[JointTree, np.ndarray, np.ndarray]]:
+    """The arms the rig tables find, (arms, 4) joints: shoulder, the upper arm's turning joint,
+    elbow and wrist; and what :func:`_turns` needs of them: the tree of the joints above the
+    wrists (their forward kinematics need no more), and in it, the joint turning each upper arm
+    and the joints placing each shoulder, elbow and wrist (of an ASF bone, its parent's end)."""
+    parts = recognise(skeleton).parts
+    names = list(skeleton.point_names)
+    arms = []
+    for side in ("left", "right"):
+        wrist = parts.get(f"{side}_wrist") or parts.get(f"{side}_hand")
+        if f"{side}_upper_arm" in parts and f"{side}_forearm" in parts and wrist:
+            forearm = parts[f"{side}_forearm"][0]
+            turning = skeleton.parent(forearm)  # the upper arm's last joint (a roll joint's, if any)
+            if turning in names:
+                arms.append((names.index(parts[f"{side}_upper_arm"][0]), names.index(turning), names.index(forearm),
+                             names.index(wrist[0])))  # fmt: skip
+    table = np.array(arms, dtype=np.intp).reshape(-1, 4)
+    tree = skeleton.tree
+    placing = table[:, [0, 2, 3]]
+    if skeleton.convention != "bvh":  # a bone starts at its parent's end, as positions(start=True)
+        placing = np.maximum(tree.parent[placing], 0)
+    pruned, where = tree.pruned(np.concatenate([table[:, 1], placing.ravel()]))
+    return table, (pruned, where[table[:, 1]], where[placing])
+
+
 BLOCK_FRAMES = 8192
 """Frames whose joints' world rotations are held at once (18 MB for 31 joints): a take of any
 length is checked in blocks."""
@@ -78,16 +95,16 @@ def _blocks(frames: int) -> list[slice]:
     return [slice(a, min(a + BLOCK_FRAMES, frames)) for a in range(0, frames, BLOCK_FRAMES)]
 
 
-def _turns(motion: Motion, rows: slice, arms: list[tuple[int, int, int, int]]) -> list[tuple[np.ndarray, np.ndarray]]:
-    """For each arm over the rows: the turn from upper arm to forearm (the cross product of the
-    two, in the axes of the joint that turns the upper arm), and their dot product."""
-    tree = motion.skeleton.tree
-    positions, rotations, _ = forward_kinematics(motion.values[rows], tree, world=True)  # one pass for both
+def _turns(
+    values: np.ndarray, tree: JointTree, turning: np.ndarray, placing: np.ndarray
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """For each arm over the frames of ``values``: the turn from upper arm to forearm (the cross
+    product of the two, in the axes of the joint that turns the upper arm), and their dot product
+    (``tree``, ``turning`` and ``placing`` as :func:`_arms` gives them)."""
+    positions, rotations, _ = forward_kinematics(values, tree, world=True, workers=1)  # one pass for both
     assert rotations is not None  # asked for
-    if motion.skeleton.convention != "bvh":
-        positions = positions[:, np.maximum(tree.parent, 0)]  # a bone's start, as positions(start=True)
     out = []
-    for shoulder, upper, elbow, hand in arms:
+    for upper, (shoulder, elbow, hand) in zip(turning, placing):
         arm = positions[:, elbow] - positions[:, shoulder]
         forearm = positions[:, hand] - positions[:, elbow]
         turn = np.einsum("fji,fj->fi", rotations[:, upper], np.cross(arm, forearm))

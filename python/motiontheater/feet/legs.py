@@ -226,9 +226,12 @@ def resolve_legs(skeleton: Skeleton, legs: Sequence[Leg] | Sequence[str] | None 
     channels; UnknownNameError for a joint the skeleton does not have.
     """
     if legs is None or (legs and isinstance(next(iter(legs)), str)):
-        found = find_legs(skeleton, legs)  # type: ignore[arg-type]
-    else:
-        found = tuple(legs)  # type: ignore[arg-type]
+        names = None if legs is None else tuple(legs)  # every take of a skeleton asks: worked out once
+        return skeleton.derived(("legs", names), lambda: _resolve(skeleton, find_legs(skeleton, names)))  # type: ignore[arg-type]
+    return _resolve(skeleton, tuple(legs))  # type: ignore[arg-type]
+
+
+def _resolve(skeleton: Skeleton, found: tuple[Leg, ...]) -> Legs:
     index = {n: i for i, n in enumerate(skeleton.joint_names)}
     rest = skeleton.rest_positions()
     for leg in found:
@@ -392,48 +395,16 @@ class LegArrays:
     angle_scale: float
 
 
-def _upper_tree(tree, keep: list[int]):
-    """The joint tree restricted to ``keep`` (closed under parents), reading the same columns."""
-    from mtcore.kinematics import JointTree
-
-    new = {old: i for i, old in enumerate(keep)}
-    kinds, cols, starts = [], [], [0]
-    for old in keep:
-        a, b = tree.dof_start[old], tree.dof_start[old + 1]
-        kinds.extend(tree.dof_kind[a:b])
-        cols.extend(tree.dof_column[a:b])
-        starts.append(len(kinds))
-    return JointTree(
-        parent=np.array([new[p] if p >= 0 else -1 for p in tree.parent[keep]]),
-        order=np.array([new[j] for j in tree.order if j in new]),
-        axis=tree.axis[keep],
-        direction=tree.direction[keep],
-        segment=tree.segment[keep],
-        dof_start=np.array(starts),
-        dof_kind=np.array(kinds, np.intc),
-        dof_column=np.array(cols, np.uintp),
-        angle_scale=tree.angle_scale,
-        parent_frame=tree.parent_frame[keep],
-    )
-
-
 _CHUNK = 16384  # frames of forward kinematics at a time: the joints' rotations stay in cache, not in memory
 
 
-def _upper_kinematics(values: np.ndarray, tree, legs: Legs) -> tuple[np.ndarray, np.ndarray]:
+def _upper_kinematics(values: np.ndarray, skeleton: Skeleton, legs: Legs) -> tuple[np.ndarray, np.ndarray]:
     """Hip points (legs, frames, 3) and the world rotations of the hip joints' parents (legs,
     frames, 3, 3), by forward kinematics of the joints above the legs only, in chunks of frames."""
-    keep: set[int] = set()
-    for j in (*legs.parents, *legs.points[:, 0]):
-        j = int(j)
-        while j >= 0:
-            keep.add(j)
-            j = int(tree.parent[j])
-    order = sorted(keep)
-    where = {old: i for i, old in enumerate(order)}
-    upper = _upper_tree(tree, order)
-    hip_rows = [where[int(p)] for p in legs.points[:, 0]]
-    parent_rows = [where[int(p)] for p in legs.parents]
+    joints = (*map(int, legs.parents), *map(int, legs.points[:, 0]))
+    upper, where = skeleton.derived(("pruned tree", joints), lambda: skeleton.tree.pruned(list(joints)))
+    hip_rows = where[legs.points[:, 0]]
+    parent_rows = where[legs.parents]
     frames = len(values)
     hips = np.empty((len(legs), frames, 3))
     parents = np.empty((len(legs), frames, 3, 3))
@@ -455,7 +426,7 @@ def leg_arrays(
     (:func:`choose_up`), with thresholds in metres by ``meters_per_unit`` (default the skeleton's)."""
     skeleton = motion.skeleton
     tree = skeleton.tree
-    hips, parents = _upper_kinematics(motion.values, tree, legs)
+    hips, parents = _upper_kinematics(motion.values, skeleton, legs)
     n = len(legs)
     columns = np.full((n, 4, 3), -1, np.int64)
     axes = np.full((n, 4, 3), -1, np.intc)

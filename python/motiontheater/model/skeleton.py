@@ -259,7 +259,10 @@ class Skeleton:
         the root at ``:root position`` and each bone's end point (start point
         with ``start=True``), p = p(parent) + direction * length, in file units.
         A BVH skeleton's is the pose its OFFSETs draw: position channels, which
-        replace offsets in motion, hold their joint's OFFSET here."""
+        replace offsets in motion, hold their joint's OFFSET here.  Read-only: it is worked out once."""
+        return self.derived(("rest positions", start), lambda: self._rest_positions(start))
+
+    def _rest_positions(self, start: bool) -> np.ndarray:
         tree = self.tree
         values = np.zeros((1, len(self.channels)))
         if self.convention == "bvh":
@@ -268,7 +271,9 @@ class Skeleton:
                     offset = self.root.position if self.is_root(joint) else self.bone(joint).direction
                     values[0, column] = offset[TRANSLATIONS.index(dof)]
         positions = forward_kinematics(values, tree)[0][0]
-        return positions[np.maximum(tree.parent, 0)] if start else positions
+        positions = positions[np.maximum(tree.parent, 0)] if start else positions
+        positions.flags.writeable = False
+        return positions
 
     def sizing(self) -> length_units.Sizing:
         """What the skeleton's size says about its length unit: its extents, up axis and the unit
