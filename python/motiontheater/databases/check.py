@@ -109,7 +109,7 @@ class _Take:
         self.meters = skeleton.meters_per_unit
         self.degrees = 1.0 if skeleton.angle_unit == "deg" else 180.0 / math.pi  # degrees per file unit
         self.root = body_joint(motion)  # the joint that carries the body (a static root above it is no body)
-        self.channels, self.triples = skeleton.derived("check channels", lambda: _channels(skeleton))
+        self.channels, self.triples, self._columns = skeleton.derived("check channels", lambda: _channels(skeleton))
 
     def frame(self, row: int) -> int:
         return self.motion.first_frame + int(row)
@@ -117,6 +117,10 @@ class _Take:
     def physical(self, channel: _Channel, value: float) -> float:
         """A value of the channel in degrees or metres."""
         return value * (self.degrees if channel.turns else self.meters)
+
+    def columns(self, joint: str, turns: bool) -> np.ndarray:
+        """The joint's rotation (or position) channels' columns."""
+        return self._columns.get((joint, turns), _NONE)
 
     def gaps(self, joint: str) -> bool:
         """Whether the joint's channels miss values (NaN) anywhere."""
@@ -131,15 +135,22 @@ class _Take:
         return euler_to_quaternions(angles, order, extrinsic=extrinsic, degrees=self.degrees == 1.0)
 
 
-def _channels(skeleton: Skeleton) -> tuple[list[_Channel], dict[str, tuple[str, bool, np.ndarray]]]:
-    """The channels, and the joints with three rotation channels: joint -> (order, extrinsic,
-    columns)."""
+_NONE = np.zeros(0, np.intp)
+
+
+def _channels(skeleton: Skeleton) -> tuple[list[_Channel], dict, dict[tuple[str, bool], np.ndarray]]:
+    """The channels; the joints with three rotation channels: joint -> (order, extrinsic,
+    columns); and each joint's rotation and position columns: (joint, turns) -> columns."""
+    channels = [_Channel(i, j, d) for i, (j, d) in enumerate(skeleton.channels)]
     triples = {
         skeleton.channels[int(row[0])][0]: (order, extrinsic, row)
         for order, extrinsic, columns in skeleton.euler_groups()
         for row in columns
     }
-    return [_Channel(i, j, d) for i, (j, d) in enumerate(skeleton.channels)], triples
+    grouped: dict[tuple[str, bool], list[int]] = {}
+    for c in channels:
+        grouped.setdefault((c.joint, c.turns), []).append(c.index)
+    return channels, triples, {key: np.array(columns, dtype=np.intp) for key, columns in grouped.items()}
 
 
 def _angle_deg(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
@@ -375,7 +386,7 @@ def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
             angles = values[:, columns]
             rolled = unroll_euler(angles, order, degrees=t.degrees == 1.0)
         else:
-            columns = np.array([c.index for c in t.channels if c.joint == joint and c.turns])
+            columns = t.columns(joint, True)
             angles = values[:, columns]
             rolled = np.unwrap(angles, axis=0, period=360.0 / t.degrees)
         delta = (rolled - angles) * t.degrees
@@ -591,7 +602,7 @@ def _apart(t: _Take, joint: str, first: int, last: int) -> float:
     if joint in t.triples:
         q = t.quaternions(joint, np.array([first, last]))
         return float(_angle_deg(q[0], q[1]))
-    columns = np.array([c.index for c in t.channels if c.joint == joint and c.turns], dtype=np.intp)
+    columns = t.columns(joint, True)
     block = np.unwrap(t.motion.values[first : last + 1, columns], axis=0, period=t.motion.skeleton.period)
     return float(np.nan_to_num(np.abs(block[-1] - block[0]), nan=np.inf).max()) * t.degrees
 
@@ -633,8 +644,7 @@ def _deviations(t: _Take, joint: str, turns: bool, first: int, last: int) -> np.
             return None
         between = slerp(np.broadcast_to(q[0], (len(share), 4)), np.broadcast_to(q[-1], (len(share), 4)), share)
         return _angle_deg(q[1:-1], between)
-    columns = [c.index for c in t.channels if c.joint == joint and c.turns == turns]
-    block = t.motion.values[np.ix_(around, np.array(columns, dtype=np.intp))]
+    block = t.motion.values[around[0] : around[-1] + 1, t.columns(joint, turns)]
     if np.isnan(block).any():
         return None
     if turns:
