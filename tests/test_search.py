@@ -202,6 +202,22 @@ def test_frame_search_equals_brute_force_and_finds_the_frame_itself(hdm05):
     assert len(others) == 3 and all(h.take != str(query_path) for h in others)
 
 
+@pytest.mark.parametrize("rate", [120.0, 30.0, 25.0, 7.0])
+def test_the_frame_searched_for_is_the_query_not_the_nearest_database_row(rate):
+    """The database keeps 10 rows a second; a frame between them is still what is looked for."""
+    if not HDM:
+        pytest.skip("the real-file corpus (../shared/data/hdm05) is absent")
+    take = mt.read_take(HDM[5]).replace(frame_rate=rate)  # the same frames, other ticks between them
+    grid = body(take)
+    for frame in (take.first_frame, take.first_frame + 5, take.first_frame + take.frames // 3, take.last_frame):
+        at = body(take, frame=frame)
+        assert frame in at.frames and np.all(np.diff(at.frames) >= 1)
+        assert abs(len(at.frames) - len(grid.frames)) <= 1  # the same 10 Hz, shifted
+        alone = body(take.crop(frame, frame))  # that one frame's features, from nothing else
+        row = int(np.flatnonzero(at.frames == frame)[0])
+        np.testing.assert_allclose(at.points[row], alone.points[0], rtol=0, atol=1e-12)
+
+
 def test_a_searched_database_holds_one_float32_copy_of_its_rows_and_saves_them_unchanged(hdm05, tmp_path):
     hdm05.save(tmp_path / "before.npz")
     db = Database.load(tmp_path / "before.npz")

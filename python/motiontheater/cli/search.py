@@ -69,6 +69,7 @@ def _search_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _search(args: argparse.Namespace) -> int:
+    from ..databases.features import FEATURE_RATE
     from ..databases.index import Database
     from ..databases.search import nearest_frames, search
 
@@ -81,7 +82,10 @@ def _search(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     if args.frame is not None:
         hits = nearest_frames(db, query, args.frame, args.k)
-        how = f"frame search: the {len(hits)} nearest of {len(db.frames)} frames"
+        how = (
+            f"frame search: the {len(hits)} nearest of {len(db.frames)} frames "
+            f"(the database holds {FEATURE_RATE:g} a second of each take)"
+        )
     else:
         found = search(db, query, args.k)
         hits = found.hits

@@ -83,12 +83,16 @@ class Body:
         return self.points[:, _AT[name]]
 
 
-def body(motion: Motion, rate: float = FEATURE_RATE) -> Body:
-    """The take's body at ``rate`` Hz (frames nearest each tick; the take's own rate if lower).
+def body(motion: Motion, rate: float = FEATURE_RATE, *, frame: int | None = None) -> Body:
+    """The take's body at ``rate`` Hz (frames nearest each tick; the take's own rate if lower),
+    the ticks from the first frame, or placed so that one falls on ``frame`` (a frame number).
     ValueError where the skeleton has no hips, legs, arms and head that the rig tables know."""
     joints = _joints(motion)
     step = max(motion.frame_rate / rate, 1.0)
-    rows = np.unique(np.round(np.arange(0, motion.frames, step)).astype(int).clip(0, max(motion.frames - 1, 0)))
+    anchor = 0 if frame is None else frame - motion.first_frame
+    start = anchor - step * np.floor(anchor / step)
+    ticks = np.arange(start, motion.frames, step)
+    rows = np.unique(np.round(ticks).astype(int).clip(0, max(motion.frames - 1, 0)))
     sampled = motion.replace(values=motion.values[rows]) if motion.frames else motion
     start = motion.skeleton.convention != "bvh"  # an ASF bone turns at its start, a BVH joint at itself
     world = sampled.positions(start=start, meters=True)[:, joints]

@@ -171,8 +171,8 @@ def nearest_frames(
         raise ValueError(f"k must be a whole number >= 1, got {k!r}")
     if not query.first_frame <= frame <= query.last_frame:
         raise ValueError(f"frame {frame} is not one of the query's frames {query.first_frame}..{query.last_frame}")
-    b = body(query)
-    row = int(np.argmin(np.abs(b.frames - frame)))
+    b = body(query, frame=frame)
+    row = int(np.flatnonzero(b.frames == frame)[0])
     q = moves(b)[row].astype(np.float64)
     tree = database.tree
     want = k
