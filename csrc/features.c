@@ -3,14 +3,17 @@
  * Clausen, "Efficient content-based retrieval of motion capture data",
  * SIGGRAPH 2005): thresholds with hysteresis, bits packed into one word per
  * frame, runs of equal words as segments, and an inverted index from words to
- * the segments that hold them (mt_hysteresis, mt_pack_bits, mt_segments,
- * mt_feature_index_build, mt_feature_index_find; see mtcore.h).
+ * the segments that hold them (mt_relations, mt_hysteresis, mt_pack_bits,
+ * mt_segments, mt_feature_index_build, mt_feature_index_find; see mtcore.h).
  */
 #include "mtcore.h"
 #include "search.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+
+static const double DEGREES = 57.295779513082320876798154814105; /* 180 / pi, as numpy's degrees takes it */
 
 int mt_hysteresis(const double *values, size_t n, size_t features, const double *low, const double *high,
                   const unsigned char *initial, unsigned char *on)
@@ -36,6 +39,126 @@ int mt_hysteresis(const double *values, size_t n, size_t features, const double 
         unsigned char *now = on + t * features;
         for (size_t f = 0; f < features; f++)
             now[f] = v[f] > high[f] ? 1 : v[f] < low[f] ? 0 : before[f];
+    }
+    return MT_OK;
+}
+
+/* NaN where either is (numpy's minimum and maximum propagate it; fmin and fmax drop it). */
+static double lower(double x, double y)
+{
+    return isnan(x) || x < y ? x : y;
+}
+
+static double higher(double x, double y)
+{
+    return isnan(x) || x > y ? x : y;
+}
+
+/* |v| as numpy's norm sums it: in axis order. */
+static double length3(const double *v)
+{
+    return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+
+static int point_ok(int i, size_t npoints)
+{
+    return i >= 0 && (size_t)i < npoints;
+}
+
+static int relation_ok(const struct mt_relation *r, size_t npoints, size_t nscalars)
+{
+    if (!(r->off <= r->on) || !isfinite(r->sign))
+        return 0;
+    switch (r->kind) {
+    case MT_RELATION_DIFFERENCE:
+        return point_ok(r->a, npoints) && r->axis >= 0 && r->axis <= 2 &&
+               (r->b < 0 ? r->c < 0 : point_ok(r->b, npoints) && (r->c < 0 || point_ok(r->c, npoints)));
+    case MT_RELATION_BEND:
+        return point_ok(r->a, npoints) && point_ok(r->b, npoints) && point_ok(r->c, npoints);
+    case MT_RELATION_SPEED:
+    case MT_RELATION_LEAN:
+        return point_ok(r->a, npoints);
+    case MT_RELATION_SCALAR:
+        return r->a >= 0 && (size_t)r->a < nscalars;
+    default:
+        return 0;
+    }
+}
+
+/* The value of relation r in frame t of the body (points: frames of npoints x 3). */
+static double relation_value(const struct mt_relation *r, const double *points, size_t n, size_t npoints,
+                             const double *scalars, size_t nscalars, double rate, size_t t)
+{
+    const size_t frame = 3 * npoints;
+    const double *p = points + t * frame;
+    double v;
+    switch (r->kind) {
+    case MT_RELATION_DIFFERENCE: {
+        double base = 0.0;
+        if (r->b >= 0) {
+            base = p[3 * r->b + r->axis];
+            if (r->c >= 0)
+                base = lower(base, p[3 * r->c + r->axis]);
+        }
+        v = p[3 * r->a + r->axis] - base;
+        break;
+    }
+    case MT_RELATION_BEND: {
+        const double *a = p + 3 * r->a, *b = p + 3 * r->b, *c = p + 3 * r->c;
+        const double u[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]}, w[3] = {c[0] - b[0], c[1] - b[1], c[2] - b[2]};
+        const double cosine = (u[0] * w[0] + u[1] * w[1] + u[2] * w[2]) / higher(length3(u) * length3(w), 1e-12);
+        v = 180.0 - acos(lower(higher(cosine, -1.0), 1.0)) * DEGREES;
+        break;
+    }
+    case MT_RELATION_SPEED: {
+        if (n < 2) {
+            v = 0.0;
+            break;
+        }
+        const size_t after = t + 1 < n ? t + 1 : t, before = t > 0 ? t - 1 : t;
+        const double *x = points + after * frame + 3 * r->a, *y = points + before * frame + 3 * r->a;
+        const double span = (double)(after - before);
+        const double d[3] = {(x[0] - y[0]) / span, (x[1] - y[1]) / span, (x[2] - y[2]) / span};
+        v = length3(d) * rate;
+        break;
+    }
+    case MT_RELATION_LEAN: {
+        const double *a = p + 3 * r->a;
+        v = atan2(sqrt(a[0] * a[0] + a[2] * a[2]), a[1]) * DEGREES;
+        break;
+    }
+    default: /* MT_RELATION_SCALAR, as relation_ok allows */
+        v = scalars[t * nscalars + (size_t)r->a];
+    }
+    return r->sign * (r->absolute ? fabs(v) : v);
+}
+
+int mt_relations(const double *points, size_t n, size_t npoints, const double *scalars, size_t nscalars, double rate,
+                 const struct mt_relation *relations, size_t count, double *values, uint64_t *words)
+{
+    if (count > 64 || npoints > SIZE_MAX / 3 || !mt_fits(n, 3 * npoints) || !mt_fits(n, nscalars) ||
+        !mt_fits(n, count) || !(rate > 0.0) || !isfinite(rate) || (count > 0 && relations == NULL))
+        return MT_EINVAL;
+    for (size_t r = 0; r < count; r++)
+        if (!relation_ok(&relations[r], npoints, nscalars))
+            return MT_EINVAL;
+    if (n == 0)
+        return MT_OK;
+    if (words == NULL || (npoints > 0 && points == NULL) || (nscalars > 0 && scalars == NULL))
+        return MT_EINVAL;
+    uint64_t state = 0;
+    for (size_t t = 0; t < n; t++) {
+        for (size_t r = 0; r < count; r++) {
+            const struct mt_relation *rel = &relations[r];
+            const double v = relation_value(rel, points, n, npoints, scalars, nscalars, rate, t);
+            if (v > rel->on)
+                state |= (uint64_t)1 << r;
+            else if (v < rel->off)
+                state &= ~((uint64_t)1 << r);
+            if (values != NULL)
+                values[t * count + r] = v;
+        }
+        words[t] = state;
     }
     return MT_OK;
 }

@@ -960,6 +960,37 @@ int mt_hysteresis(const double *values, size_t n, size_t features, const double 
 int mt_pack_bits(const unsigned char *bits, size_t n, size_t features, uint64_t *words);
 
 /*
+ * The relations of a body, frame by frame, in one pass: points (n x npoints x
+ * 3, row-major: frame, point, axis) and scalars (n x nscalars) of the body at
+ * `rate` frames a second (finite, > 0); relation r (count <= 64) reads them as
+ * its kind says, its value multiplied by sign (after |.| where absolute), and
+ * turns on above `on`, off below `off` (off <= on), else (NaN too) keeps its
+ * state of the frame before (off before the first), as mt_hysteresis; bit r
+ * of words[t] (n) is its state in frame t.  values (n x count) receives the
+ * values, or is NULL.  An index out of range, an axis not 0..2, an unknown
+ * kind or a NaN threshold is MT_EINVAL.
+ */
+enum mt_relation_kind {
+    MT_RELATION_DIFFERENCE = 0, /* p[a][axis] minus the lower of p[b][axis] and p[c][axis]
+                                   (c < 0: p[b][axis]; b < 0, with c < 0: 0) */
+    MT_RELATION_BEND = 1,       /* 180 minus the angle at p[b] between p[a] and p[c], degrees */
+    MT_RELATION_SPEED = 2,      /* |dp[a]/dt| (central differences, one-sided at the ends; 0 in a
+                                   body of one frame) */
+    MT_RELATION_LEAN = 3,       /* the angle of p[a] from the y axis, degrees */
+    MT_RELATION_SCALAR = 4      /* scalars[a] */
+};
+struct mt_relation {
+    int kind;
+    int a, b, c;
+    int axis;
+    int absolute;
+    double sign, off, on;
+};
+
+int mt_relations(const double *points, size_t n, size_t npoints, const double *scalars, size_t nscalars, double rate,
+                 const struct mt_relation *relations, size_t count, double *values, uint64_t *words);
+
+/*
  * The runs of equal words (n) as segments: the first `capacity` of them into
  * first (their first frames) and values (their words); *count receives how
  * many there are (at most n; first and values may be NULL for capacity 0).

@@ -12,13 +12,15 @@ import pytest
 import motiontheater as mt
 from corpus import real_files
 from motiontheater.cli import main
-from motiontheater.databases.features import body, moves, pose_features
+from motiontheater.databases.features import RELATIONS, body, describe, moves, pose_features, words
 from motiontheater.databases.index import Database, build
 from motiontheater.databases.search import nearest_frames, search
-from mtcore.search import dtw
+from mtcore.search import dtw, pack_bits
+from twins.search import body_relations
 from variants import with_offset_channels, with_static_root
 
 HDM = real_files("hdm05/*.amc")
+TAKES = [p for p in real_files("*/*.amc") + real_files("*/*.bvh") if p.name != "rest.bvh"]
 VARIANTS = {
     "game rig": lambda take: with_static_root(with_offset_channels(take), shift=(250.0, 0.0, -400.0)),
     "z-up": lambda take: with_static_root(take, turn=(90.0, 0.0, 0.0), keep_world=False),
@@ -81,6 +83,22 @@ def test_features_do_not_depend_on_the_rig_unit_or_up_axis(variant, tmp_path):
     mt.write_bvh(VARIANTS[variant](take), path)
     other = mt.read_take(path)
     np.testing.assert_allclose(pose_features(body(other)), pose_features(body(take)), atol=1e-4)
+
+
+@pytest.mark.parametrize("path", TAKES, ids=[f"{p.parent.name}/{p.name}" for p in TAKES])
+def test_the_relations_table_states_muellers_facts_on_every_real_take(path):
+    """The C kernel's table of relations gives, bit for bit, the facts written out one by one."""
+    take = mt.read_take(path)
+    try:
+        b = body(take)
+    except ValueError as e:
+        assert "rig tables" in str(e) or "no length" in str(e)  # a body the rig tables cannot find
+        pytest.skip(f"{path.name}: {e}")
+    got, facts = words(b), body_relations(b)
+    np.testing.assert_array_equal(got, pack_bits(facts))
+    assert len(RELATIONS) == facts.shape[1] and describe(int(got[0])) == [
+        name for name, on in zip(RELATIONS, facts[0]) if on
+    ]
 
 
 def test_a_cmu_query_finds_itself_in_every_rig(tmp_path):

@@ -2,6 +2,7 @@
 and brute force: the searches must find exactly what computing every distance and sorting finds."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -455,6 +456,37 @@ def test_feature_bad_input():
         ms.FeatureIndex([np.ones(3)])
 
 
+@pytest.mark.parametrize(
+    ("relation", "message"),
+    [
+        (ms.Relation("height", 0), "kind must be one of difference, bend, speed, lean, scalar, got 'height'"),
+        (ms.Relation("difference", 0, 1, off=1.0, on=0.0), "off must be at most on, got off 1.0 and on 0.0"),
+        (ms.Relation("difference", 0, 1, off=math.nan, on=0.0), "off must be at most on"),
+        (ms.Relation("difference", 0, 3), "b must be the index of one of the 3 points, got 3"),
+        (ms.Relation("difference", 0, -1, 2), "c needs b"),
+        (ms.Relation("difference", 0, 1, axis=3), "axis must be 0, 1 or 2, got 3"),
+        (ms.Relation("bend", 0, 1), "c must be the index of one of the 3 points, got -1"),
+        (ms.Relation("speed", -2), "a must be the index of one of the 3 points, got -2"),
+        (ms.Relation("scalar", 1), "a must be the index of one of the 1 scalars, got 1"),
+        (ms.Relation("lean", 0, sign=math.inf), "sign must be finite"),
+    ],
+)
+def test_a_relation_that_cannot_be_measured_is_named(relation, message):
+    with pytest.raises(ValueError, match=re.escape(f"relation 1 ({relation.kind}): {message}")):
+        ms.relations(np.zeros((4, 3, 3)), np.zeros((4, 1)), 10.0, [ms.Relation("lean", 0), relation])
+
+
+def test_relations_refuse_bad_bodies_and_rates():
+    with pytest.raises(ValueError, match="rate must be a finite number"):
+        ms.relations(np.zeros((4, 3, 3)), np.zeros((4, 1)), 0.0, [])
+    with pytest.raises(ValueError, match="at most 64 relations"):
+        ms.relations(np.zeros((4, 3, 3)), np.zeros((4, 1)), 10.0, [ms.Relation("lean", 0)] * 65)
+    with pytest.raises(ValueError, match="points"):
+        ms.relations(np.zeros((4, 3, 2)), np.zeros((4, 1)), 10.0, [])
+    with pytest.raises(ValueError, match="scalars"):
+        ms.relations(np.zeros((4, 3, 3)), np.zeros((5, 1)), 10.0, [])
+
+
 # ---------------------------------------------------------------------------
 # layouts: any real dtype and memory layout, computed in float64
 
@@ -511,6 +543,10 @@ def test_c_refusals_become_value_errors():
     with pytest.raises(ValueError, match="mt_pack_bits"):
         check(lib.mt_pack_bits(c_array(np.zeros(3 * 65, np.uint8), "unsigned char[]"), 3, 65,
                                c_array(words, "uint64_t[]")), "mt_pack_bits")  # fmt: skip
+    table = ffi.new("struct mt_relation[]", [{"kind": lib.MT_RELATION_BEND, "a": 0, "b": 1, "c": 5}])
+    with pytest.raises(ValueError, match="mt_relations"):  # c past the 3 points
+        check(lib.mt_relations(c_array(np.zeros(9)), 1, 3, ffi.NULL, 0, 10.0, table, 1, ffi.NULL,
+                               c_array(words, "uint64_t[]")), "mt_relations")  # fmt: skip
     depth = ffi.new("size_t *")
     with pytest.raises(ValueError, match="mt_kdtree_depth"):
         check(lib.mt_kdtree_depth(10, 0, depth), "mt_kdtree_depth")

@@ -7,7 +7,8 @@ Three ways, each exact, each with the slow, obvious answer it must give spelled 
   series nearest a query, which warps only the windows whose bound can still win;
 - :class:`KDTree`: the k nearest rows of a matrix (frames of poses, feature vectors)
   to each query row, with rows excluded per query (a frame and its neighbours);
-- relational features (Müller, Röder and Clausen, SIGGRAPH 2005): thresholds with
+- relational features (Müller, Röder and Clausen, SIGGRAPH 2005): a body's
+  :func:`relations` (each a :class:`Relation` of its points, in one pass), thresholds with
   :func:`hysteresis`, bits packed into one word per frame (:func:`pack_bits`), runs of equal
   words (:func:`segments`) and :class:`FeatureIndex`, an inverted index of many takes'
   segments that finds where a query's sequence of words occurs.
@@ -44,6 +45,8 @@ __all__ = [
     "FeatureIndex",
     "KDTree",
     "Neighbours",
+    "Relation",
+    "Relations",
     "Segments",
     "dtw",
     "dtw_search",
@@ -51,6 +54,7 @@ __all__ = [
     "lb_envelope",
     "lb_keogh",
     "pack_bits",
+    "relations",
     "segments",
 ]
 
@@ -325,6 +329,88 @@ class KDTree:
 
 # ---------------------------------------------------------------------------
 # relational features
+
+
+RELATION_KINDS = ("difference", "bend", "speed", "lean", "scalar")
+"""What a :class:`Relation` measures, by its points a, b, c (indices into the body's points; -1
+none) and, for "scalar", a the index of a scalar: "difference", point a's coordinate ``axis``
+minus the lower of b's and c's (b's alone where c is -1; 0 where b is too); "bend", 180 minus
+the angle at b between a and c, in degrees; "speed", how fast a moves (central differences,
+one-sided at the ends), per second; "lean", the angle of a from the y axis, in degrees;
+"scalar", the body's scalar a."""
+
+
+class Relation(NamedTuple):
+    """One relational feature: its value, what ``kind`` measures times ``sign`` (of its magnitude
+    where ``absolute``), turns it on above ``on`` and off below ``off``."""
+
+    kind: str
+    a: int
+    b: int = -1
+    c: int = -1
+    axis: int = 0
+    sign: float = 1.0
+    absolute: bool = False
+    off: float = 0.0
+    on: float = 0.0
+
+
+class Relations(NamedTuple):
+    """A body's relations: ``words`` (frames,) uint64, bit r the state of relation r; ``values``
+    (frames, relations) what each measured."""
+
+    words: np.ndarray
+    values: np.ndarray
+
+
+def relations(points: ArrayLike, scalars: ArrayLike, rate: float, table: Sequence[Relation]) -> Relations:
+    """The relations of ``table`` (at most 64) over a body's ``points`` (frames, points, 3) and
+    ``scalars`` (frames, scalars) at ``rate`` frames a second, each with hysteresis as
+    :func:`hysteresis` gives it from off, packed as :func:`pack_bits` packs them: one pass over
+    the frames in C."""
+    p = _checks.real(points, "points", (None, "points", 3))
+    v = _checks.real(scalars, "scalars", (len(p), "scalars"))
+    if not (isinstance(rate, (int, float)) and math.isfinite(rate) and rate > 0):
+        raise ValueError(f"rate must be a finite number of frames a second above 0, got {rate!r}")
+    if len(table) > 64:
+        raise ValueError(f"at most 64 relations fit one uint64 word a frame, got {len(table)}")
+    c_table: Any = ffi.new("struct mt_relation[]", max(len(table), 1))
+    for i, r in enumerate(table):
+        problem = _relation_problem(r, p.shape[1], v.shape[1])
+        if problem:
+            raise ValueError(f"relation {i} ({r.kind}): {problem}")
+        c = c_table[i]
+        c.kind, c.a, c.b, c.c, c.axis = RELATION_KINDS.index(r.kind), r.a, r.b, r.c, r.axis
+        c.absolute, c.sign, c.off, c.on = bool(r.absolute), r.sign, r.off, r.on
+    words = np.empty(len(p), dtype=np.uint64)
+    values = np.empty((len(p), len(table)))
+    status = lib.mt_relations(
+        c_array(p), len(p), p.shape[1], c_array(v), v.shape[1], float(rate), c_table, len(table), c_array(values),
+        c_array(words, "uint64_t[]"),
+    )  # fmt: skip
+    check(status, "mt_relations")
+    return Relations(words, values)
+
+
+def _relation_problem(r: Relation, points: int, scalars: int) -> str:
+    """What makes ``r`` unmeasurable on a body of so many points and scalars, or ""."""
+    if r.kind not in RELATION_KINDS:
+        return f"kind must be one of {', '.join(RELATION_KINDS)}, got {r.kind!r}"
+    if not r.off <= r.on:
+        return f"off must be at most on, got off {r.off} and on {r.on}"
+    if not math.isfinite(r.sign):
+        return f"sign must be finite, got {r.sign}"
+    if r.kind == "scalar":
+        return "" if 0 <= r.a < scalars else f"a must be the index of one of the {scalars} scalars, got {r.a}"
+    if r.kind == "difference" and r.b < 0 <= r.c:
+        return "c needs b: the lower of b and c, or b alone"
+    used = {"difference": "abc"[: 1 + (r.b >= 0) + (r.c >= 0)], "bend": "abc"}.get(r.kind, "a")
+    for name in used:
+        if not 0 <= getattr(r, name) < points:
+            return f"{name} must be the index of one of the {points} points, got {getattr(r, name)}"
+    if r.kind == "difference" and r.axis not in (0, 1, 2):
+        return f"axis must be 0, 1 or 2, got {r.axis}"
+    return ""
 
 
 def hysteresis(values: ArrayLike, low: ArrayLike, high: ArrayLike, initial: ArrayLike = False) -> np.ndarray:

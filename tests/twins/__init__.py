@@ -1017,6 +1017,13 @@ TWINS: dict[str, Twin] = {
         search_twins.knn_cases,
         lambda got, want: (exact(got[0], want[0]), close(1e-12)(got[1], want[1])),
     ),
+    # the words exactly; the values to rounding (acos, atan2 and sqrt of the C library and Python's)
+    "mt_relations": Twin(
+        lambda *case: tuple(mt_search.relations(*case)),
+        search_twins.relations,
+        search_twins.relation_cases,
+        lambda got, want: (exact(got[0], want[0]), close(1e-12)(got[1], want[1])),
+    ),
     "mt_hysteresis": Twin(mt_search.hysteresis, search_twins.hysteresis, search_twins.hysteresis_cases, exact),
     "mt_pack_bits": Twin(mt_search.pack_bits, search_twins.pack_bits, search_twins.pack_cases, exact),
     "mt_segments": Twin(

@@ -117,6 +117,118 @@ def hysteresis(values, low, high, initial=False):
     return out[:, 0] if one else out
 
 
+def relations(points, scalars, rate, table):
+    """Each relation measured frame by frame from its definition, then its hysteresis and the words."""
+    p, sc = np.asarray(points, float), np.asarray(scalars, float)
+    n = len(p)
+    values = np.zeros((n, len(table)))
+    for t in range(n):
+        for i, r in enumerate(table):
+            values[t, i] = _measure(r, p, sc, rate, t)
+    on = hysteresis(values, [r.off for r in table], [r.on for r in table]) if table else np.zeros((n, 0), bool)
+    return pack_bits(on), values
+
+
+def _measure(r, p, scalars, rate, t):
+    def point(i, frame=t):
+        return p[frame, i]
+
+    if r.kind == "difference":
+        base = 0.0 if r.b < 0 else point(r.b)[r.axis] if r.c < 0 else np.minimum(point(r.b)[r.axis], point(r.c)[r.axis])
+        v = point(r.a)[r.axis] - base
+    elif r.kind == "bend":
+        u, w = point(r.a) - point(r.b), point(r.c) - point(r.b)
+        cos = np.dot(u, w) / np.maximum(math.sqrt(np.dot(u, u)) * math.sqrt(np.dot(w, w)), 1e-12)
+        v = 180.0 - math.degrees(math.acos(np.clip(cos, -1.0, 1.0))) if not math.isnan(cos) else math.nan
+    elif r.kind == "speed":
+        if len(p) < 2:
+            v = 0.0
+        else:
+            after, before = min(t + 1, len(p) - 1), max(t - 1, 0)
+            v = math.sqrt(np.sum(((point(r.a, after) - point(r.a, before)) / (after - before)) ** 2)) * rate
+    elif r.kind == "lean":
+        x, y, z = point(r.a)
+        v = math.degrees(math.atan2(math.hypot(x, z), y))
+    else:
+        v = scalars[t, r.a]
+    return r.sign * (abs(v) if r.absolute else v)
+
+
+def relation_cases(rng):
+    from mtcore.search import Relation
+
+    out = []
+    for frames in (0, 1, 2, 3, 40):
+        points = rng.normal(size=(frames, 6, 3)).cumsum(axis=0) * 0.3
+        scalars = rng.normal(size=(frames, 2))
+        if frames > 2:
+            points[1, 4] = math.nan  # a gap holds every relation of the point as it was
+            scalars[2, 1] = math.nan
+        table = []
+        for _ in range(12):
+            kind = str(rng.choice(["difference", "bend", "speed", "lean", "scalar"]))
+            a, b, c = (int(i) for i in rng.choice(6, 3, replace=False))
+            if kind == "difference":
+                b, c = (b, c) if rng.random() < 0.4 else (b, -1) if rng.random() < 0.5 else (-1, -1)
+            elif kind == "scalar":
+                a = int(rng.integers(2))
+            off = float(rng.normal()) * (30.0 if kind in ("bend", "lean") else 0.5) + (60.0 if kind == "bend" else 0.0)
+            table.append(
+                Relation(kind, a, b, c, int(rng.integers(3)), float(rng.choice([1.0, -1.0])), bool(rng.random() < 0.3),
+                         off, off + float(rng.choice([0.0, 0.2, 5.0])))
+            )  # fmt: skip
+        out.append((points, scalars, float(rng.choice([10.0, 120.0])), table))
+    return out + [(np.zeros((3, 1, 3)), np.zeros((3, 0)), 30.0, [])]
+
+
+def body_relations(b):
+    """Müller's facts of a Body (motiontheater.databases.features) written out with numpy, one by
+    one as RELATIONS names them: what the table must mean, as booleans (frames, 25)."""
+    at = b.at
+    values, low, high = [], [], []
+
+    def fact(value, off, on):
+        values.append(value)
+        low.append(off)
+        high.append(on)
+
+    def angle(a, b_, c):
+        u, v = a - b_, c - b_
+        cos = np.sum(u * v, -1) / np.maximum(np.linalg.norm(u, axis=-1) * np.linalg.norm(v, axis=-1), 1e-12)
+        return np.degrees(np.arccos(np.clip(cos, -1, 1)))
+
+    def speed(name):
+        p = at(name)
+        return np.linalg.norm(np.gradient(p, axis=0), axis=1) * b.rate if len(p) > 1 else np.zeros(len(p))
+
+    fact(at("right_ankle")[:, 2] - at("left_ankle")[:, 2], 0.1, 0.2)
+    fact(at("left_ankle")[:, 2] - at("right_ankle")[:, 2], 0.1, 0.2)
+    fact(at("right_ankle")[:, 1] - at("left_ankle")[:, 1], 0.1, 0.2)
+    fact(at("left_ankle")[:, 1] - at("right_ankle")[:, 1], 0.1, 0.2)
+    for side in ("right", "left"):
+        fact(180 - angle(at(f"{side}_hip"), at(f"{side}_knee"), at(f"{side}_ankle")), 40.0, 60.0)
+    for side in ("right", "left"):
+        fact(at(f"{side}_wrist")[:, 1] - at("head")[:, 1], -0.05, 0.05)
+    for side in ("right", "left"):
+        fact(at(f"{side}_wrist")[:, 2], 0.3, 0.45)
+    for side, sign in (("right", -1.0), ("left", 1.0)):
+        fact(sign * (at(f"{side}_wrist")[:, 0] - at(f"{side}_shoulder")[:, 0]), 0.35, 0.5)
+    for side in ("right", "left"):
+        knees = np.minimum(at("right_knee")[:, 1], at("left_knee")[:, 1])
+        fact(knees - at(f"{side}_wrist")[:, 1], -0.05, 0.05)
+    for side in ("right", "left"):
+        fact(180 - angle(at(f"{side}_shoulder"), at(f"{side}_elbow"), at(f"{side}_wrist")), 50.0, 70.0)
+    for name in ("right_wrist", "left_wrist", "right_ankle", "left_ankle"):
+        fact(speed(name), 1.5, 2.0)
+    fact(np.abs(at("right_ankle")[:, 0] - at("left_ankle")[:, 0]), 0.45, 0.6)
+    fact(-b.height, -0.75, -0.65)
+    torso = at("neck")
+    fact(np.degrees(np.arctan2(np.linalg.norm(torso[:, [0, 2]], axis=1), torso[:, 1])), 30.0, 45.0)
+    fact(b.speed, 0.6, 0.9)
+    fact(np.abs(b.turning), 60.0, 90.0)
+    return hysteresis(np.stack(values, axis=1), np.array(low), np.array(high))
+
+
 def pack_bits(bits):
     """Python integers: the sum of 2^f over the set bits f of each frame."""
     bits = np.asarray(bits, bool)

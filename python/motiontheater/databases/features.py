@@ -11,19 +11,20 @@ Two things are kept per frame, at FEATURE_RATE:
 
 - :func:`pose_features`, real numbers: the points in the body's frame, the hips' height above
   the floor and their speed over it; what dynamic time warping ranks by;
-- :func:`relations`, Müller, Röder and Clausen's relational features (SIGGRAPH 2005): yes/no
-  facts such as "the right foot is in front of the left", "a hand is above the head", each with
-  two thresholds (hysteresis, :func:`mtcore.search.hysteresis`) so that a fact does not flicker
-  at its edge; packed into one word per frame, whose runs the index holds.
+- :func:`words`, Müller, Röder and Clausen's relational features (SIGGRAPH 2005): yes/no
+  facts such as "the right foot is in front of the left", "a hand is above the head"
+  (RELATIONS), each with two thresholds so that a fact does not flicker at its edge, packed
+  into one word per frame (:func:`mtcore.search.relations`, in C), whose runs the index holds.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from mtcore.search import hysteresis, pack_bits
+from mtcore.search import Relation, relations
 
 from ..characters.rigs import recognise
 from ..feet.upright import take_up
@@ -215,92 +216,66 @@ def moves(b: Body) -> np.ndarray:
     )
 
 
-def _angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """The angle at b between b->a and b->c, in degrees (180: straight)."""
-    u, v = a - b, c - b
-    cos = np.sum(u * v, -1) / np.maximum(np.linalg.norm(u, axis=-1) * np.linalg.norm(v, axis=-1), 1e-12)
-    return np.degrees(np.arccos(np.clip(cos, -1, 1)))
+def _difference(a: str, b: str = "", c: str = "", *, axis: int, off: float, on: float, **how: Any) -> Relation:
+    """Point a's coordinate ``axis`` minus b's (the lower of b's and c's; nothing: 0)."""
+    return Relation("difference", _AT[a], _AT[b] if b else -1, _AT[c] if c else -1, axis, off=off, on=on, **how)
 
 
-RELATIONS = (
-    "right foot in front of the left",
-    "left foot in front of the right",
-    "right foot raised",
-    "left foot raised",
-    "right knee bent",
-    "left knee bent",
-    "right hand above the head",
-    "left hand above the head",
-    "right hand in front of the body",
-    "left hand in front of the body",
-    "right hand out to the side",
-    "left hand out to the side",
-    "right hand below the knees",
-    "left hand below the knees",
-    "right elbow bent",
-    "left elbow bent",
-    "right hand moving fast",
-    "left hand moving fast",
-    "right foot moving fast",
-    "left foot moving fast",
-    "feet apart",
-    "hips low",
-    "torso leaning",
-    "body moving over the floor",
-    "body turning",
-)
-"""The relational features, bit i of a frame's word being RELATIONS[i]."""
+def _bend(a: str, b: str, c: str, off: float, on: float) -> Relation:
+    """How far the limb a-b-c is bent at b from straight, degrees."""
+    return Relation("bend", _AT[a], _AT[b], _AT[c], off=off, on=on)
 
 
-def relations(b: Body) -> np.ndarray:
-    """(frames, len(RELATIONS)) booleans: see RELATIONS; thresholds in leg lengths, degrees and
-    seconds, each a pair (off below the first, on above the second) so that facts hold steady."""
-    at = b.at
-    values, low, high = [], [], []
+def _fast(a: str, off: float, on: float) -> Relation:
+    """How fast point a moves, leg lengths a second."""
+    return Relation("speed", _AT[a], off=off, on=on)
 
-    def fact(value: np.ndarray, off: float, on: float) -> None:
-        values.append(value)
-        low.append(off)
-        high.append(on)
 
-    rel_speed = {}
-    for name in ("right_wrist", "left_wrist", "right_ankle", "left_ankle"):
-        p = at(name)
-        rel_speed[name] = np.linalg.norm(np.gradient(p, axis=0), axis=1) * b.rate if len(p) > 1 else np.zeros(len(p))
-    fact(at("right_ankle")[:, 2] - at("left_ankle")[:, 2], 0.1, 0.2)
-    fact(at("left_ankle")[:, 2] - at("right_ankle")[:, 2], 0.1, 0.2)
-    fact(at("right_ankle")[:, 1] - at("left_ankle")[:, 1], 0.1, 0.2)
-    fact(at("left_ankle")[:, 1] - at("right_ankle")[:, 1], 0.1, 0.2)
-    for side in ("right", "left"):
-        fact(180 - _angle(at(f"{side}_hip"), at(f"{side}_knee"), at(f"{side}_ankle")), 40.0, 60.0)
-    for side in ("right", "left"):
-        fact(at(f"{side}_wrist")[:, 1] - at("head")[:, 1], -0.05, 0.05)
-    for side in ("right", "left"):
-        fact(at(f"{side}_wrist")[:, 2], 0.3, 0.45)
-    for side, sign in (("right", -1.0), ("left", 1.0)):
-        fact(sign * (at(f"{side}_wrist")[:, 0] - at(f"{side}_shoulder")[:, 0]), 0.35, 0.5)
-    for side in ("right", "left"):
-        knees = np.minimum(at("right_knee")[:, 1], at("left_knee")[:, 1])
-        fact(knees - at(f"{side}_wrist")[:, 1], -0.05, 0.05)
-    for side in ("right", "left"):
-        fact(180 - _angle(at(f"{side}_shoulder"), at(f"{side}_elbow"), at(f"{side}_wrist")), 50.0, 70.0)
-    fact(rel_speed["right_wrist"], 1.5, 2.0)
-    fact(rel_speed["left_wrist"], 1.5, 2.0)
-    fact(rel_speed["right_ankle"], 1.5, 2.0)
-    fact(rel_speed["left_ankle"], 1.5, 2.0)
-    fact(np.abs(at("right_ankle")[:, 0] - at("left_ankle")[:, 0]), 0.45, 0.6)
-    fact(-b.height, -0.75, -0.65)  # hips lower than 0.65 leg lengths: on when height falls below
-    torso = at("neck")
-    lean = np.degrees(np.arctan2(np.linalg.norm(torso[:, [0, 2]], axis=1), torso[:, 1]))
-    fact(lean, 30.0, 45.0)
-    fact(b.speed, 0.6, 0.9)
-    fact(np.abs(b.turning), 60.0, 90.0)
-    return hysteresis(np.stack(values, axis=1), np.array(low), np.array(high))
+_X, _Y, _Z = 0, 1, 2  # the body's axes: to its left, up, forward
+_HEIGHT, _SPEED, _TURNING = 0, 1, 2  # the scalars of a body, as words passes them
+
+RELATIONS = {
+    "right foot in front of the left": _difference("right_ankle", "left_ankle", axis=_Z, off=0.1, on=0.2),
+    "left foot in front of the right": _difference("left_ankle", "right_ankle", axis=_Z, off=0.1, on=0.2),
+    "right foot raised": _difference("right_ankle", "left_ankle", axis=_Y, off=0.1, on=0.2),
+    "left foot raised": _difference("left_ankle", "right_ankle", axis=_Y, off=0.1, on=0.2),
+    "right knee bent": _bend("right_hip", "right_knee", "right_ankle", 40.0, 60.0),
+    "left knee bent": _bend("left_hip", "left_knee", "left_ankle", 40.0, 60.0),
+    "right hand above the head": _difference("right_wrist", "head", axis=_Y, off=-0.05, on=0.05),
+    "left hand above the head": _difference("left_wrist", "head", axis=_Y, off=-0.05, on=0.05),
+    "right hand in front of the body": _difference("right_wrist", axis=_Z, off=0.3, on=0.45),
+    "left hand in front of the body": _difference("left_wrist", axis=_Z, off=0.3, on=0.45),
+    "right hand out to the side": _difference("right_wrist", "right_shoulder", axis=_X, sign=-1.0, off=0.35, on=0.5),
+    "left hand out to the side": _difference("left_wrist", "left_shoulder", axis=_X, off=0.35, on=0.5),
+    # the lower knee above the wrist
+    "right hand below the knees": _difference(
+        "right_wrist", "right_knee", "left_knee", axis=_Y, sign=-1.0, off=-0.05, on=0.05
+    ),
+    "left hand below the knees": _difference(
+        "left_wrist", "right_knee", "left_knee", axis=_Y, sign=-1.0, off=-0.05, on=0.05
+    ),
+    "right elbow bent": _bend("right_shoulder", "right_elbow", "right_wrist", 50.0, 70.0),
+    "left elbow bent": _bend("left_shoulder", "left_elbow", "left_wrist", 50.0, 70.0),
+    "right hand moving fast": _fast("right_wrist", 1.5, 2.0),
+    "left hand moving fast": _fast("left_wrist", 1.5, 2.0),
+    "right foot moving fast": _fast("right_ankle", 1.5, 2.0),
+    "left foot moving fast": _fast("left_ankle", 1.5, 2.0),
+    "feet apart": _difference("right_ankle", "left_ankle", axis=_X, absolute=True, off=0.45, on=0.6),
+    # hips lower than 0.65 leg lengths: on when the height falls below
+    "hips low": Relation("scalar", _HEIGHT, sign=-1.0, off=-0.75, on=-0.65),
+    "torso leaning": Relation("lean", _AT["neck"], off=30.0, on=45.0),
+    "body moving over the floor": Relation("scalar", _SPEED, off=0.6, on=0.9),
+    "body turning": Relation("scalar", _TURNING, absolute=True, off=60.0, on=90.0),
+}
+"""Müller's relational features, bit i of a frame's word being the i-th: each a measure of the
+body (leg lengths, degrees, seconds) with two thresholds, off below the first and on above the
+second, so that a fact holds steady at its edge."""
 
 
 def words(b: Body) -> np.ndarray:
-    """The relational features of each frame as one word (uint64, bit i RELATIONS[i])."""
-    return pack_bits(relations(b))
+    """The relational features of each frame as one word (uint64, bit i the i-th of RELATIONS)."""
+    scalars = np.stack([b.height, b.speed, b.turning], axis=1)
+    return relations(b.points, scalars, b.rate, list(RELATIONS.values())).words
 
 
 def describe(word: int) -> list[str]:
