@@ -1,6 +1,6 @@
 /*
  * check.c - what is wrong with a take's channels, in one pass over its rows
- * (mt_check_channels; see mtcore.h).
+ * (mt_check_channels), and the pace of its steps (mt_check_pace; see mtcore.h).
  *
  * The rows are walked in order and every channel carries its open events
  * from row to row, so that the values are read once, in the order they lie
@@ -220,5 +220,43 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
     close_event(&repeat, &sink, channels, MT_CHECK_REPEAT);
     free(open);
     *count = sink.count;
+    return MT_OK;
+}
+
+/* x wrapped into [-period/2, period/2) (period 0: as it is). */
+static double wrapped(double x, double period)
+{
+    return period > 0.0 ? x - period * floor(x / period + 0.5) : x;
+}
+
+int mt_check_pace(const double *values, size_t rows, size_t channels, size_t stride, const double *weight,
+                  const double *period, double *moved, double *paced, double *stepped)
+{
+    if (stride < channels || (channels > 0 && (weight == NULL || period == NULL)) ||
+        (rows > 0 && (moved == NULL || paced == NULL || stepped == NULL)) || (rows > 0 && channels > 0 && values == NULL) ||
+        (channels > 0 && stride > SIZE_MAX / (rows > 0 ? rows : 1)))
+        return MT_EINVAL;
+    for (size_t k = 0; k < channels; k++)
+        if (!(weight[k] >= 0.0) || !isfinite(weight[k]) || !(period[k] >= 0.0) || !isfinite(period[k]))
+            return MT_EINVAL;
+    for (size_t t = 0; t < rows; t++) {
+        double m2 = 0.0, dm = 0.0, d2 = 0.0;
+        if (t >= 1 && t + 3 <= rows) {
+            const double *a = values + (t - 1) * stride, *b = a + stride, *c = b + stride, *d = c + stride;
+            for (size_t k = 0; k < channels; k++) {
+                const double into = wrapped(b[k] - a[k], period[k]), step = wrapped(c[k] - b[k], period[k]);
+                const double out = wrapped(d[k] - c[k], period[k]);
+                const double mean = (into + out) / 2;
+                if (!isfinite(mean) || !isfinite(step))
+                    continue; /* a gap, or values no motion reaches: other findings' */
+                m2 += weight[k] * mean * mean;
+                dm += weight[k] * step * mean;
+                d2 += weight[k] * step * step;
+            }
+        }
+        moved[t] = m2;
+        paced[t] = dm;
+        stepped[t] = d2;
+    }
     return MT_OK;
 }

@@ -13,6 +13,7 @@ from artifacts import KINDS, hits, inject
 from corpus import real_files
 from motiontheater.databases.check import check_motion, recipe
 from motiontheater.databases.check_feet import STRIDE_SPEED_RANGE, STRIDE_SPEED_SHARE
+from motiontheater.databases.check_pace import BLOCK_FRAMES, DROP_EVIDENCE, step_pace
 from motiontheater.databases.findings import KINDS as FINDING_KINDS
 from motiontheater.databases.findings import SEVERITIES
 from motiontheater.feet.footskate import prepare
@@ -118,6 +119,63 @@ def test_recipes_remove_the_injected_findings_and_change_no_frame_outside_them(i
     counts = tally[kind]
     assert counts["fixed"] >= 0.95 * (counts["fixed"] + counts["kept"]), (variant, kind, dict(counts))
     assert counts["touched"] == 0, (variant, kind, dict(counts))
+
+
+@pytest.mark.parametrize("variant", ["as found", "z-up", "in mm"])
+def test_frames_taken_out_of_real_takes_are_found_where_the_body_moves(variant, tmp_path):
+    """One or two frames taken out at random rows of every real take: where the body moves over
+    the missing time more than its noise could (three times the evidence the check asks for), the
+    check finds them at that step (recall >= 0.95 at 60 Hz and above; >= 0.8 below,
+    where a step holds enough change of acceleration that the steps beside it foretell it less
+    well), mostly how many; the frames it finds missing elsewhere the take had missing before
+    (precision >= 0.95)."""
+    if not TAKES:
+        pytest.skip("the real-file corpus (../shared/data) is absent")
+    rng = np.random.default_rng(27)
+    tally = collections.defaultdict(collections.Counter)
+    for path in TAKES if variant == "as found" else BVHS:
+        take = _variant(path, variant, tmp_path)
+        if take.frames < 40:
+            continue
+        before = {(f.first, f.last) for f in check_motion(take, str(path)) if f.kind == "dropped"}
+        counts = tally["fast" if take.frame_rate >= 60 else "slow"]
+        for _ in range(6):
+            missing, row = int(rng.integers(1, 3)), int(rng.integers(10, take.frames - 12))
+            cut = take.replace(values=np.delete(take.values, range(row, row + missing), axis=0))
+            counts["made"] += 1
+            if step_pace(cut).moved[row - 1] < 3 * DROP_EVIDENCE:
+                continue  # a still body hides a missing frame (and loses nothing by it)
+            counts["visible"] += 1
+            at = take.first_frame + row - 1  # the step from the frame before the cut to the one after
+            found = [f for f in check_motion(cut, str(path)) if f.kind == "dropped"]
+            hit = [f for f in found if (f.first, f.last) == (at, at + 1)]
+            counts["found" if hit else "missed"] += 1
+            counts["counted"] += any(round(f.size * take.frame_rate) == missing for f in hit)
+            # a missing frame the take had, a frame either way (its evidence near the threshold)
+            shifted = {a - missing * (a > at) + shift for a, _ in before for shift in (-1, 0, 1)}
+            counts["false"] += sum(f not in hit and f.first not in shifted for f in found)
+    made = sum(c["made"] for c in tally.values())
+    assert sum(c["visible"] for c in tally.values()) >= 0.6 * made, tally  # most steps of a take move
+    for rates, least in (("fast", 0.95), ("slow", 0.8)):
+        counts = tally[rates]
+        assert counts["found"] >= least * counts["visible"], (rates, tally)
+        assert counts["counted"] >= 0.8 * counts["found"], (rates, tally)  # how many: the pace of two frames missing
+        assert counts["false"] <= 0.05 * (counts["found"] + counts["false"]), (rates, tally)
+
+
+def test_frames_missing_from_smooth_motion_are_found_in_a_take_of_any_length(monkeypatch):
+    """A smooth synthetic take has no frame missing; with frames taken out, the check tells each
+    cut and no other, also where the take is held a block of frames at a time."""
+    take = _smooth_take(120.0)
+    assert [f for f in check_motion(take) if f.kind == "dropped"] == []
+    rows = [40, 90, 91, 150]  # 91: two frames missing at once
+    cut = take.replace(values=np.delete(take.values, rows, axis=0))
+    want = [(take.first_frame + 39, 1), (take.first_frame + 88, 2), (take.first_frame + 146, 1)]
+    for block in (BLOCK_FRAMES, 64, 7):
+        monkeypatch.setattr("motiontheater.databases.check_pace.BLOCK_FRAMES", block)
+        found = [f for f in check_motion(cut) if f.kind == "dropped"]
+        assert [(f.first, round(f.size * take.frame_rate)) for f in found] == want, block
+        assert all(f.unit == "s" and f.fix == () and f.severity == "low" for f in found)
 
 
 @pytest.mark.parametrize("path", TAKES, ids=[p.name for p in TAKES])

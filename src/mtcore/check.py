@@ -1,5 +1,6 @@
 """The take check's channel pass: gaps, frozen runs, spikes, steps and repeated rows in one pass
-(the kernel ``mt_check_channels``).  What the events mean for a take, in its units and joints,
+(the kernel ``mt_check_channels``), and the pace of each step, for rows missing between two
+(``mt_check_pace``).  What the events mean for a take, in its units and joints,
 is :mod:`motiontheater.databases.check`'s."""
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._status import check
 
-__all__ = ["FROZEN", "GAP", "KINDS", "REPEAT", "SPIKE", "STEP", "ChannelEvents", "channel_events"]
+__all__ = ["FROZEN", "GAP", "KINDS", "REPEAT", "SPIKE", "STEP", "ChannelEvents", "Pace", "channel_events", "pace"]
 
 GAP, FROZEN, SPIKE, STEP, REPEAT = (
     lib.MT_CHECK_GAP,
@@ -94,3 +95,41 @@ def _limits(limit: ArrayLike, channels: int, name: str) -> np.ndarray:
     if np.isnan(a).any() or (a < 0).any():
         raise ValueError(f"{name} must be non-negative numbers, got {a[np.isnan(a) | (a < 0)][0]}")
     return np.ascontiguousarray(a)
+
+
+@dataclass(frozen=True)
+class Pace:
+    """How far each step of a take moves against the steps beside it, as weighted sums over the
+    channels of m, the mean of the changes into row t and out of row t + 1, and d, the change from
+    row t to row t + 1: ``moved`` of m^2, ``paced`` of d m and ``stepped`` of d^2, each (rows,).
+    paced / moved is how many steps of motion the step holds (2: a row missing), and stepped
+    - 2 s paced + s^2 moved how far it lies from s of them.  0 where a step has no steps on
+    both sides."""
+
+    moved: np.ndarray
+    paced: np.ndarray
+    stepped: np.ndarray
+
+
+def pace(values: ArrayLike, weight: ArrayLike, period: ArrayLike) -> Pace:
+    """The :class:`Pace` of the (rows, channels) values' steps, each channel weighted by
+    ``weight`` (one per channel, or one for all: 1 / the variance of a step's change less the
+    mean of the changes beside it, from noise and smooth motion), its changes wrapped into a
+    ``period`` where that is above 0 (angles).  The kernel ``mt_check_pace`` (csrc/mtcore.h)."""
+    x = np.ascontiguousarray(values, dtype=np.float64)
+    if x.ndim != 2:
+        raise ValueError(f"values must be two-dimensional (rows, channels), got shape {x.shape}")
+    rows, channels = x.shape
+    w, p = (_finite(a, channels, name) for a, name in ((weight, "weight"), (period, "period")))
+    moved, paced, stepped = np.zeros(rows), np.zeros(rows), np.zeros(rows)
+    status = lib.mt_check_pace(c_array(x), rows, channels, channels, c_array(w), c_array(p), c_array(moved),
+                               c_array(paced), c_array(stepped))  # fmt: skip
+    check(status, "mt_check_pace")
+    return Pace(moved, paced, stepped)
+
+
+def _finite(value: ArrayLike, channels: int, name: str) -> np.ndarray:
+    a = _limits(value, channels, name)
+    if not np.isfinite(a).all():
+        raise ValueError(f"{name} must be finite, got {a[~np.isfinite(a)][0]}")
+    return a

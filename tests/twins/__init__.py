@@ -27,7 +27,7 @@ from mtcore import rotations as rot
 from mtcore import search as mt_search
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
-from mtcore.check import channel_events
+from mtcore.check import channel_events, pace
 from mtcore.combine import combine_frames
 from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
 from mtcore.retarget import RetargetPlan, retarget_rotations
@@ -971,6 +971,10 @@ TWINS: dict[str, Twin] = {
     "mt_fill_gaps": Twin(fast_fill, signal_twins.fill_gaps_twin, gap_cases, close(1e-9)),
     # rows and kinds exactly; sizes and the roughness sum to rounding (both sum in row order)
     "mt_check_channels": Twin(fast_check, check.check_channels_twin, check_cases, close(1e-12)),
+    # the wrap by floor in C, by remainder in the twin: equal to rounding
+    "mt_check_pace": Twin(
+        lambda x, w, p: tuple(vars(pace(x, w, p)).values()), check.pace_twin, check.pace_cases, close(1e-9)
+    ),
     "mt_nan_runs": Twin(
         lambda x, *_: mt_signal.nan_runs(x), lambda x, *_: signal_twins.nan_runs_twin(x), nan_run_cases, exact
     ),

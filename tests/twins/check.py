@@ -94,3 +94,40 @@ def check_channels_twin(values, spike_limit, step_limit, min_run, begin=0, end=N
     table = np.array([e[:5] for e in events], dtype=np.intp).reshape(-1, 5)
     sizes = np.array([e[5] for e in events], dtype=float)
     return table, sizes, roughness, smooth
+
+
+def pace_twin(values, weight, period):
+    """Each step's changes from the rows around it, one row at a time: unwrapped by numpy's
+    remainder, the channels with a missing or infinite change left out."""
+    x = np.asarray(values, float)
+    rows, channels = x.shape
+    w, p = np.broadcast_to(weight, channels), np.broadcast_to(period, channels)
+    moved, paced, stepped = np.zeros(rows), np.zeros(rows), np.zeros(rows)
+
+    def change(a, b, k):
+        c = x[b, k] - x[a, k]
+        return c if p[k] == 0 or not math.isfinite(c) else (c + p[k] / 2) % p[k] - p[k] / 2
+
+    for t in range(1, rows - 2):
+        for k in range(channels):
+            mean = (change(t - 1, t, k) + change(t + 1, t + 2, k)) / 2
+            step = change(t, t + 1, k)
+            if math.isfinite(mean) and math.isfinite(step):
+                moved[t] += w[k] * mean * mean
+                paced[t] += w[k] * step * mean
+                stepped[t] += w[k] * step * step
+    return moved, paced, stepped
+
+
+def pace_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for rows, channels in ((0, 2), (1, 1), (3, 2), (4, 3), (5, 1), (60, 6)):
+        x = rng.normal(size=(rows, channels)).cumsum(axis=0) * 40
+        if rows > 10:
+            x[7, 1] = math.nan
+            x[20, 2] = math.inf
+            x[30:, 0] += 400.0  # an angle that wraps
+        weight = rng.uniform(0, 2, channels)
+        period = np.where(np.arange(channels) % 2 == 0, 360.0, 0.0)
+        out.append((x, weight, period))
+    return out + [(np.zeros((6, 0)), 1.0, 0.0)]

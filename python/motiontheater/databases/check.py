@@ -38,6 +38,7 @@ from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 from ..model.units import HUMAN_HEIGHT
 from .check_arms import arm_findings
 from .check_feet import leg_findings
+from .check_pace import dropped_findings
 from .findings import Finding
 
 SPIKE_DEG = 5.0
@@ -202,6 +203,8 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         }
         findings += _spikes(t, by_kind[kernel.SPIKE], by_kind[kernel.STEP], explained, spikes)
         findings += _jitter(t, found.roughness, found.smooth_rows)
+        dropped, findings = dropped_findings(motion, take, findings)
+        findings += dropped
         findings += _bones(t)
         findings += _speed(t)
         findings += leg_findings(motion, take, t.meters)

@@ -17,6 +17,7 @@ KINDS = {
     "frozen": "a channel held at one value while it moves before and after",
     "dead": "a channel that never moves while the joint's other channels do",
     "repeated": "frames equal to the frame before in every channel (dropped and filled by repetition)",
+    "dropped": "frames missing between two: the body moves as far in one step as in two or more",
     "teleport": "the root jumps farther in a frame than anyone runs",
     "speed": "the root moves faster than anyone runs, for a while",
     "jitter": "high-frequency noise on a joint's channels",

@@ -1,0 +1,121 @@
+"""Dropped frames: steps of a take that hold two or more steps of motion, the frames between
+them missing (a stream that lost packets, a capture that skipped a camera frame).
+
+A missing frame shows where the body is, not in the file's angles: every joint moves as far
+from one frame to the next as in two steps, while the steps before and after move as usual.
+Near gimbal lock Euler angles swing while the joints stay put, so the joints' positions are
+compared (forward kinematics, in metres), each coordinate counting by its own noise (the
+frame-to-frame roughness over the take), so that only a step the noise cannot explain is told.
+The mean m of the changes into and out of a step and the step's change d give, summed over the
+coordinates in units of their noise, the evidence that the step holds k steps of motion rather
+than one: sum ((d - m)^2 - (d - k m)^2), where the k steps fit well (the whole body moves k
+steps, not one joint farther); the kernel :func:`mtcore.check.pace` computes the sums, in one
+pass over the rows.  Nothing is made up to fix it: the finding is told, with how
+long the missing time was.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mtcore import check as kernel
+
+from ..model.motion import Motion
+from .findings import Finding
+
+DROP_EVIDENCE = 25.0
+"""How much better "frames are missing between these two" explains a step than "the take moves
+on evenly", in units of the noise (a log-likelihood ratio of 12.5: five sigma)."""
+DROP_FIT = 0.5
+"""The most of the step's misfit as one step of motion that frames missing may leave: the whole
+body moves as many steps, not one joint farther (a teleport of the root, a spike of a hand)."""
+MOST_MISSING = 5
+"""The most frames told missing in one step (a longer loss is a cut, not a dropped frame)."""
+NOISE_M = 0.0001
+"""The least noise a coordinate is taken to have, metres (a take of few digits, or synthetic)."""
+BLOCK_FRAMES = 8192
+"""Frames whose joints' positions are held at once: a take of any length is checked in blocks."""
+AROUND = ("gap", "repeated")
+"""Findings whose frames move unevenly for their own reason: no step within them is told (a
+frame repeated in place of a lost one, then a step of two: the repeat is the finding).  A flip
+moves no joint, and a held channel's catching up moves only the joints below it: the fit of
+the whole body tells them apart."""
+CONSEQUENCES = ("jump", "teleport", "spike")
+"""Findings that frames missing make (a fast hand, the root, jump as far as in two frames):
+within a frame of a step with frames missing, the finding is the missing frames."""
+
+
+def dropped_findings(motion: Motion, take: str, found: list[Finding]) -> tuple[list[Finding], list[Finding]]:
+    """The steps of the take with frames missing between them (but beside the ``found``
+    findings that explain an uneven step), and ``found`` without the jumps those missing frames
+    make."""
+    pace = step_pace(motion)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = pace.paced / pace.moved
+    steps = np.clip(np.round(np.nan_to_num(ratio)), 2.0, MOST_MISSING + 1.0)
+
+    def misfit(s: np.ndarray | float) -> np.ndarray:
+        return pace.stepped - 2 * s * pace.paced + s * s * pace.moved
+
+    one, many = misfit(1.0), misfit(steps)
+    taken = (one - many > DROP_EVIDENCE) & (many < DROP_FIT * one)
+    quiet = np.ones(motion.frames, bool)  # the rows no other finding explains a step beside
+    for f in found:
+        a, b = f.first - motion.first_frame, f.last - motion.first_frame
+        if f.kind in AROUND:
+            quiet[max(a - 2, 0) : max(b + 3, 0)] = False
+    out, made = [], set()
+    for row in map(int, np.flatnonzero(taken & quiet & np.roll(quiet, -1))):
+        a, b = motion.first_frame + row, motion.first_frame + row + 1
+        made.update((a - 1, a, b, b + 1))
+        missing = int(steps[row]) - 1
+        seconds = missing / motion.frame_rate
+        out.append(
+            Finding(
+                take, "dropped", (), a, b, "low", round(seconds, 6), "s",
+                f"the body moves {ratio[row]:.2g} times as far from frame {a} to {b} as into and out of them: "
+                f"{missing} frame(s) ({seconds * 1000:.3g} ms) seem missing between them (told, not fixed: no "
+                "frame is made up)",
+            )
+        )  # fmt: skip
+    kept = [f for f in found if not (f.kind in CONSEQUENCES and f.last - f.first <= 2 and {f.first, f.last} <= made)]
+    return out, kept
+
+
+def step_pace(motion: Motion) -> kernel.Pace:
+    """The :func:`mtcore.check.pace` of the joints' positions (metres), each coordinate weighted
+    by its noise: the frame-to-frame roughness over the take, at least NOISE_M."""
+    rows = motion.frames
+    if rows < 4:
+        return kernel.Pace(np.zeros(rows), np.zeros(rows), np.zeros(rows))
+    blocks = [(a, min(a + BLOCK_FRAMES, rows)) for a in range(0, rows, BLOCK_FRAMES)]
+    held = _positions(motion, 0, rows) if len(blocks) == 1 else None
+    squares, counts = 0.0, 0
+    for a, b in blocks:  # rows a-1 .. b: the roughness of rows a .. b-1, each row's once
+        p = held if held is not None else _positions(motion, max(a - 1, 0), min(b + 1, rows))
+        r = p[:-2] + p[2:]
+        r *= -0.5
+        r += p[1:-1]
+        sums = np.einsum("ij,ij->j", r, r)
+        count = np.full(len(sums), len(r))
+        for c in np.flatnonzero(~np.isfinite(sums)):  # a gap, or values no motion reaches: their rows left out
+            finite = np.isfinite(r[:, c])
+            sums[c], count[c] = np.sum(r[finite, c] ** 2), finite.sum()
+        squares, counts = squares + sums, counts + count
+    with np.errstate(invalid="ignore", divide="ignore"):
+        noise = np.nan_to_num(squares / counts / 1.5)  # the variance of one coordinate
+    # d - m = 1.5 x[t+1] - 1.5 x[t] + 0.5 x[t-1] - 0.5 x[t+2]: five times the variance of one
+    weight = 1.0 / (5.0 * (noise + NOISE_M**2))
+    sums = np.zeros((3, rows))
+    for a, b in blocks:  # rows a-1 .. b+1: the steps a .. b-1 and their neighbours
+        first = max(a - 1, 0)
+        p = held if held is not None else _positions(motion, first, min(b + 2, rows))
+        pace = kernel.pace(p, weight, 0.0)
+        sums[:, a:b] = np.stack([pace.moved, pace.paced, pace.stepped])[:, a - first : b - first]
+    return kernel.Pace(*sums)
+
+
+def _positions(motion: Motion, first: int, stop: int) -> np.ndarray:
+    """The joints' world positions of rows first..stop-1, metres, (rows, joints x 3)."""
+    part = motion.replace(values=motion.values[first:stop])
+    return part.positions(meters=True).reshape(stop - first, -1)
