@@ -64,7 +64,8 @@ def dropped_findings(motion: Motion, take: str, found: list[Finding]) -> tuple[l
         a, b = f.first - motion.first_frame, f.last - motion.first_frame
         if f.kind in AROUND:
             quiet[max(a - 2, 0) : max(b + 3, 0)] = False
-    out, made = [], set()
+    out: list[Finding] = []
+    made: set[int] = set()
     for row in map(int, np.flatnonzero(taken & quiet & np.roll(quiet, -1))):
         a, b = motion.first_frame + row, motion.first_frame + row + 1
         made.update((a - 1, a, b, b + 1))
@@ -90,7 +91,7 @@ def step_pace(motion: Motion) -> kernel.Pace:
         return kernel.Pace(np.zeros(rows), np.zeros(rows), np.zeros(rows))
     blocks = [(a, min(a + BLOCK_FRAMES, rows)) for a in range(0, rows, BLOCK_FRAMES)]
     held = _positions(motion, 0, rows) if len(blocks) == 1 else None
-    squares, counts = 0.0, 0
+    squares, counts = np.zeros(3 * len(motion.skeleton.joint_names)), np.zeros(3 * len(motion.skeleton.joint_names))
     for a, b in blocks:  # rows a-1 .. b: the roughness of rows a .. b-1, each row's once
         p = held if held is not None else _positions(motion, max(a - 1, 0), min(b + 1, rows))
         r = p[:-2] + p[2:]
@@ -101,7 +102,8 @@ def step_pace(motion: Motion) -> kernel.Pace:
         for c in np.flatnonzero(~np.isfinite(sums)):  # a gap, or values no motion reaches: their rows left out
             finite = np.isfinite(r[:, c])
             sums[c], count[c] = np.sum(r[finite, c] ** 2), finite.sum()
-        squares, counts = squares + sums, counts + count
+        squares += sums
+        counts += count
     with np.errstate(invalid="ignore", divide="ignore"):
         noise = np.nan_to_num(squares / counts / 1.5)  # the variance of one coordinate
     # d - m = 1.5 x[t+1] - 1.5 x[t] + 0.5 x[t-1] - 0.5 x[t+2]: five times the variance of one
