@@ -281,6 +281,31 @@ def test_a_fast_smooth_turn_is_no_high_spike_and_a_pop_as_far_is():
     assert [(f.joints, f.severity) for f in popped if f.joints == ("LeftHand",)] == [(("LeftHand",), "high")]
 
 
+def test_at_30_hz_a_swing_off_its_neighbours_path_is_low_and_a_turn_out_and_back_as_far_medium():
+    """LAFAN1's left forearm swings 50 deg from frame 561 to 563, 15 deg off the path between
+    them at 562: as far as smooth motion goes at 30 Hz, low; the forearm turned 15 deg out and
+    back for one frame where it is slow is a spike a person sees, medium."""
+    lafan = real_files("bvh-producers/bvhTools_test2_lafan1.bvh")
+    if not lafan:
+        pytest.skip("the real-file corpus (../shared/data/bvh-producers) is absent")
+    take = mt.read_take(lafan[0])
+
+    def forearm(motion, frame):
+        return [
+            f for f in check_motion(motion) if f.kind == "spike" and f.joints == ("LeftForeArm",) and f.first == frame
+        ]
+
+    swing = forearm(take, 562)
+    assert len(swing) == 1 and swing[0].size > 10 and swing[0].severity == "low", swing
+    q = take.rotations(local=True, quaternions=True)[:, take.skeleton.joint_names.index("LeftForeArm")]
+    turns = np.degrees(2 * np.arccos(np.clip(np.abs(np.sum(q[1:] * q[:-1], axis=1)), -1, 1)))
+    row = int(np.argmin(turns[100:-100] + turns[101:-99])) + 101  # the forearm at its stillest
+    values = take.values.copy()
+    values[row, take.columns("LeftForeArm", take.skeleton.dofs("LeftForeArm"))[0]] += 15.0
+    popped = forearm(take.replace(values=values), take.first_frame + row)
+    assert [f.severity for f in popped] == ["medium"] and 12 < popped[0].size < 18, popped
+
+
 @pytest.mark.parametrize("variant", ["as found", "game rig", "z-up"])
 def test_an_elbow_bent_backwards_is_found_where_it_is(variant, tmp_path):
     """CMU's elbow is a hinge of one channel (rx); in the game rig and z-up BVH written from it,

@@ -624,7 +624,14 @@ def _turning_spike(
         and deviation > 2 * _pace(t, joint, first, last)
         and _fastest(t, joint, first, last) > SPIKE_TURN_DEG_S
     )
-    severity = "high" if high else "medium" if deviation > 10 else "low"
+    # medium: farther out than smooth motion at twice the peak acceleration (10 deg at 45 Hz and
+    # above; 22 at 30 Hz, where a swinging forearm bends off the path between its neighbours by
+    # 15), or farther out than the rows around it lie apart: a turn out and back
+    medium = deviation > 10 and (
+        deviation > 2 * limit
+        or (first > 0 and last < t.motion.frames - 1 and deviation > _apart(t, joint, first - 1, last + 1))
+    )
+    severity = "high" if high else "medium" if medium else "low"
     return Finding(
         t.name, "spike", (joint,), t.frame(first), t.frame(last), severity, round(deviation, 6), "deg",
         f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s)",
