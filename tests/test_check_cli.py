@@ -51,7 +51,10 @@ def test_the_recipes_fix_the_take_when_apply_runs_them(spiked, tmp_path, capsys)
     recipe = fixes / "02_01.amc.toml"
     fixed = tmp_path / "fixed.amc"
     assert main(["apply", str(spiked), "--recipe", str(recipe), "-o", str(fixed)]) == 0
-    capsys.readouterr()
+    # the spike and the gap each filled; a run of one step told once, with its count (a check's
+    # recipe may hold hundreds)
+    assert recipe.read_text().count('run = "fill_gaps"') == 2
+    assert f"(fill_gaps x2) on {mt.read_take(spiked).frames} frames of {spiked}" in capsys.readouterr().out
     after = _json(capsys, fixed)
     assert not [f for f in after if f["kind"] in ("spike", "gap") and f["severity"] != "low" and 95 < f["first"] < 210]
     before, repaired = mt.read_take(spiked), mt.read_take(fixed)

@@ -5,6 +5,7 @@ recipe help serve ``batch`` too."""
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import sys
 from functools import partial
@@ -305,7 +306,9 @@ def _apply(args: argparse.Namespace) -> int:
         written = target
     else:
         written = _write_result(motion, result, target, args)
-    names = ", ".join(entry.name for entry in pipeline.entries) or "no steps"
+    # a check's recipe may hold hundreds of steps: each run of one step told once, with its count
+    runs = [(name, len(list(run))) for name, run in itertools.groupby(entry.name for entry in pipeline.entries)]
+    names = ", ".join(name if count == 1 else f"{name} x{count}" for name, count in runs) or "no steps"
     print(f"{args.recipe} ({names}) on {motion.frames} frames of {source}: wrote {written}")
     return 0
 
