@@ -1,5 +1,6 @@
 """Batch processing: the corpus on 2 processes and on Dask, kills and resumes, failures, streaming."""
 
+import dataclasses
 import os
 import re
 import shutil
@@ -80,8 +81,9 @@ def test_takes_go_to_the_workers_in_groups_and_each_is_reported(data_dir, tmp_pa
     assert not summary.failed and sorted(r.input for r in summary.results) == sorted(j.input for j in jobs)
     expected = expected_bytes(data_dir / "edge" / "test.amc", "mean", 3)
     assert all((tmp_path / "out" / f"take{i:02d}.amc").read_bytes() == expected for i in range(70))
-    manifest = batch.Manifest(tmp_path / "out", mt.Pipeline.of("mean", size=3).to_toml())
+    manifest = batch.Manifest(tmp_path / "out")
     assert all(manifest.done(job) for job in jobs)
+    assert not manifest.done(dataclasses.replace(jobs[0], pipeline=mt.Pipeline.of("mean", size=5)))  # another recipe
 
 
 def test_a_bad_take_is_reported_and_the_others_go_on(data_dir, tmp_path, capsys):

@@ -62,6 +62,33 @@ def test_the_recipes_fix_the_take_when_apply_runs_them(spiked, tmp_path, capsys)
     np.testing.assert_array_equal(repaired.values[rows], before.values[rows])
 
 
+def test_batch_runs_each_takes_own_recipe_from_the_folder_check_wrote(spiked, data_dir, tmp_path, capsys):
+    """Two takes, one with findings to fix: batch --recipe FOLDER fixes it as apply does, leaves
+    the other out (it has nothing to fix), and --resume knows both again."""
+    takes = tmp_path / "takes"
+    takes.mkdir()
+    for path in (spiked, spiked.with_name("02.asf"), data_dir / "cmu" / "02_03.amc"):  # 02_03: nothing to fix
+        shutil.copy(path, takes)
+    fixes, out = tmp_path / "fixes", tmp_path / "fixed"
+    assert main(["check", str(takes), "--recipes", str(fixes), "--quiet"]) == 0
+    assert sorted(p.name for p in fixes.iterdir()) == ["02_01.amc.toml"]
+    capsys.readouterr()
+    assert main(["batch", str(takes), "--recipe", str(fixes), "-o", str(out), "--quiet"]) == 0
+    assert sorted(p.name for p in out.glob("*.amc")) == ["02_01.amc"]
+    alone = tmp_path / "alone.amc"
+    assert main(["apply", str(spiked), "--recipe", str(fixes / "02_01.amc.toml"), "-o", str(alone)]) == 0
+    np.testing.assert_array_equal(mt.read_take(out / "02_01.amc").values, mt.read_take(alone).values)
+    capsys.readouterr()
+    assert main(["batch", str(takes), "--recipe", str(fixes), "-o", str(out), "--resume"]) == 0
+    told = capsys.readouterr().out
+    assert "0 processed, 1 skipped (already done), 1 without a recipe (nothing to fix), 0 failed of 2 takes" in told
+    (fixes / "02_01.amc.toml").write_text("[[step]]\nrun = 'no such step'\n")
+    assert main(["batch", str(takes), "--recipe", str(fixes), "-o", str(tmp_path / "again")]) == 1
+    assert f"FAILED {takes / '02_01.amc'}: {fixes / '02_01.amc.toml'}: step 1: no step 'no such step'" in (
+        capsys.readouterr().err
+    )
+
+
 def test_reports_are_written_as_json_csv_and_html(spiked, tmp_path, capsys):
     for suffix in ("json", "csv", "html"):
         target = tmp_path / f"report.{suffix}"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from ..editing.filtering import FILTERS
@@ -14,7 +15,13 @@ from .verb import Verb, prose
 
 def _arguments(parser: argparse.ArgumentParser) -> None:
     add_filter_options(parser)
-    parser.add_argument("--recipe", metavar="FILE", help="a TOML recipe of steps (instead of a filter flag)")
+    parser.add_argument(
+        "--recipe",
+        metavar="FILE",
+        help="a TOML recipe of steps (instead of a filter flag), or a folder of recipes, one per take, as check "
+        "--recipes writes them (TAKE.toml, the inputs' tree below it): each take runs its own, a take with none "
+        "is left out",
+    )
     parser.add_argument("inputs", nargs="+", help="AMC and BVH files, folders or globs")
     parser.add_argument("-o", "--output", required=True, help="the output folder")
     add_take_options(parser)
@@ -49,12 +56,14 @@ def _batch(args: argparse.Namespace) -> int:
     has_filter = any(getattr(args, kind) is not None for kind in FILTERS)
     if bool(args.recipe) == has_filter:
         raise ValueError("give a recipe (--recipe FILE) or one filter (--median N, --mean N or --binomial N)")
-    pipeline = Pipeline.read(args.recipe) if args.recipe else filter_pipeline(args)
+    recipes = args.recipe if args.recipe and os.path.isdir(args.recipe) else None
+    pipeline = None if recipes else Pipeline.read(args.recipe) if args.recipe else filter_pipeline(args)
     # the takes are read by the workers: the take options go with each job
     jobs, settled = plan_jobs(
         args.inputs,
         args.output,
         pipeline,
+        recipes=recipes,
         skeleton=args.asf,
         frame_rate=args.frame_rate,
         unit=args.unit,

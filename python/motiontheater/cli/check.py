@@ -121,7 +121,8 @@ CHECK = Verb(
         "links open a viewer page of the take at the finding's frame; the pages go in a folder beside the report), "
         "or the same as JSON or CSV. --recipes writes, for each take with medium or high findings that a step "
         "fixes, a recipe of those steps confined to their frames and joints; run it with "
-        "'motiontheater apply TAKE --recipe TAKE.toml -o FIXED', or 'motiontheater batch --recipe'."
+        "'motiontheater apply TAKE --recipe TAKE.toml -o FIXED', or every take its own at once with "
+        "'motiontheater batch INPUTS --recipe FOLDER -o FIXED'."
     ),
     epilog=(
         "Example: motiontheater check captures/ -o report.html --recipes fixes/\n"

@@ -99,6 +99,7 @@ class Result:
     output: str
     ok: bool = True
     skipped: bool = False
+    unrecipied: bool = False  # a folder of recipes holds none for this take: nothing to do
     streamed: bool = False
     error: str = ""
     bytes: int = 0
@@ -162,9 +163,8 @@ class Manifest:
     made it from inputs that have not changed since.
     """
 
-    def __init__(self, folder: str | os.PathLike, recipe: str):
+    def __init__(self, folder: str | os.PathLike):
         self.path = Path(folder) / MANIFEST
-        self.recipe = hashlib.sha256(recipe.encode()).hexdigest()
         self.entries: dict[str, dict[str, Any]] = {}
         self._log: Any = None
         for path in (self.path, Path(folder) / _OLD_MANIFEST):
@@ -182,7 +182,7 @@ class Manifest:
             _stamp(os.stat(job.skeleton)) if job.skeleton else None,
         )
         return {
-            "recipe": self.recipe,
+            "recipe": _recipe_digest(job.pipeline),
             "input": os.path.abspath(job.input),
             "stamps": [list(take), list(skeleton) if skeleton else None],  # as JSON has them
         }
@@ -254,6 +254,12 @@ def _manifest_line(key: str, entry: dict[str, Any]) -> bytes:
     return json.dumps({"output": key, **entry}).encode() + b"\n"
 
 
+@functools.lru_cache(maxsize=64)
+def _recipe_digest(pipeline: Pipeline) -> str:
+    """What the manifest notes of the recipe that made an output: its TOML's SHA-256."""
+    return hashlib.sha256(pipeline.to_toml().encode()).hexdigest()
+
+
 @functools.lru_cache(maxsize=2)
 def _read_manifest(path: str, mtime_ns: int, size: int) -> dict[str, dict[str, Any]]:
     """A manifest file's entries, parsed once while the file stays as it was: the plan reads it
@@ -280,8 +286,9 @@ def _manifest_entries(text: str) -> dict[str, dict[str, Any]]:
 def plan_jobs(
     inputs: Iterable[str],
     out: str | os.PathLike,
-    pipeline: Pipeline,
+    pipeline: Pipeline | None,
     *,
+    recipes: str | os.PathLike | None = None,
     skeleton: str | None = None,
     frame_rate: float | None = None,
     resume: bool = False,
@@ -293,7 +300,9 @@ def plan_jobs(
     allow_nan: bool = False,
 ) -> tuple[list[Job], list[Result]]:
     """The jobs to run, and the takes settled before running (not a regular file, no skeleton, or
-    already done by this recipe when resuming).  Every take's output is named before any is
+    already done by this recipe when resuming).  Each take runs ``pipeline``, or with
+    ``recipes``, a folder, its own recipe there (its path below the inputs with .toml added, as
+    ``check --recipes`` writes them; a take with none is settled as having nothing to do).  Every take's output is named before any is
     written, and the run is refused (ValueError naming both files) where an output would replace
     an input (its own, unless ``in_place``) or a skeleton the takes are read with, or where two
     takes would write the same file."""
@@ -302,8 +311,25 @@ def plan_jobs(
     folders: dict[Path, list[Path]] = {}  # the ASFs of each folder, listed once
     skeleton_stamps: dict[Path, Stamp] = {}
     reads: dict[Identity, str] = {}  # every file the run reads
+    if (pipeline is None) == (recipes is None):
+        raise ValueError("give one pipeline for every take, or a folder of recipes, one per take")
     for take, relative in found:
         target = Path(out) / relative
+        own = pipeline
+        if recipes is not None:
+            recipe = Path(recipes) / f"{relative.as_posix()}.toml"
+            if not recipe.is_file():
+                settled.append(Result(str(take), str(target), unrecipied=True))
+                continue
+            try:
+                own = Pipeline.read(recipe)
+            except (OSError, ValueError) as e:  # a recipe that cannot be read fails its take alone
+                said = str(e)
+                settled.append(
+                    Result(str(take), str(target), ok=False, error=said if str(recipe) in said else f"{recipe}: {said}")
+                )
+                continue
+        assert own is not None
         try:
             status = regular_file(take)
             reads.setdefault(_identity(status), str(take))
@@ -322,7 +348,7 @@ def plan_jobs(
                 str(take),
                 str(target),
                 str(asf) if asf else "",
-                pipeline,
+                own,
                 frame_rate,
                 stream_above,
                 chunk_frames,
@@ -337,7 +363,7 @@ def plan_jobs(
     keys = _path_keys()
     candidates = _name_outputs(candidates, keys)
     _refuse_clashes(candidates, reads, in_place, keys)
-    manifest = Manifest(out, pipeline.to_toml())
+    manifest = Manifest(out)
     jobs = []
     for job in candidates:
         if resume and manifest.done(job):
@@ -624,12 +650,13 @@ class Summary:
 
     def as_dict(self) -> dict:
         """The totals and failures, ready for JSON."""
-        done = [r for r in self.results if r.ok and not r.skipped]
+        done = [r for r in self.results if r.ok and not r.skipped and not r.unrecipied]
         processed = sum(r.bytes for r in done)
         return {
             "files": self.planned or len(self.results),
             "processed": len(done),
             "skipped": sum(r.skipped for r in self.results),
+            "without_recipe": sum(r.unrecipied for r in self.results),
             "failed": len(self.failed),
             "not_run": max(0, self.planned - len(self.results)),
             "streamed": sum(r.streamed for r in self.results),
@@ -644,7 +671,11 @@ class Summary:
     def text(self) -> str:
         """The totals in a line, then a line per failure, and why the run ended early if it did."""
         d = self.as_dict()
-        totals = f"{d['processed']} processed, {d['skipped']} skipped (already done), {d['failed']} failed of {d['files']} takes"
+        totals = (
+            f"{d['processed']} processed, {d['skipped']} skipped (already done), "
+            + (f"{d['without_recipe']} without a recipe (nothing to fix), " if d["without_recipe"] else "")
+            + f"{d['failed']} failed of {d['files']} takes"
+        )
         if d["processed"]:  # a rate of nothing done says nothing
             totals += f"; {d['megabytes']:.1f} MB in {d['seconds']:.1f} s ({d['megabytes_per_second']:.1f} MB/s)"
         lines = [totals]
@@ -678,7 +709,7 @@ def run(
     what was done, and the summary says so (``interrupted``)."""
     summary = Summary(list(settled), planned=len(settled) + len(jobs))
     progress = progress or Progress(len(jobs), sum(j.bytes for j in jobs), enabled=False)
-    manifest = Manifest(out, jobs[0].pipeline.to_toml()) if jobs else None
+    manifest = Manifest(out) if jobs else None
     _check_writable(out)
     start = time.perf_counter()
     remove_stale_partials(out, recursive=True)
