@@ -122,6 +122,19 @@ def test_steps_take_a_frame_range(cmu):
     assert not np.array_equal(part.values[99:300], take.values[99:300])
 
 
+def test_a_step_that_changes_the_skeleton_takes_no_frame_range(cmu):
+    """scale makes every length longer, the bones too: confined to frames it would scale their
+    translations alone (the root leaping ten times as far for them); it takes no range, and no
+    splice puts in frames of another skeleton."""
+    take = read(cmu / "07_05-walk.amc", cmu / "07-walk.asf")
+    with pytest.raises(ValueError, match="step 'scale' has no option 'frames'"):
+        mt.Pipeline.of("scale", factor=10.0, frames=[100, 150]).apply(take)
+    scaled = take.scale(factor=10.0)
+    np.testing.assert_allclose(scaled.positions(), 10 * take.positions(), rtol=1e-12, atol=1e-9)
+    with pytest.raises(ValueError, match="only frames can be put in"):
+        take.splice(take.crop(100, 150).scale(factor=10.0))
+
+
 def test_kernels_from_many_threads_equal_serial(rng):
     """cffi releases the GIL: the kernels keep no state, so concurrent calls give the serial results."""
     x = rng.standard_normal((3000, 9)).cumsum(axis=0)

@@ -62,7 +62,11 @@ def unroll(
     return motion.replace(values=values)
 
 
-@step("scale", "multiply every length (bones, offsets, translations) by a factor: a unit off by a known factor")
+@step(
+    "scale",
+    "multiply every length (bones, offsets, translations) by a factor: a unit off by a known factor",
+    frames="none",
+)
 def scale(
     motion: Motion, *, factor: Annotated[float, "the factor, e.g. 10 for lengths written in cm as if mm"]
 ) -> Motion:

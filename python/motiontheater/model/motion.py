@@ -207,6 +207,10 @@ class Motion:
         one's frames, as :meth:`crop` gives) put in their place; every other frame as it was."""
         if piece.skeleton.channels != self.skeleton.channels:
             raise ValueError("splice: the piece is a motion of another skeleton")
+        if piece.skeleton != self.skeleton:  # its bones, units or offsets changed: no frame range holds that
+            raise ValueError(
+                "splice: the piece's skeleton has other lengths, units or offsets; only frames can be put in"
+            )
         if not self.first_frame <= piece.first_frame <= piece.last_frame <= self.last_frame:
             raise ValueError(
                 f"splice: frames {piece.first_frame}..{piece.last_frame} are not within "
