@@ -409,6 +409,9 @@ def test_a_take_of_nan_zeros_or_huge_values_is_checked_without_a_warning(path):
     broken["zeros"] = np.zeros_like(take.values)
     broken["huge"] = take.values.copy()
     broken["huge"][: take.frames // 2] = 1e6
+    broken["infinite"] = take.values.copy()  # a number too large to write, read as infinity
+    broken["infinite"][:, 0] = np.inf
+    broken["infinite"][rng.random(take.values.shape) < 0.01] = -np.inf
     for name, values in broken.items():
         with warnings.catch_warnings():
             warnings.simplefilter("error", RuntimeWarning)

@@ -69,3 +69,29 @@ def test_feet_verbs_on_a_take_of_nan_say_so(folder, capsys, verb):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert "01_02.amc: no frame holds the legs as numbers" in err and "Singular" not in err, err  # named by the take
+
+
+def test_a_number_too_large_to_write_is_read_as_infinity_and_judged_without_numpys_warnings(data_dir):
+    """1e400 in a BVH is read as infinity: finding the body that carries the take (a channel held
+    at it spans no number) and checking the take say what they find without a RuntimeWarning."""
+    import io
+    import warnings
+
+    from motiontheater.databases.check import check_motion
+    from motiontheater.model.rig import body_view
+
+    lines = (data_dir / "bvh" / "walk01.bvh").read_text().splitlines()
+    at = next(i for i, line in enumerate(lines) if line.startswith("Frame Time")) + 1
+    for row in (0, 40, 41):
+        values = lines[at + row].split()
+        values[0 if row == 0 else 10] = "1e400"
+        lines[at + row] = " ".join(values)
+    whole = "\n".join(lines) + "\n"
+    one = "\n".join(lines[: at - 2] + ["Frames: 1", lines[at - 1], lines[at]]) + "\n"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert np.isinf(mt.read_bvh(io.BytesIO(one.encode())).values[0, 0])
+        assert body_view(mt.read_bvh(io.BytesIO(one.encode()))).body
+        take = mt.read_bvh(io.BytesIO(whole.encode()))
+        gaps = [f for f in check_motion(take) if f.kind == "gap"]
+    assert [(f.first, f.last) for f in gaps if f.first > 1] == [(41, 42)] and "infinite" in gaps[-1].detail

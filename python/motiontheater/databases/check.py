@@ -173,6 +173,9 @@ def _limits(take: _Take) -> tuple[np.ndarray, np.ndarray]:
 
 def check_motion(motion: Motion, take: str = "") -> list[Finding]:
     """Every finding of the take (named ``take`` in them), sorted by first frame, severity and kind."""
+    infinite = np.isinf(motion.values)
+    if infinite.any():  # a number too large to write, read as infinity: a value missing, as NaN is
+        motion = motion.replace(values=np.where(infinite, np.nan, motion.values))
     t = _Take(motion, take)
     findings = _unit(t)
     for finding in findings:  # lengths are judged in the unit the fix makes them
@@ -294,7 +297,7 @@ def _gaps(t: _Take, events: np.ndarray, sizes: np.ndarray) -> list[Finding]:
         out.append(
             Finding(
                 t.name, "gap", (joint,), t.frame(first), t.frame(last), severity, round(seconds, 6), "s",
-                f"{joint}: {last - first + 1} frame(s) ({seconds:.3g} s) missing (NaN)"
+                f"{joint}: {last - first + 1} frame(s) ({seconds:.3g} s) missing (NaN or infinite)"
                 + ("" if fix else ", too long or at an end of the take to fill"),
                 t.channels[c].name, fix,
             )

@@ -13,7 +13,7 @@ KINDS = {
     "spike": "a joint's rotation or position far outside its neighbours for a few frames",
     "flip": "Euler angles that jump to an equivalent triple or by a whole turn: a jump that is not motion",
     "jump": "a joint's rotation jumps and stays: a change no joint makes in one frame",
-    "gap": "missing values (NaN) in a joint's channels",
+    "gap": "missing values (NaN, or infinite) in a joint's channels",
     "frozen": "a channel held at one value while it moves before and after",
     "dead": "a channel that never moves while the joint's other channels do",
     "repeated": "frames equal to the frame before in every channel (dropped and filled by repetition)",

@@ -306,8 +306,9 @@ def _still_columns(motion: Motion) -> set[int]:
     if not len(values):
         return set(range(values.shape[1]))
     rest = motion.skeleton.rest_positions()
-    size = float(np.nanmax(np.ptp(rest, axis=0))) if len(rest) > 1 else 0.0
-    spread = np.ptp(values, axis=0)
+    with np.errstate(invalid="ignore"):  # a column held at an infinity spans NaN: not told still
+        size = float(np.nanmax(np.ptp(rest, axis=0))) if len(rest) > 1 else 0.0
+        spread = np.ptp(values, axis=0)
     return {int(c) for c in np.flatnonzero(spread <= STILL * max(size, 1.0))}
 
 
