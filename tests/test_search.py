@@ -184,6 +184,14 @@ def test_index_and_search_verbs(tmp_path, capsys):
     assert hits[0]["take"] == str(kick) and hits[0]["distance"] < 1e-9
     assert all("kickLFront" in h["take"] for h in hits), hits
     assert page.stat().st_size > 0 and "wrote" in out.err
+    # the query a take that is longer than any other, and half of it: how each was searched told
+    longest = max(HDM, key=lambda p: mt.read_take(p).frames)
+    shorter = sum(mt.read_take(p).frames < mt.read_take(longest).frames for p in HDM)
+    assert main(["search", str(db), str(longest), "-k", "1"]) == 0
+    told = capsys.readouterr().out
+    assert f"of 1 windows, 1 warped; {shorter} take(s) shorter than the query, each warped whole" in told, told
+    assert main(["search", str(db), str(longest), "-k", "1", "--frames", "1:120"]) == 0
+    assert f"; {shorter} take(s) shorter" not in capsys.readouterr().out  # a second of it fits most takes
 
 
 def test_bad_databases_and_queries_are_told_in_a_sentence(tmp_path, capsys):

@@ -89,11 +89,13 @@ def _search(args: argparse.Namespace) -> int:
     else:
         found = search(db, query, args.k)
         hits = found.hits
-        how = (
-            f"{len(hits)} of {len(db)} takes, "
-            + ("the index's candidates" if found.filtered else "every window")
-            + f": {found.windows} of {found.total} windows, {found.warped} warped"
-        )
+        parts = []
+        if found.total:
+            which = "the index's candidates" if found.filtered else "every window"
+            parts.append(f"{which}: {found.windows} of {found.total} windows, {found.warped} warped")
+        if found.whole:
+            parts.append(f"{found.whole} take(s) shorter than the query, each warped whole")
+        how = f"{len(hits)} of {len(db)} takes, " + "; ".join(parts)
     seconds = time.perf_counter() - start
     if args.json:
         json.dump([h.as_dict() for h in hits], sys.stdout, indent=1)

@@ -53,13 +53,15 @@ class Hit:
 class Found:
     """The hits, best first, and how they were found: ``windows`` ranked of ``total`` windows in
     the takes searched, ``filtered`` whether the index chose them (else every window was ranked),
-    ``warped`` the windows whose DTW was computed (the rest pruned by their lower bound)."""
+    ``warped`` the windows whose DTW was computed (the rest pruned by their lower bound), and
+    ``whole`` the takes shorter than the query, each warped whole against it."""
 
     hits: tuple[Hit, ...]
     windows: int
     total: int
     filtered: bool
     warped: int
+    whole: int = 0
 
 
 def search(
@@ -93,15 +95,14 @@ def search(
     chosen = _filtered(database, words(b), takes, m, radius, k) if use_index else None
     starts = chosen if chosen is not None else every
     hits, warped = _longer(database, q, starts, radius, k)
-    for i in searched:  # a take shorter than the query: the whole of it against the whole query
+    shorter = [i for i in searched if database.entries[i].rows < m]
+    for i in shorter:  # a take shorter than the query: the whole of it against the whole query
         e = database.entries[i]
-        if e.rows < m:
-            rows = database.poses[database.rows_of(e)]
-            distance = dtw(q, rows, m - e.rows + radius) / m
-            hits[i] = Hit(e.take, *_span(database, e, e.start, e.rows), distance)
-            warped += 1
+        rows = database.poses[database.rows_of(e)]
+        distance = dtw(q, rows, m - e.rows + radius) / m
+        hits[i] = Hit(e.take, *_span(database, e, e.start, e.rows), distance)
     ranked = sorted(hits.values(), key=lambda h: (h.distance, h.take))[:k]
-    return Found(tuple(ranked), len(starts), len(every), chosen is not None, int(warped))
+    return Found(tuple(ranked), len(starts), len(every), chosen is not None, int(warped), len(shorter))
 
 
 def _longer(database: Database, q: np.ndarray, starts: np.ndarray, radius: int, k: int) -> tuple[dict, int]:
