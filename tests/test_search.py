@@ -12,7 +12,8 @@ import pytest
 import motiontheater as mt
 from corpus import real_files
 from motiontheater.cli import main
-from motiontheater.databases.features import RELATIONS, body, describe, moves, pose_features, words
+from motiontheater.databases import features
+from motiontheater.databases.features import POINTS, RELATIONS, body, describe, moves, pose_features, words
 from motiontheater.databases.index import Database, build
 from motiontheater.databases.search import nearest_frames, search
 from mtcore.search import dtw, pack_bits
@@ -20,6 +21,7 @@ from twins.search import body_relations
 from variants import with_offset_channels, with_static_root
 
 HDM = real_files("hdm05/*.amc")
+POINT = {name: i for i, (name, _) in enumerate(POINTS)}
 TAKES = [p for p in real_files("*/*.amc") + real_files("*/*.bvh") if p.name != "rest.bvh"]
 VARIANTS = {
     "game rig": lambda take: with_static_root(with_offset_channels(take), shift=(250.0, 0.0, -400.0)),
@@ -99,6 +101,26 @@ def test_the_relations_table_states_muellers_facts_on_every_real_take(path):
     assert len(RELATIONS) == facts.shape[1] and describe(int(got[0])) == [
         name for name, on in zip(RELATIONS, facts[0]) if on
     ]
+
+
+def test_a_rig_without_hands_has_its_wrists_where_its_forearms_end():
+    """Blender's Rigify export (bvhTools test3) and MoDi end their arms at the forearm's End Site:
+    that is the wrist (a BVH joint sits where it turns: the forearm's own point is the elbow), so
+    their takes are bodies the index holds."""
+    rigs = {
+        "bvhTools_test3.bvh": ("forearm.L_End", "forearm.R_End"),
+        "MoDi_000000_joints_1_frames_64.bvh": ("L_Elbow_End", "R_Elbow_End"),
+    }
+    found = [p for name in rigs for p in real_files(f"bvh-producers/{name}")]
+    if len(found) < len(rigs):
+        pytest.skip("the real-file corpus (../shared/data/bvh-producers) is absent")
+    for path in found:
+        take = mt.read_take(path)
+        names = [take.skeleton.point_names[j] for j in features._joints(take)]
+        assert (names[POINT["left_wrist"]], names[POINT["right_wrist"]]) == rigs[path.name]
+        b = body(take)
+        forearm = np.linalg.norm(b.at("left_wrist") - b.at("left_elbow"), axis=1)
+        assert forearm.min() > 0.2 and np.ptp(forearm) < 1e-9 * forearm.max()  # a bone: as long in every frame
 
 
 def test_a_cmu_query_finds_itself_in_every_rig(tmp_path):

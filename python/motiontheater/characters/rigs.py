@@ -161,6 +161,21 @@ def _recognise(skeleton: Skeleton) -> Recognised:
     return best
 
 
+def wrist(skeleton: Skeleton, side: str) -> str | None:
+    """The point at the ``side`` ("left", "right") wrist: the rig's wrist or hand joint, or where
+    a BVH rig without hands ends its forearm, at its End Site (a BVH joint sits where it turns:
+    the forearm's own point is the elbow).  None where the rig has neither."""
+    parts = recognise(skeleton).parts
+    found = parts.get(f"{side}_wrist") or parts.get(f"{side}_hand")
+    if found:
+        return found[0]
+    forearm = parts.get(f"{side}_forearm")
+    if skeleton.convention != "bvh" or not forearm:
+        return None
+    children = skeleton.children(forearm[-1])
+    return children[0] if len(children) == 1 and skeleton.bone(children[0]).end_site else None
+
+
 def match_chain(source: Sequence[str], target: Sequence[str]) -> list[tuple[str, str]]:
     """(source, target) pairs of two chains listed from the hips up: end to end, the joints between
     by their place along the chain; the longer chain's extra joints stay unpaired."""

@@ -16,7 +16,7 @@ import numpy as np
 
 from mtcore.kinematics import JointTree, forward_kinematics
 
-from ..characters.rigs import recognise
+from ..characters.rigs import recognise, wrist
 from ..feet.contacts import runs
 from ..model.motion import Motion
 from ..model.skeleton import Skeleton
@@ -70,13 +70,13 @@ def _arms(skeleton: Skeleton) -> tuple[np.ndarray, tuple[JointTree, np.ndarray, 
     names = list(skeleton.point_names)
     arms = []
     for side in ("left", "right"):
-        wrist = parts.get(f"{side}_wrist") or parts.get(f"{side}_hand")
-        if f"{side}_upper_arm" in parts and f"{side}_forearm" in parts and wrist:
+        end = wrist(skeleton, side)
+        if f"{side}_upper_arm" in parts and f"{side}_forearm" in parts and end:
             forearm = parts[f"{side}_forearm"][0]
             turning = skeleton.parent(forearm)  # the upper arm's last joint (a roll joint's, if any)
             if turning in names:
                 arms.append((names.index(parts[f"{side}_upper_arm"][0]), names.index(turning), names.index(forearm),
-                             names.index(wrist[0])))  # fmt: skip
+                             names.index(end)))  # fmt: skip
     table = np.array(arms, dtype=np.intp).reshape(-1, 4)
     tree = skeleton.tree
     placing = table[:, [0, 2, 3]]

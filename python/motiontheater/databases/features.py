@@ -26,7 +26,7 @@ import numpy as np
 
 from mtcore.search import Relation, relations
 
-from ..characters.rigs import recognise
+from ..characters.rigs import recognise, wrist
 from ..feet.upright import take_up
 from ..model.motion import Motion
 from ..model.rig import body_joint
@@ -144,6 +144,8 @@ def _joints(motion: Motion) -> list[int]:
         joint = next(
             (parts[p.rstrip("-")][-1 if p.endswith("-") else 0] for p in tried if p.rstrip("-") in parts), None
         )
+        if joint is None and point.endswith("_wrist"):  # a rig without hands: where its forearm ends
+            joint = wrist(motion.skeleton, point.split("_")[0])
         if joint is None:
             missing.append(point)
         else:
