@@ -674,24 +674,30 @@ PACE_FRAMES = 3
 def _pace(t: _Take, joint: str, first: int, last: int) -> float:
     """The most the joint turns from one frame to the next over the PACE_FRAMES frames before
     rows first..last and after them, in degrees (0 where it has no three rotation channels)."""
-    return max(_turns(t, joint, first - PACE_FRAMES, first - 1), _turns(t, joint, last + 1, last + PACE_FRAMES))
+    return _fastest_step(t, joint, (first - PACE_FRAMES, first - 1), (last + 1, last + PACE_FRAMES))
 
 
 def _fastest(t: _Take, joint: str, first: int, last: int) -> float:
     """The fastest the joint turns from one frame to the next from the row before rows
     first..last to the row after them, in degrees per second (inf without three rotation
     channels, where the check has no other measure than the channel's own)."""
-    return _turns(t, joint, first - 1, last + 1) * t.rate if joint in t.triples else math.inf
+    return _fastest_step(t, joint, (first - 1, last + 1)) * t.rate if joint in t.triples else math.inf
 
 
-def _turns(t: _Take, joint: str, first: int, last: int) -> float:
-    """The most the joint turns from one frame to the next over rows first..last of the take, in
-    degrees (0 where it has no three rotation channels or fewer than two of those rows)."""
-    rows = np.arange(max(first, 0), min(last, t.motion.frames - 1) + 1)
-    if joint not in t.triples or len(rows) < 2:
+def _fastest_step(t: _Take, joint: str, *spans: tuple[int, int]) -> float:
+    """The most the joint turns from one frame to the next within the spans of rows (first,
+    last) of the take, in degrees (0 where it has no three rotation channels or no span two of
+    those rows): the rotations of every span's rows made at once."""
+    if joint not in t.triples:
         return 0.0
-    q = t.quaternions(joint, rows)
+    cut = [np.arange(max(a, 0), min(b, t.motion.frames - 1) + 1) for a, b in spans]
+    cut = [rows for rows in cut if len(rows) >= 2]
+    if not cut:
+        return 0.0
+    q = t.quaternions(joint, np.concatenate(cut))
     steps = _angle_deg(q[1:], q[:-1])
+    ends = np.cumsum([len(rows) for rows in cut])[:-1]
+    steps[ends - 1] = np.nan  # the step from one span's last row to the next span's first is none
     return float(np.nanmax(steps)) if not np.isnan(steps).all() else 0.0
 
 
