@@ -99,7 +99,7 @@ class Result:
     output: str
     ok: bool = True
     skipped: bool = False
-    unrecipied: bool = False  # a folder of recipes holds none for this take: nothing to do
+    no_recipe: bool = False  # a folder of recipes holds none for this take: nothing to do
     streamed: bool = False
     error: str = ""
     bytes: int = 0
@@ -319,7 +319,7 @@ def plan_jobs(
         if recipes is not None:
             recipe = Path(recipes) / f"{relative.as_posix()}.toml"
             if not recipe.is_file():
-                settled.append(Result(str(take), str(target), unrecipied=True))
+                settled.append(Result(str(take), str(target), no_recipe=True))
                 continue
             try:
                 own = Pipeline.read(recipe)
@@ -650,13 +650,13 @@ class Summary:
 
     def as_dict(self) -> dict:
         """The totals and failures, ready for JSON."""
-        done = [r for r in self.results if r.ok and not r.skipped and not r.unrecipied]
+        done = [r for r in self.results if r.ok and not r.skipped and not r.no_recipe]
         processed = sum(r.bytes for r in done)
         return {
             "files": self.planned or len(self.results),
             "processed": len(done),
             "skipped": sum(r.skipped for r in self.results),
-            "without_recipe": sum(r.unrecipied for r in self.results),
+            "without_recipe": sum(r.no_recipe for r in self.results),
             "failed": len(self.failed),
             "not_run": max(0, self.planned - len(self.results)),
             "streamed": sum(r.streamed for r in self.results),

@@ -49,13 +49,14 @@ POINTS = (
     ("right_shoulder", ("right_upper_arm",)),
     ("left_elbow", ("left_forearm",)),
     ("right_elbow", ("right_forearm",)),
-    ("left_wrist", ("left_wrist", "left_hand")),
-    ("right_wrist", ("right_wrist", "right_hand")),
+    ("left_wrist", ()),  # rigs.wrist: the wrist or hand joint, or the End Site of a hand-less forearm
+    ("right_wrist", ()),
     ("neck", ("neck", "spine-", "head")),
     ("head", ("head", "neck-")),
 )
 """Each point of the body, and the rig parts whose joint sits there (the first the rig has; of a
-chain its first joint, or with "-" its last: a rig without a head joint has its neck's top)."""
+chain its first joint, or with "-" its last: a rig without a head joint has its neck's top); the
+wrists are where :func:`motiontheater.characters.rigs.wrist` finds them."""
 _AT = {name: i for i, (name, _) in enumerate(POINTS)}
 SPEED_WEIGHT = 0.5
 """How much the hips' speed over the floor (leg lengths per second) counts against the pose."""
@@ -141,11 +142,12 @@ def _joints(motion: Motion) -> list[int]:
     names = motion.skeleton.point_names  # the rig tables name the root as the file does
     out, missing = [motion.skeleton.joint_names.index(body_joint(motion))], []  # the hips: the body's joint
     for point, tried in POINTS[1:]:
-        joint = next(
-            (parts[p.rstrip("-")][-1 if p.endswith("-") else 0] for p in tried if p.rstrip("-") in parts), None
-        )
-        if joint is None and point.endswith("_wrist"):  # a rig without hands: where its forearm ends
+        if point.endswith("_wrist"):
             joint = wrist(motion.skeleton, point.split("_")[0])
+        else:
+            joint = next(
+                (parts[p.rstrip("-")][-1 if p.endswith("-") else 0] for p in tried if p.rstrip("-") in parts), None
+            )
         if joint is None:
             missing.append(point)
         else:
@@ -272,12 +274,13 @@ RELATIONS = {
 """Müller's relational features, bit i of a frame's word being the i-th: each a measure of the
 body (leg lengths, degrees, seconds) with two thresholds, off below the first and on above the
 second, so that a fact holds steady at its edge."""
+_TABLE = tuple(RELATIONS.values())
 
 
 def words(b: Body) -> np.ndarray:
     """The relational features of each frame as one word (uint64, bit i the i-th of RELATIONS)."""
     scalars = np.stack([b.height, b.speed, b.turning], axis=1)
-    return relations(b.points, scalars, b.rate, list(RELATIONS.values())).words
+    return relations(b.points, scalars, b.rate, _TABLE).words
 
 
 def describe(word: int) -> list[str]:
