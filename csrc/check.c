@@ -223,30 +223,22 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
     return MT_OK;
 }
 
-/* x wrapped into [-period/2, period/2) (period 0: as it is). */
-static double wrapped(double x, double period)
-{
-    return period > 0.0 ? x - period * floor(x / period + 0.5) : x;
-}
-
 int mt_check_pace(const double *values, size_t rows, size_t channels, size_t stride, const double *weight,
-                  const double *period, double *moved, double *paced, double *stepped)
+                  double *moved, double *paced, double *stepped)
 {
-    if (stride < channels || (channels > 0 && (weight == NULL || period == NULL)) ||
+    if (stride < channels || (channels > 0 && weight == NULL) ||
         (rows > 0 && (moved == NULL || paced == NULL || stepped == NULL)) || (rows > 0 && channels > 0 && values == NULL) ||
         (channels > 0 && stride > SIZE_MAX / (rows > 0 ? rows : 1)))
         return MT_EINVAL;
     for (size_t k = 0; k < channels; k++)
-        if (!(weight[k] >= 0.0) || !isfinite(weight[k]) || !(period[k] >= 0.0) || !isfinite(period[k]))
+        if (!(weight[k] >= 0.0) || !isfinite(weight[k]))
             return MT_EINVAL;
     for (size_t t = 0; t < rows; t++) {
         double m2 = 0.0, dm = 0.0, d2 = 0.0;
         if (t >= 1 && t + 3 <= rows) {
             const double *a = values + (t - 1) * stride, *b = a + stride, *c = b + stride, *d = c + stride;
             for (size_t k = 0; k < channels; k++) {
-                const double into = wrapped(b[k] - a[k], period[k]), step = wrapped(c[k] - b[k], period[k]);
-                const double out = wrapped(d[k] - c[k], period[k]);
-                const double mean = (into + out) / 2;
+                const double step = c[k] - b[k], mean = ((b[k] - a[k]) + (d[k] - c[k])) / 2;
                 if (!isfinite(mean) || !isfinite(step))
                     continue; /* a gap, or values no motion reaches: other findings' */
                 m2 += weight[k] * mean * mean;

@@ -1067,19 +1067,18 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
  * The pace of a take's steps (check.c), for the rows missing between two (dropped frames).
  * Step t goes from row t to row t + 1; for 1 <= t <= rows - 3, with d_k = x[t+1] - x[t] the
  * change of channel k over the step and m_k the mean of the changes into row t and out of row
- * t + 1 (each change of a channel with period[k] > 0, an angle, wrapped into [-period/2,
- * period/2)), summed over the channels whose four values there are numbers:
+ * t + 1, summed over the channels whose four values there are finite:
  * moved[t] = sum_k weight[k] m_k^2, paced[t] = sum_k weight[k] d_k m_k and stepped[t] =
  * sum_k weight[k] d_k^2.  paced / moved is how many steps of motion the step holds: 1 where the
  * take moves on evenly, 2 where a row is missing between rows t and t + 1, and stepped - 2 s
  * paced + s^2 moved how far from s steps it lies; weight[k] >= 0 (1 / the variance of d - m
  * that noise gives the channel) makes them sums in units of that noise.  Steps 0, rows - 2 and
  * rows - 1 (every step below 4 rows) get 0.  Rows as mt_check_channels reads them (stride);
- * moved, paced and stepped have rows entries.  A weight or period that is negative or
- * not finite is MT_EINVAL.
+ * moved, paced and stepped have rows entries.  A weight that is negative or not finite is
+ * MT_EINVAL.
  */
 int mt_check_pace(const double *values, size_t rows, size_t channels, size_t stride, const double *weight,
-                  const double *period, double *moved, double *paced, double *stepped);
+                  double *moved, double *paced, double *stepped);
 
 /* MT_CDEF_END */
 

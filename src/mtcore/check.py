@@ -111,25 +111,19 @@ class Pace:
     stepped: np.ndarray
 
 
-def pace(values: ArrayLike, weight: ArrayLike, period: ArrayLike) -> Pace:
+def pace(values: ArrayLike, weight: ArrayLike) -> Pace:
     """The :class:`Pace` of the (rows, channels) values' steps, each channel weighted by
     ``weight`` (one per channel, or one for all: 1 / the variance of a step's change less the
-    mean of the changes beside it, from noise and smooth motion), its changes wrapped into a
-    ``period`` where that is above 0 (angles).  The kernel ``mt_check_pace`` (csrc/mtcore.h)."""
+    mean of the changes beside it, from noise).  The kernel ``mt_check_pace`` (csrc/mtcore.h)."""
     x = np.ascontiguousarray(values, dtype=np.float64)
     if x.ndim != 2:
         raise ValueError(f"values must be two-dimensional (rows, channels), got shape {x.shape}")
     rows, channels = x.shape
-    w, p = (_finite(a, channels, name) for a, name in ((weight, "weight"), (period, "period")))
+    w = _limits(weight, channels, "weight")
+    if not np.isfinite(w).all():
+        raise ValueError(f"weight must be finite, got {w[~np.isfinite(w)][0]}")
     moved, paced, stepped = np.zeros(rows), np.zeros(rows), np.zeros(rows)
-    status = lib.mt_check_pace(c_array(x), rows, channels, channels, c_array(w), c_array(p), c_array(moved),
+    status = lib.mt_check_pace(c_array(x), rows, channels, channels, c_array(w), c_array(moved),
                                c_array(paced), c_array(stepped))  # fmt: skip
     check(status, "mt_check_pace")
     return Pace(moved, paced, stepped)
-
-
-def _finite(value: ArrayLike, channels: int, name: str) -> np.ndarray:
-    a = _limits(value, channels, name)
-    if not np.isfinite(a).all():
-        raise ValueError(f"{name} must be finite, got {a[~np.isfinite(a)][0]}")
-    return a

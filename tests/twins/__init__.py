@@ -971,9 +971,8 @@ TWINS: dict[str, Twin] = {
     "mt_fill_gaps": Twin(fast_fill, signal_twins.fill_gaps_twin, gap_cases, close(1e-9)),
     # rows and kinds exactly; sizes and the roughness sum to rounding (both sum in row order)
     "mt_check_channels": Twin(fast_check, check.check_channels_twin, check_cases, close(1e-12)),
-    # the wrap by floor in C, by remainder in the twin: equal to rounding
     "mt_check_pace": Twin(
-        lambda x, w, p: tuple(vars(pace(x, w, p)).values()), check.pace_twin, check.pace_cases, close(1e-9)
+        lambda x, w: tuple(vars(pace(x, w)).values()), check.pace_twin, check.pace_cases, close(1e-9)
     ),
     "mt_nan_runs": Twin(
         lambda x, *_: mt_signal.nan_runs(x), lambda x, *_: signal_twins.nan_runs_twin(x), nan_run_cases, exact

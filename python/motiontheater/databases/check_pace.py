@@ -112,7 +112,7 @@ def step_pace(motion: Motion) -> kernel.Pace:
     for a, b in blocks:  # rows a-1 .. b+1: the steps a .. b-1 and their neighbours
         first = max(a - 1, 0)
         p = held if held is not None else _positions(motion, first, min(b + 2, rows))
-        pace = kernel.pace(p, weight, 0.0)
+        pace = kernel.pace(p, weight)
         sums[:, a:b] = np.stack([pace.moved, pace.paced, pace.stepped])[:, a - first : b - first]
     return kernel.Pace(*sums)
 
