@@ -110,6 +110,7 @@ BATCH = Verb(
     )
     + RECIPE_HELP,
     epilog="Example: motiontheater batch --median 5 --jobs 2 captures/ -o smoothed/\n"
-    "Example: motiontheater batch --recipe steps.toml captures/ -o cleaned/",
+    "Example: motiontheater batch --recipe steps.toml captures/ -o cleaned/\n"
+    "Example: motiontheater check captures/ --recipes fixes/ && motiontheater batch --recipe fixes/ captures/ -o fixed/",
     laid_out=True,
 )
