@@ -1080,6 +1080,42 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
 int mt_check_pace(const double *values, size_t rows, size_t channels, size_t stride, const double *weight,
                   double *moved, double *paced, double *stepped);
 
+/*
+ * The take check's measures of the legs, frame by frame (check_legs.c).  points (nlegs x
+ * frames x 5 x 3): knee, ankle, ball, heel and toe tip of each leg (as mt_leg_points gives
+ * them); hips (nlegs x frames x 3).  Lengths in any one unit, meters_per_unit metres each; a
+ * point p lies p.(up - slope) - level above the floor (up a unit vector, slope perpendicular to
+ * it, as in struct mt_footskate); rest (nlegs x 3): the heights at which heel, ball and toe tip
+ * rest on it; tips (nlegs): 1 where the leg has a toe tip.  Out:
+ *
+ *   drift (nlegs x 2 x frames), of heel and ball: where the point is on the floor, its distance
+ *       across up from where it was at the first frame of that run of frames on the floor; NaN
+ *       elsewhere.  On the floor: less than floor_height metres above its lowest along up over
+ *       the `window` frames before and after (the take's ends cut the window; NaN heights are
+ *       left out), and slower than floor_speed m/s across up (the larger of its steps to the
+ *       frames before and after, times frame_rate; 0 in a take of one frame).
+ *   depth (nlegs x frames): how far below where it rests the lowest of heel, ball and (with a
+ *       tip) toe tip lies; NaN where none is a number.
+ *   back (nlegs x frames): the degrees the knee bends backwards: the angle between thigh (hip
+ *       to knee) and shin (knee to ankle) where the turn from thigh to shin goes the other way
+ *       round than the turn from shin to foot (ankle to ball), the foot lies across the shin
+ *       (the cosine between them under foot_across: a pointed foot along the shin tells
+ *       nothing) and the bend is under `folded` degrees (a knee folded further turns its hinge
+ *       with the thigh); 0 elsewhere, and where a point is NaN.
+ *
+ * MT_ENOMEM where scratch of 4 x frames numbers cannot be had.
+ */
+struct mt_leg_check {
+    double up[3], slope[3], level;
+    double meters_per_unit, frame_rate;
+    size_t window;
+    double floor_height, floor_speed;
+    double foot_across, folded;
+};
+
+int mt_check_legs(const double *points, const double *hips, size_t nlegs, size_t frames, const double *rest,
+                  const int *tips, const struct mt_leg_check *check, double *drift, double *depth, double *back);
+
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

@@ -5,6 +5,7 @@ is :mod:`motiontheater.databases.check`'s."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,7 +16,21 @@ from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._status import check
 
-__all__ = ["FROZEN", "GAP", "KINDS", "REPEAT", "SPIKE", "STEP", "ChannelEvents", "Pace", "channel_events", "pace"]
+__all__ = [
+    "FROZEN",
+    "GAP",
+    "KINDS",
+    "REPEAT",
+    "SPIKE",
+    "STEP",
+    "ChannelEvents",
+    "LegCheck",
+    "LegMeasures",
+    "Pace",
+    "channel_events",
+    "leg_measures",
+    "pace",
+]
 
 GAP, FROZEN, SPIKE, STEP, REPEAT = (
     lib.MT_CHECK_GAP,
@@ -127,3 +142,79 @@ def pace(values: ArrayLike, weight: ArrayLike) -> Pace:
                                c_array(paced), c_array(stepped))  # fmt: skip
     check(status, "mt_check_pace")
     return Pace(moved, paced, stepped)
+
+
+@dataclass(frozen=True)
+class LegCheck:
+    """What :func:`leg_measures` needs besides the legs: the floor (a point p lies p . (up -
+    slope) - level above it; ``up`` a unit vector, ``slope`` perpendicular to it), the unit
+    (``meters_per_unit``) and rate (Hz), and the limits, physical: a foot point is on the floor
+    less than ``floor_height`` metres above its lowest over the ``window`` frames before and
+    after, and slower than ``floor_speed`` m/s across up; a knee's backwards bend is told where
+    the foot lies across the shin (their cosine under ``foot_across``) and the bend is under
+    ``folded`` degrees."""
+
+    up: tuple[float, float, float]
+    slope: tuple[float, float, float]
+    level: float
+    meters_per_unit: float
+    frame_rate: float
+    window: int
+    floor_height: float
+    floor_speed: float
+    foot_across: float
+    folded: float
+
+    def as_struct(self):
+        """The settings as the kernel takes them (``struct mt_leg_check``)."""
+        up, slope = _checks.real(self.up, "up", (3,)), _checks.real(self.slope, "slope", (3,))
+        if not np.isfinite(up).all() or abs(float(np.linalg.norm(up)) - 1) > 1e-9:
+            raise ValueError(f"up must be a unit vector of 3, got {self.up}")
+        if not np.isfinite(slope).all() or abs(float(slope @ up)) > 1e-9:
+            raise ValueError(f"slope must be a finite vector of 3 perpendicular to up, got {self.slope}")
+        for name in ("level", "meters_per_unit", "frame_rate", "floor_height", "floor_speed", "foot_across", "folded"):
+            if not math.isfinite(getattr(self, name)):
+                raise ValueError(f"{name} must be finite, got {getattr(self, name)}")
+        if not (self.meters_per_unit > 0 and self.frame_rate > 0):
+            raise ValueError(
+                f"meters_per_unit and frame_rate must be positive, got {self.meters_per_unit}, {self.frame_rate}"
+            )
+        settings = ffi.new("struct mt_leg_check *")
+        settings.up, settings.slope = up.tolist(), slope.tolist()
+        settings.window = _checks.integer(self.window, "window", 0)
+        for name in ("level", "meters_per_unit", "frame_rate", "floor_height", "floor_speed", "foot_across", "folded"):
+            setattr(settings, name, float(getattr(self, name)))
+        return settings
+
+
+@dataclass(frozen=True)
+class LegMeasures:
+    """The legs frame by frame, as ``mt_check_legs`` (csrc/mtcore.h) measures them, in the
+    points' unit and degrees: ``drift`` (legs, 2, frames) of heel and ball, how far the point has
+    moved across up since its run of frames on the floor began (NaN off the floor); ``depth``
+    (legs, frames), how far the lowest of heel, ball and toe tip lies below where it rests;
+    ``back`` (legs, frames), how far the knee bends backwards (0: it does not, or cannot tell)."""
+
+    drift: np.ndarray
+    depth: np.ndarray
+    back: np.ndarray
+
+
+def leg_measures(
+    points: ArrayLike, hips: ArrayLike, rest: ArrayLike, tips: ArrayLike, settings: LegCheck
+) -> LegMeasures:
+    """The :class:`LegMeasures` of legs given as ``points`` (legs, frames, 5, 3: knee, ankle,
+    ball, heel, toe tip; :func:`mtcore.footskate.leg_points`) and ``hips`` (legs, frames, 3),
+    their feet resting at heights ``rest`` (legs, 3: heel, ball, tip) above the floor, ``tips``
+    (legs) telling which legs have a toe tip."""
+    p = _checks.real(points, "points", (None, None, 5, 3))
+    legs, frames = p.shape[:2]
+    h = _checks.real(hips, "hips", (legs, frames, 3))
+    r = _checks.real(rest, "rest", (legs, 3))
+    t = np.ascontiguousarray(np.broadcast_to(np.asarray(tips, dtype=bool), (legs,)), dtype=np.intc)
+    struct = settings.as_struct()
+    drift, depth, back = np.empty((legs, 2, frames)), np.empty((legs, frames)), np.empty((legs, frames))
+    status = lib.mt_check_legs(c_array(p), c_array(h), legs, frames, c_array(r), c_array(t, "int[]"), struct,
+                               c_array(drift), c_array(depth), c_array(back))  # fmt: skip
+    check(status, "mt_check_legs")
+    return LegMeasures(drift, depth, back)

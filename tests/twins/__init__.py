@@ -28,6 +28,7 @@ from mtcore import search as mt_search
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
 from mtcore.check import channel_events, pace
+from mtcore.check import leg_measures as check_legs
 from mtcore.combine import combine_frames
 from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
 from mtcore.retarget import RetargetPlan, retarget_rotations
@@ -973,6 +974,13 @@ TWINS: dict[str, Twin] = {
     "mt_check_channels": Twin(fast_check, check.check_channels_twin, check_cases, close(1e-12)),
     "mt_check_pace": Twin(
         lambda x, w: tuple(vars(pace(x, w)).values()), check.pace_twin, check.pace_cases, close(1e-9)
+    ),
+    # acos in the knee's bend, the floor's heights and drifts summed as the contract says
+    "mt_check_legs": Twin(
+        lambda *case: tuple(vars(check_legs(*case)).values()),
+        check.check_legs_twin,
+        check.check_legs_cases,
+        close(1e-9),
     ),
     "mt_nan_runs": Twin(
         lambda x, *_: mt_signal.nan_runs(x), lambda x, *_: signal_twins.nan_runs_twin(x), nan_run_cases, exact

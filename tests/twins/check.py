@@ -126,3 +126,79 @@ def pace_cases(rng: np.random.Generator) -> list[tuple]:
         weight = rng.uniform(0, 2, channels)
         out.append((x, weight))
     return out + [(np.zeros((6, 0)), 1.0)]
+
+
+def check_legs_twin(points, hips, rest, tips, settings):
+    """The legs' measures frame by frame from the contract: every window's lowest searched, every
+    run of frames on the floor walked from its start."""
+    p, hips = np.asarray(points, float), np.asarray(hips, float)
+    legs, frames = p.shape[:2]
+    up, slope = np.asarray(settings.up, float), np.asarray(settings.slope, float)
+    mpu, w = settings.meters_per_unit, settings.window
+    drift = np.full((legs, 2, frames), math.nan)
+    depth, back = np.full((legs, frames), math.nan), np.zeros((legs, frames))
+    for i in range(legs):
+        for t in range(frames):
+            knee, ankle, ball, heel, tip = p[i, t]
+            thigh, shin, foot = knee - hips[i, t], ankle - knee, ball - ankle
+            with np.errstate(all="ignore"):
+                bend = math.degrees(
+                    math.acos(np.clip(thigh @ shin / (np.linalg.norm(thigh) * np.linalg.norm(shin)), -1, 1))
+                )
+                across = abs(shin @ foot / (np.linalg.norm(shin) * np.linalg.norm(foot)))
+                turn = np.cross(thigh, shin) @ np.cross(shin, foot)
+            if turn > 0 and across < settings.foot_across and bend < settings.folded:
+                back[i, t] = bend
+            points_resting = (heel, ball, tip)[: 3 if tips[i] else 2]
+            heights = [(q @ (up - slope) - settings.level) - rest[i][k] for k, q in enumerate(points_resting)]
+            finite = [h for h in heights if not math.isnan(h)]
+            if finite:
+                depth[i, t] = -min(finite)
+        for k, index in enumerate((3, 2)):  # heel, ball
+            q = p[i, :, index]
+            h = q @ up
+            flat = q - h[:, None] * up
+            steps = [np.linalg.norm(flat[t + 1] - flat[t]) * settings.frame_rate for t in range(frames - 1)]
+            start = None
+            for t in range(frames):
+                around = [x for x in h[max(0, t - w) : t + w + 1] if not math.isnan(x)]
+                lift = h[t] - min(around) if around else math.nan
+                beside = [steps[s] for s in (t - 1, t) if 0 <= s < frames - 1]
+                speed = 0.0 if frames == 1 else (math.nan if any(map(math.isnan, beside)) else max(beside))
+                if lift * mpu < settings.floor_height and speed * mpu < settings.floor_speed:
+                    start = t if start is None else start
+                    drift[i, k, t] = np.linalg.norm(flat[t] - flat[start])
+                else:
+                    start = None
+    return drift, depth, back
+
+
+def check_legs_cases(rng: np.random.Generator) -> list[tuple]:
+    """Legs that stand, slide and step (feet resting on the floor for stretches, then lifted),
+    knees bent both ways, NaN frames; y-up and z-down floors, sloped; windows from none to
+    beyond the take."""
+    from mtcore.check import LegCheck
+
+    out = []
+    for legs, frames, window, up in ((0, 5, 2, (0, 1, 0)), (1, 0, 2, (0, 1, 0)), (1, 1, 3, (0, 1, 0)),
+                                     (2, 2, 0, (0, 0, -1)), (2, 9, 1, (0, 1, 0)), (2, 80, 6, (0, 0, -1)),
+                                     (1, 40, 100, (1, 0, 0))):  # fmt: skip
+        up = np.array(up, float)
+        slope = np.zeros(3)
+        slope[np.flatnonzero(up == 0)[0]] = 0.02
+        lifted = np.where(np.sin(np.arange(frames) / 6.0) > 0.3, 0.15, 0.0)  # steps
+        slide = np.cumsum(rng.normal(0, 0.01, frames)) * (np.arange(frames) % 30 < 15)
+        points = rng.normal(0, 0.3, (legs, frames, 5, 3))
+        for i in range(legs):
+            for k in (2, 3):  # ball and heel: on the floor, sliding, lifted
+                points[i, :, k] = rng.normal(0, 0.002, (frames, 3)) + slide[:, None] * np.roll(up, 1)
+                points[i, :, k] += (lifted * (i + 1) + 0.01 * k)[:, None] * up
+        hips = points[:, :, 0] + rng.normal(0, 0.4, (legs, frames, 3))
+        if frames > 10:
+            points[0, 4, 3] = math.nan
+            points[-1, 7:9] = math.nan
+        tips = rng.random(legs) < 0.5
+        settings = LegCheck(tuple(up), tuple(slope), float(rng.normal(0, 0.01)), 0.9, 120.0, window, 0.03, 0.6,
+                            math.cos(math.radians(45)), 90.0)  # fmt: skip
+        out.append((points, hips, rng.uniform(0, 0.05, (legs, 3)), tips, settings))
+    return out

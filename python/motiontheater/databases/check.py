@@ -111,6 +111,7 @@ class _Take:
         self.degrees = 1.0 if skeleton.angle_unit == "deg" else 180.0 / math.pi  # degrees per file unit
         self.root = body_joint(motion)  # the joint that carries the body (a static root above it is no body)
         self.channels, self.triples, self._columns = skeleton.derived("check channels", lambda: _channels(skeleton))
+        self._quaternions: dict[str, np.ndarray] = {}
 
     def frame(self, row: int) -> int:
         return self.motion.first_frame + int(row)
@@ -131,9 +132,15 @@ class _Take:
         return "deg" if channel.turns else "m"
 
     def quaternions(self, joint: str, rows: np.ndarray) -> np.ndarray:
-        order, extrinsic, columns = self.triples[joint]
-        angles = self.motion.values[np.ix_(rows, columns)]
-        return euler_to_quaternions(angles, order, extrinsic=extrinsic, degrees=self.degrees == 1.0)
+        """The joint's rotations at the rows, of every row made once (candidates ask for the
+        rows around them again and again)."""
+        made = self._quaternions.get(joint)
+        if made is None:
+            order, extrinsic, columns = self.triples[joint]
+            angles = self.motion.values[:, columns]
+            made = euler_to_quaternions(angles, order, extrinsic=extrinsic, degrees=self.degrees == 1.0)
+            self._quaternions[joint] = made
+        return made[rows]
 
 
 _NONE = np.zeros(0, np.intp)
@@ -609,7 +616,7 @@ def _apart(t: _Take, joint: str, first: int, last: int) -> float:
         q = t.quaternions(joint, np.array([first, last]))
         return float(_angle_deg(q[0], q[1]))
     columns = t.columns(joint, True)
-    block = np.unwrap(t.motion.values[first : last + 1, columns], axis=0, period=t.motion.skeleton.period)
+    block = _unwrapped(t.motion.values[first : last + 1, columns], t.motion.skeleton.period)
     return float(np.nan_to_num(np.abs(block[-1] - block[0]), nan=np.inf).max()) * t.degrees
 
 
@@ -661,11 +668,20 @@ def _deviations(t: _Take, joint: str, turns: bool, first: int, last: int) -> np.
     if np.isnan(block).any():
         return None
     if turns:
-        block = np.unwrap(block, axis=0, period=t.motion.skeleton.period)
+        block = _unwrapped(block, t.motion.skeleton.period)
     block = block * (t.degrees if turns else t.meters)
     line = block[0] + share[:, None] * (block[-1] - block[0])
     off = block[1:-1] - line
     return np.abs(off).max(axis=1) if turns else np.linalg.norm(off, axis=1)
+
+
+def _unwrapped(block: np.ndarray, period: float) -> np.ndarray:
+    """The block's columns unwrapped along its rows (numpy's unwrap), skipped where no step
+    between rows reaches half a turn: there unwrapping changes nothing, and nearly every block of
+    a candidate is so."""
+    if (np.abs(np.diff(block, axis=0)) < period / 2).all():
+        return block
+    return np.unwrap(block, axis=0, period=period)
 
 
 PACE_FRAMES = 3

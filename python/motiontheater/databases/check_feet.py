@@ -17,12 +17,11 @@ import warnings
 
 import numpy as np
 
-from mtcore.search import lb_envelope
+from mtcore.check import LegCheck, leg_measures
 
 from ..feet.contacts import runs
 from ..feet.footskate import prepare
-from ..feet.legs import Ground, LegArrays, speeds
-from ..feet.skate import knee_bends
+from ..feet.legs import Ground, LegArrays
 from ..model.motion import Motion
 from ..model.rig import body_view
 from .findings import Finding
@@ -43,8 +42,10 @@ FLOOR_M = 0.15
 centre rests a few centimetres above the sole)."""
 KNEE_BACK_DEG = 20.0
 """Degrees a knee may bend backwards (past straight; 5-10 degrees is human) before it is bent
-backwards; 45 is high.  Bends the other way deeper than 90 degrees are not counted: there the
-knee's hinge turns with the thigh and says nothing of which way the knee bends."""
+backwards; 45 is high."""
+KNEE_FOLDED_DEG = 90.0
+"""Bends the other way deeper than this are not counted: there the knee's hinge turns with the
+thigh and says nothing of which way the knee bends."""
 FOOT_ACROSS = math.cos(math.radians(45))
 """A foot within 45 degrees of square to the shin tells which way the knee bends."""
 STRIDE_ALIKE = 0.75
@@ -86,6 +87,18 @@ class _Legs:
         self.up = np.asarray(ground.up)
         view = body_view(motion).motion  # the cleanup moves the body: it needs its translation
         self.movable = {"tx", "ty", "tz"} <= set(view.skeleton.dofs("root"))
+        rate = motion.frame_rate
+        # the heel or ball on the floor: within SKATE_HEIGHT of its lowest in the SKATE_AROUND
+        # seconds around (not the fitted floor, which moves with the frames that rest: a foot that
+        # slides rests in none; nor its lowest over the take, which a crouch or a step down sets
+        # elsewhere), slower than SKATE_SPEED (a swinging foot passes lower, but faster)
+        settings = LegCheck(
+            ground.up, ground.slope, ground.level, mpu, rate, max(1, round(SKATE_AROUND * rate)),
+            SKATE_HEIGHT, SKATE_SPEED, FOOT_ACROSS, KNEE_FOLDED_DEG,
+        )  # fmt: skip
+        self.measures = leg_measures(
+            arrays.points, arrays.hips, ground.clearance, arrays.legs.points[:, 4] >= 0, settings
+        )
 
     def frame(self, row: int) -> int:
         return self.motion.first_frame + int(row)
@@ -105,26 +118,15 @@ class _Legs:
     def skates(self) -> list[Finding]:
         """Runs of frames in which a heel or ball stays on the floor and slower than a step, over
         which it slides farther than SKATE_M: found without the footplants, which a slide splits."""
-        arrays, legs = self.arrays, self.arrays.legs
         shortest = max(2, round(SKATE_SECONDS * self.motion.frame_rate))
-        window = max(1, round(SKATE_AROUND * self.motion.frame_rate))
         out = []
-        for i, foot in enumerate(legs.feet):
+        for i, foot in enumerate(self.arrays.legs.feet):
             slides = []  # (first row, last row, metres, point)
-            for k, (column, point) in enumerate(((3, "heel"), (2, "ball"))):
-                p = arrays.points[i, :, column]
-                vertical = p @ self.up
-                p = p - vertical[:, None] * self.up
-                # the height above the point's own lowest in the seconds around (not the fitted
-                # floor, which moves with the frames that rest: a foot that slides rests in none;
-                # nor its lowest over the take, which a crouch or a step down sets elsewhere)
-                low = (vertical - _lowest_around(vertical, window)) * self.mpu < SKATE_HEIGHT
-                slow = speeds(p, self.motion.frame_rate) * self.mpu < SKATE_SPEED
-                for s, e in zip(*runs(low & slow)):
-                    if e - s < shortest:
-                        continue
-                    slide = float(np.linalg.norm(p[s:e] - p[s], axis=-1).max()) * self.mpu
-                    if slide > SKATE_M:
+            for k, point in enumerate(("heel", "ball")):
+                drift = self.measures.drift[i, k]
+                for s, e in zip(*runs(~np.isnan(drift))):
+                    slide = float(drift[s:e].max()) * self.mpu
+                    if e - s >= shortest and slide > SKATE_M:
                         slides.append((int(s), int(e) - 1, slide, point))
             for first, last, slide, point in _merged(slides):
                 out.append(
@@ -138,15 +140,10 @@ class _Legs:
         return out
 
     def penetrations(self) -> list[Finding]:
-        legs = self.arrays.legs
-        heights = self.ground.heights(self.arrays.points) * self.mpu  # (legs, frames, 3) heel, ball, tip
         shortest = max(1, round(PENETRATION_SECONDS * self.motion.frame_rate))
         out = []
-        for i, foot in enumerate(legs.feet):
-            points = 3 if legs.points[i, 4] >= 0 else 2
-            with np.errstate(invalid="ignore"), warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)  # frames of NaN (a gap) sink nowhere
-                depth = -np.nanmin(heights[i, :, :points], axis=1)
+        for i, foot in enumerate(self.arrays.legs.feet):
+            depth = self.measures.depth[i] * self.mpu  # NaN where the foot is a gap: it sinks nowhere
             for s, e in zip(*runs(np.nan_to_num(depth) > PENETRATION_M)):
                 if e - s < shortest:
                     continue
@@ -173,23 +170,15 @@ class _Legs:
         ]  # fmt: skip
 
     def knees(self) -> list[Finding]:
-        arrays, legs = self.arrays, self.arrays.legs
-        thigh = arrays.points[:, :, 0] - arrays.hips
-        shin = arrays.points[:, :, 1] - arrays.points[:, :, 0]
-        foot = arrays.points[:, :, 2] - arrays.points[:, :, 1]
-        with np.errstate(invalid="ignore", divide="ignore"):  # a frame of NaN, a leg of no length: no bend
-            bends = knee_bends(arrays)
-            across = np.abs(_cosine(shin, foot)) < FOOT_ACROSS
-        # a knee bends the shin away from where the foot points: the turn from thigh to shin is
-        # the other way round than the turn from shin to foot, at any bend and any hip; told only
-        # where the foot stands across the shin (a pointed foot lies along it) and the knee is
-        # not folded (where the turns' axes are of little length)
-        turns = np.sum(np.cross(thigh, shin) * np.cross(shin, foot), axis=-1)
-        backwards = np.where((turns > 0) & across & (bends < 90), bends, 0.0)
+        """Knees bent backwards: a knee bends the shin away from where the foot points, so the
+        turn from thigh to shin is the other way round than the turn from shin to foot, at any
+        bend and any hip (told only where the foot stands across the shin, and the knee is not
+        folded: see :func:`mtcore.check.leg_measures`)."""
         out = []
-        for i, leg in enumerate(legs.legs):
-            for s, e in zip(*runs(backwards[i] > KNEE_BACK_DEG)):
-                worst = float(backwards[i, s:e].max())
+        for i, leg in enumerate(self.arrays.legs.legs):
+            backwards = self.measures.back[i]
+            for s, e in zip(*runs(backwards > KNEE_BACK_DEG)):
+                worst = float(backwards[s:e].max())
                 out.append(
                     Finding(
                         self.take, "knee", (leg.knee,), self.frame(s), self.frame(e - 1),
@@ -256,19 +245,6 @@ def _stride(alternation: np.ndarray) -> int | None:
         return None
     lag = int(below[0] + np.argmax(alike[below[0] : n // 2]))
     return lag if alike[lag] >= STRIDE_ALIKE else None
-
-
-def _lowest_around(x: np.ndarray, half: int) -> np.ndarray:
-    """The least of x over the ``half`` samples before and after each (NaN ignored): the lower
-    LB_Keogh envelope, a running minimum in C."""
-    finite = np.isfinite(x)
-    if not finite.any():
-        return np.full_like(x, np.nan)
-    return lb_envelope(np.where(finite, x, np.max(x[finite])), half).lower[:, 0]
-
-
-def _cosine(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.sum(a * b, -1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
 
 
 def _merged(slides: list[tuple[int, int, float, str]]) -> list[tuple[int, int, float, str]]:
