@@ -1081,6 +1081,39 @@ int mt_check_pace(const double *values, size_t rows, size_t channels, size_t str
                   double *moved, double *paced, double *stepped);
 
 /*
+ * Where the feet rest, and the floor they rest on (ground.c).  points (nlegs x frames x 5 x 3) as
+ * mt_leg_points gives them; their contact points are heel, ball and toe tip, k = 0, 1, 2 in that
+ * order; tips (nlegs): 1 where a leg has a toe tip; up: a signed coordinate axis.
+ *
+ * mt_resting_points: resting (nlegs x frames x 3) is 1 where contact point k rests: slower than
+ * rest_speed m/s (its speed the larger of its steps to the frames before and after, times
+ * frame_rate, in metres by meters_per_unit; 0 in a take of one frame) with a height along up that
+ * is a number.  A point that rests so in fewer than `needed` frames rests instead in the
+ * `needed` slowest of the frames where it lies no higher than the 20th percentile of its heights
+ * (numpy's linear percentile, NaN left out; ties in frame order, NaN speeds last), those of them
+ * with a height.  A leg without a toe tip has no resting tip.
+ *
+ * mt_fit_floor: the floor under the resting samples: heights along up z = g . (x, y) + c_p,
+ * (x, y) a sample's horizontal coordinates (the axes where up is 0, in order) less their mean over
+ * the samples, c_p a rest height per contact point that has samples, fitted by least squares to
+ * every s-th resting sample in the order leg, frame, point (s the least that leaves at most
+ * `samples` of them), the gradient held back by a ridge of sqrt(samples taken) * prior on each of
+ * its components; fitted three times, each time to the samples less than `band` above the last
+ * fit.  A gradient longer than max_tilt is shortened to it.  Out: slope (3; the gradient, 0
+ * along up), level (where the floor meets the line of up through the horizontal origin: the lowest
+ * rest height less slope . the samples' mean), clearance (nlegs x 3): each contact point's rest
+ * height above the lowest (0 for a point without samples; a leg without a toe tip gets its
+ * ball's for its tip).  MT_EINVAL where up is no coordinate axis, nothing rests or the equations
+ * are singular.
+ */
+int mt_resting_points(const double *points, size_t nlegs, size_t frames, const int *tips, const double *up,
+                      double frame_rate, double meters_per_unit, double rest_speed, size_t needed,
+                      unsigned char *resting);
+int mt_fit_floor(const double *points, const unsigned char *resting, size_t nlegs, size_t frames, const int *tips,
+                 const double *up, double band, double prior, size_t samples, double max_tilt, double *level,
+                 double *slope, double *clearance);
+
+/*
  * The take check's measures of the legs, frame by frame (check_legs.c).  points (nlegs x
  * frames x 5 x 3): knee, ankle, ball, heel and toe tip of each leg (as mt_leg_points gives
  * them); hips (nlegs x frames x 3).  Lengths in any one unit, meters_per_unit metres each; a

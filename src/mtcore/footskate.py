@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _checks
 from ._cdata import c_array
 from ._mtcore import ffi, lib
 from ._parallel import run_all, thread_count
@@ -38,10 +39,12 @@ __all__ = [
     "PlantThresholds",
     "adjust_root",
     "cleanup",
+    "fit_floor",
     "leg_points",
     "plan_leg",
     "plant_masks",
     "point_speeds",
+    "resting_points",
     "solve_leg",
     "write_channels",
 ]
@@ -635,3 +638,54 @@ def plant_masks(heights, speed, central, thresholds: PlantThresholds) -> np.ndar
         "mt_plant_masks",
     )
     return mask.view(bool)
+
+
+def _contact_legs(points, tips, up) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points (legs, frames, 5, 3), which legs have a toe tip as C ints, and up as a signed axis."""
+    p = np.ascontiguousarray(points, dtype=np.float64)
+    if p.ndim != 4 or p.shape[2:] != (5, 3):
+        raise ValueError(f"points must have shape (legs, frames, 5, 3), got {p.shape}")
+    t = np.ascontiguousarray(np.broadcast_to(np.asarray(tips, dtype=bool), p.shape[:1]), dtype=np.intc)
+    u = _doubles(up, "up", (3,))
+    if np.count_nonzero(u) != 1 or abs(u).max() != 1.0:
+        raise ValueError(f"up must be a signed coordinate axis such as (0, 1, 0), got {u.tolist()}")
+    return p, t, u
+
+
+def resting_points(points, tips, up, frame_rate: float, meters_per_unit: float, rest_speed: float, needed: int):
+    """Where each leg's heel, ball and toe tip rest: (legs, frames, 3) booleans, ``points`` (legs,
+    frames, 5, 3) as :func:`leg_points` gives them, ``tips`` (legs) which legs have a toe tip.  A
+    point rests where it is slower than ``rest_speed`` m/s; one that rests so in fewer than
+    ``needed`` frames rests in the ``needed`` slowest of its frames no higher along ``up`` (a
+    signed coordinate axis) than its 20th percentile (``mt_resting_points``, csrc/mtcore.h)."""
+    p, t, u = _contact_legs(points, tips, up)
+    legs, frames = p.shape[:2]
+    rate, meters = float(frame_rate), float(meters_per_unit)
+    if not (rate > 0 and meters > 0 and math.isfinite(rate * meters)):
+        raise ValueError(f"frame_rate and meters_per_unit must be positive, got {frame_rate}, {meters_per_unit}")
+    resting = np.zeros((legs, frames, 3), dtype=np.uint8)
+    status = lib.mt_resting_points(c_array(p), legs, frames, c_array(t, "int[]"), c_array(u), rate, meters,
+                                   float(rest_speed), _checks.integer(needed, "needed", 0),
+                                   c_array(resting, "unsigned char[]"))  # fmt: skip
+    check(status, "mt_resting_points")
+    return resting.view(bool)
+
+
+def fit_floor(points, resting, tips, up, band: float, prior: float, samples: int, max_tilt: float):
+    """The floor under the resting contact points (``resting`` as :func:`resting_points` gives
+    it): (level, slope (3,), clearance (legs, 3)) by least squares with a rest height per point,
+    refitted twice without the samples more than ``band`` above the fit (``mt_fit_floor``,
+    csrc/mtcore.h); ValueError where nothing rests."""
+    p, t, u = _contact_legs(points, tips, up)
+    legs, frames = p.shape[:2]
+    rests = np.ascontiguousarray(resting, dtype=np.uint8)
+    if rests.shape != (legs, frames, 3):
+        raise ValueError(f"resting must have shape ({legs}, {frames}, 3), got {rests.shape}")
+    if not rests.any():
+        raise ValueError("no contact point rests in any frame: there is no floor to fit")
+    level, slope, clearance = ffi.new("double *"), np.zeros(3), np.zeros((legs, 3))
+    status = lib.mt_fit_floor(c_array(p), c_array(rests, "unsigned char[]"), legs, frames, c_array(t, "int[]"),
+                              c_array(u), float(band), float(prior), _checks.integer(samples, "samples", 1),
+                              float(max_tilt), level, c_array(slope), c_array(clearance))  # fmt: skip
+    check(status, "mt_fit_floor")
+    return float(level[0]), slope, clearance

@@ -998,6 +998,9 @@ TWINS: dict[str, Twin] = {
     "mt_footskate_solve": Twin(fast_solve, slow_solve, solve_cases, close(1e-6)),
     "mt_footskate_write": Twin(fs.write_channels, footskate.write_channels, write_cases, exact),
     "mt_plant_masks": Twin(fs.plant_masks, footskate.plant_masks, plant_cases, exact),
+    "mt_resting_points": Twin(fs.resting_points, footskate.resting_points, footskate.ground_cases, exact),
+    # LAPACK's solve against elimination: the same system, rounded otherwise
+    "mt_fit_floor": Twin(fs.fit_floor, footskate.fit_floor, footskate.fit_cases, close(1e-9)),
     "mt_point_speeds": Twin(
         lambda p, which, rate, central: fs.point_speeds(p, which, rate, central=central),
         lambda p, which, rate, central: footskate.point_speeds(p, which, rate, central=central),

@@ -765,3 +765,88 @@ def plant_masks(heights, speed, central, th):
         np.add.at(edges, last[keep], -1)
         out[r] = np.cumsum(edges[:-1]) > 0
     return out
+
+
+CONTACT = [3, 2, 4]  # heel, ball, tip among a leg's points
+
+
+def resting_points(points, tips, up, frame_rate, meters_per_unit, rest_speed, needed):
+    """Where the contact points rest, over all frames at once: the speeds and heights, then the
+    slowest low frames of each point that rests too seldom (a stable sort: ties in frame order)."""
+    points, up = np.asarray(points, float), np.asarray(up, float)
+    speed = point_speeds(points, CONTACT, frame_rate).transpose(0, 2, 1) * meters_per_unit
+    vertical = dot(points[:, :, CONTACT], up)
+    resting = speed < rest_speed
+    for i in range(points.shape[0]):
+        for k in range(3):
+            if resting[i, :, k].sum() < needed and np.isfinite(vertical[i, :, k]).any():
+                low = vertical[i, :, k] <= np.nanpercentile(vertical[i, :, k], 20)
+                slow = np.argsort(np.where(low, speed[i, :, k], np.inf), kind="stable")[:needed]
+                resting[i, slow, k] = True
+    resting[~np.asarray(tips, bool), :, 2] = False
+    return resting & np.isfinite(vertical)
+
+
+def fit_floor(points, resting, tips, up, band, prior, samples, max_tilt):
+    """The floor's normal equations summed by numpy and solved by LAPACK, three times."""
+    points, up, tips = np.asarray(points, float), np.asarray(up, float), np.asarray(tips, bool)
+    legs, frames = points.shape[:2]
+    horizontal = [a for a in range(3) if up[a] == 0]
+    where = np.flatnonzero(resting)
+    where = where[:: -(-len(where) // samples)] if len(where) > samples else where
+    ids, point = np.unique((where // 3 // frames) * 3 + where % 3, return_inverse=True)
+    flat = points.reshape(-1, 5, 3)[where // 3, np.take(CONTACT, where % 3)]
+    centre = flat[:, horizontal].mean(axis=0)
+    x, y = flat[:, horizontal[0]] - centre[0], flat[:, horizontal[1]] - centre[1]
+    z = flat @ up
+    ridge = np.sqrt(len(z)) * prior
+    keep, n = np.ones(len(z), bool), len(ids)
+    for _ in range(3):
+        w = keep.astype(float)
+        a = np.zeros((2 + n, 2 + n))
+        a[0, 0], a[1, 1] = (w * x * x).sum() + ridge**2, (w * y * y).sum() + ridge**2
+        a[0, 1] = a[1, 0] = (w * x * y).sum()
+        a[0, 2:] = a[2:, 0] = np.bincount(point, w * x, n)
+        a[1, 2:] = a[2:, 1] = np.bincount(point, w * y, n)
+        a[2:, 2:] = np.diag(np.bincount(point, w, n))
+        b = np.concatenate(([(w * x * z).sum(), (w * y * z).sum()], np.bincount(point, w * z, n)))
+        coef = np.linalg.solve(a, b)
+        keep = z - (coef[0] * x + coef[1] * y + coef[2:][point]) < band
+    gradient = coef[:2] * min(1.0, max_tilt / max(np.linalg.norm(coef[:2]), 1e-300))
+    slope = np.zeros(3)
+    slope[horizontal] = gradient
+    rests = np.full(legs * 3, np.nan)
+    rests[ids] = coef[2:]
+    base = np.nanmin(rests)
+    clearance = np.nan_to_num(rests.reshape(legs, 3) - base)
+    clearance[~tips, 2] = clearance[~tips, 1]
+    return base - gradient @ centre, slope, clearance
+
+
+def ground_cases(rng: np.random.Generator) -> list[tuple]:
+    """Legs that stand, walk and run on their balls (a point that never rests), on floors y-up and
+    z-down, tilted, NaN frames, with and without toe tips; many samples, thinned."""
+    out = []
+    for legs, frames, up in ((1, 1, (0, 1, 0)), (2, 3, (0, 0, -1)), (2, 60, (0, 1, 0)), (1, 400, (1, 0, 0))):
+        up = np.array(up, float)
+        t = np.arange(frames)
+        stance = (np.sin(t / 5.0) > 0)[:, None]
+        ahead = np.cumsum(~stance, axis=0) * 0.05  # where the walk has got to
+        points = rng.normal(0, 0.001, (legs, frames, 5, 3)) + ahead[:, :, None] * np.roll(up, 1)
+        points += (np.where(stance, 0.0, 0.1) + 0.02 * rng.random((legs, 1, 1)))[..., None] * up
+        points += 0.03 * up * (points @ np.roll(up, 1))[..., None]  # a tilted floor
+        if frames > 50:
+            points[0, :, 2] += 5.0 * t[:, None] * np.roll(up, 2)  # a ball that never rests
+            points[-1, 10:13] = np.nan
+        tips = rng.random(legs) < 0.5
+        for rate, needed in ((120.0, 6), (30.0, 3)):
+            out.append((points, tips, up, rate, 0.9, 0.1, needed))
+    return out
+
+
+def fit_cases(rng: np.random.Generator) -> list[tuple]:
+    return [
+        (p, resting_points(p, tips, up, rate, mpu, speed, needed), tips, up, band, prior, samples, tilt)
+        for p, tips, up, rate, mpu, speed, needed in ground_cases(rng)
+        for band, prior, samples, tilt in ((0.015, 0.15, 50_000, 0.09), (0.002, 0.5, 7, 0.01))
+    ]

@@ -581,22 +581,13 @@ def fit_ground(
         raise ValueError(f"a take of {frames} frame(s) has no resting feet to find the floor from: give more frames")
     up_vector = choose_up(arrays, up)
     scale = body_scale(legs, meters_per_unit)
-    contact = [3, 2, 4]  # heel, ball, tip among the legs' points
     has_tip = legs.points[:, 4] >= 0
-    speed = kernels.point_speeds(arrays.points, contact, frame_rate).transpose(0, 2, 1) * meters_per_unit
-    vertical = along(arrays.points[:, :, 2:], up_vector)[:, :, [1, 0, 2]]  # ball, heel, tip: heel, ball, tip
-    resting = speed < _REST_SPEED * scale
-    needed = max(3, round(0.05 * frame_rate))
-    for i in range(len(legs)):  # a point that never rests (a run on the balls): its slowest low frames
-        for k in range(3):
-            if resting[i, :, k].sum() < needed:
-                low = vertical[i, :, k] <= np.nanpercentile(vertical[i, :, k], 20)
-                slow = np.argsort(np.where(low, speed[i, :, k], np.inf))[:needed]
-                resting[i, slow, k] = True
-    resting[~has_tip, :, 2] = False
-    resting &= np.isfinite(vertical)
-    horizontal_axes = [a for a in range(3) if up_vector[a] == 0]
+    needed = max(3, round(0.05 * frame_rate))  # a point that never rests (a run on the balls): its slowest low frames
+    resting = kernels.resting_points(
+        arrays.points, has_tip, up_vector, frame_rate, meters_per_unit, _REST_SPEED * scale, needed
+    )
     if floor is not None:
+        vertical = along(arrays.points[:, :, 2:], up_vector)[:, :, [1, 0, 2]]  # ball, heel, tip: heel, ball, tip
         ankles = along(arrays.points[:, :, 1], up_vector)
         median_ankle = float(np.nanmedian(ankles))
         if floor > median_ankle:
@@ -610,44 +601,10 @@ def fit_ground(
                 if resting[i, :, k].any():
                     clearance[i, k] = max(0.0, float(np.median(vertical[i, resting[i, :, k], k])) - floor)
         return Ground(_triple(up_vector), float(floor), (0.0, 0.0, 0.0), clearance)
-    where = np.flatnonzero(resting)
-    if len(where) > _FIT_SAMPLES:  # a long take: evenly spaced samples tell the plane as well
-        where = where[:: -(-len(where) // _FIT_SAMPLES)]
-    point_id = (where // 3 // frames) * 3 + where % 3
-    ids, point = np.unique(point_id, return_inverse=True)
-    flat = arrays.points.reshape(-1, 5, 3)[where // 3, np.take(contact, where % 3)]
-    x, y = flat[:, horizontal_axes[0]], flat[:, horizontal_axes[1]]
-    z = vertical.reshape(-1)[where]
-    centre = np.array([x.mean(), y.mean()])
-    x, y = x - centre[0], y - centre[1]
-    band = _FIT_BAND * scale / meters_per_unit
-    prior = np.sqrt(len(z)) * _SLOPE_PRIOR * scale / meters_per_unit
-    keep = np.ones(len(z), bool)
-    n = len(ids)
-    xx, yy, xy, xz, yz = x * x, y * y, x * y, x * z, y * z  # the weights are 0 or 1: w x x is w (x x)
-    for _ in range(3):  # z = gx x + gy y + c[point]: least squares by its normal equations, summed by point
-        w = keep.astype(float)
-        a = np.zeros((2 + n, 2 + n))
-        a[0, 0], a[1, 1] = (w * xx).sum() + prior**2, (w * yy).sum() + prior**2
-        a[0, 1] = a[1, 0] = (w * xy).sum()
-        a[0, 2:] = a[2:, 0] = np.bincount(point, w * x, n)
-        a[1, 2:] = a[2:, 1] = np.bincount(point, w * y, n)
-        a[2:, 2:] = np.diag(np.bincount(point, w, n))
-        b = np.concatenate(([(w * xz).sum(), (w * yz).sum()], np.bincount(point, w * z, n)))
-        coef = np.linalg.solve(a, b)
-        keep = z - (coef[0] * x + coef[1] * y + coef[2:][point]) < band
-    gradient = coef[:2]
-    norm = np.linalg.norm(gradient)
-    if norm > _MAX_TILT:
-        gradient = gradient * (_MAX_TILT / norm)
-    slope = np.zeros(3)
-    slope[horizontal_axes] = gradient
-    rests = np.full(len(legs) * 3, np.nan)
-    rests[ids] = coef[2:]
-    base = float(np.nanmin(rests))
-    clearance = np.nan_to_num(rests.reshape(len(legs), 3) - base)
-    clearance[~has_tip, 2] = clearance[~has_tip, 1]
-    level = base - float(slope[horizontal_axes] @ centre)
+    band, prior = _FIT_BAND * scale / meters_per_unit, _SLOPE_PRIOR * scale / meters_per_unit
+    level, slope, clearance = kernels.fit_floor(
+        arrays.points, resting, has_tip, up_vector, band, prior, _FIT_SAMPLES, _MAX_TILT
+    )
     return Ground(_triple(up_vector), level, _triple(slope), clearance)
 
 
