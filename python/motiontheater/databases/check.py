@@ -111,6 +111,7 @@ class _Take:
         self.degrees = 1.0 if skeleton.angle_unit == "deg" else 180.0 / math.pi  # degrees per file unit
         self.root = body_joint(motion)  # the joint that carries the body (a static root above it is no body)
         self.channels, self.triples, self._columns = skeleton.derived("check channels", lambda: _channels(skeleton))
+        self.turning = np.array([c.turns for c in self.channels], dtype=bool)  # the rotation channels
         self._quaternions: dict[str, np.ndarray] = {}
 
     def frame(self, row: int) -> int:
@@ -173,8 +174,8 @@ def _limits(take: _Take) -> tuple[np.ndarray, np.ndarray]:
     spike_m = max(SPIKE_M, PEAK_ACCELERATION_M * dt2 / 2)
     jump_deg = max(JUMP_DEG, PEAK_ACCELERATION_DEG * dt2)
     jump_m = RUN_SPEED * take.dt / math.sqrt(3)  # a jump of RUN_SPEED * dt in any direction shows on an axis
-    spikes = np.array([spike_deg / take.degrees if c.turns else spike_m / take.meters for c in take.channels])
-    steps = np.array([jump_deg / take.degrees if c.turns else jump_m / take.meters for c in take.channels])
+    spikes = np.where(take.turning, spike_deg / take.degrees, spike_m / take.meters)
+    steps = np.where(take.turning, jump_deg / take.degrees, jump_m / take.meters)
     return spikes, steps
 
 
@@ -471,12 +472,15 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     rows = len(values)
     out = []
     edges: dict[int, list[tuple[str, float]]] = {}  # spikes at the first or last frame, by row
-    for joint, first, last, c, size in _joint_runs(t, events, sizes, pad=1):
+    candidates = [
+        (joint, first, last, c, size)
+        for joint, first, last, c, size in _joint_runs(t, events, sizes, pad=1)
+        if not any((joint, t.channels[c].turns, t.frame(r)) in explained for r in range(first, last + 1))
+    ]
+    bounds = [t.physical(t.channels[c], limits[c]) for _, _, _, c, _ in candidates]
+    trimmed = _trimmed(t, [(joint, t.channels[c].turns, a, b) for joint, a, b, c, _ in candidates], bounds)
+    for (joint, _, _, c, size), limit, (first, last, deviation) in zip(candidates, bounds, trimmed):
         channel = t.channels[c]
-        if any((joint, channel.turns, t.frame(r)) in explained for r in range(first, last + 1)):
-            continue
-        limit = t.physical(channel, limits[c])
-        first, last, deviation = _trimmed(t, joint, channel.turns, first, last, limit)
         if deviation is None:  # at an end of the take, or beside a missing value
             deviation = abs(t.physical(channel, size))
             if channel.turns and (first == 0 or last == rows - 1):
@@ -547,7 +551,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
                 if pop is not None:
                     if not quiet and (channel.joint, pop) not in popped:
                         popped.add((channel.joint, pop))
-                        off = _deviations(t, channel.joint, True, pop, pop)
+                        off = _deviations(t, [(channel.joint, True, pop, pop)])[0]
                         if off is not None and float(off[0]) > limit:
                             out.append(_turning_spike(t, channel.joint, channel.name, pop, pop, float(off[0]), limit))
                     continue
@@ -586,7 +590,7 @@ def _excursions(
             continue
         if _apart(t, joint, a - 1, b) >= 0.5 * min(size_a, size_b):
             continue
-        off = _deviations(t, joint, True, a, b - 1)
+        off = _deviations(t, [(joint, True, a, b - 1)])[0]
         if off is None:
             continue
         paired.update({(joint, a), (joint, b)})
@@ -649,30 +653,78 @@ def _turning_spike(
     )  # fmt: skip
 
 
-def _deviations(t: _Take, joint: str, turns: bool, first: int, last: int) -> np.ndarray | None:
-    """How far each of rows first..last lies off the path between the rows around them: the
+Run = tuple[str, bool, int, int]
+"""A joint's rotation (True) or position (False) over rows first..last: (joint, turns, first, last)."""
+
+
+def _deviations(t: _Take, runs: list[Run]) -> list[np.ndarray | None]:
+    """For each run, how far each of its rows lies off the path between the rows around it: the
     joint's rotation in degrees from the SLERP between them (its angles, unwrapped, from the line
     between them where it has fewer than three), or its position in metres from the line
-    between them.  None at an end of the take or where a value is missing."""
-    if first < 1 or last > t.motion.frames - 2:
-        return None
-    around = np.arange(first - 1, last + 2)
-    share = (around[1:-1] - around[0]) / (around[-1] - around[0])
-    if turns and joint in t.triples:
-        q = t.quaternions(joint, around)
-        if np.isnan(q).any():
-            return None
-        between = slerp(np.broadcast_to(q[0], (len(share), 4)), np.broadcast_to(q[-1], (len(share), 4)), share)
-        return _angle_deg(q[1:-1], between)
-    block = t.motion.values[around[0] : around[-1] + 1, t.columns(joint, turns)]
-    if np.isnan(block).any():
-        return None
+    between them; None at an end of the take or where a value is missing.  Every run at once:
+    a take's candidates are many, and each alone costs a dozen numpy calls."""
+    out: list[np.ndarray | None] = [None] * len(runs)
+    inside = [i for i, (_, _, first, last) in enumerate(runs) if first >= 1 and last <= t.motion.frames - 2]
+    groups: dict[tuple, list[int]] = {}
+    for i in inside:
+        joint, turns = runs[i][:2]
+        key = ("slerp",) if turns and joint in t.triples else (turns, len(t.columns(joint, turns)))
+        groups.setdefault(key, []).append(i)
+    for key, members in groups.items():
+        chosen = [runs[i] for i in members]
+        found = _slerp_deviations(t, chosen) if key == ("slerp",) else _line_deviations(t, chosen, key[0])
+        for i, off in zip(members, found):
+            out[i] = off
+    return out
+
+
+def _blocks(runs: list[Run]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The rows of each run with the row before and after it, end to end: those rows, where each
+    run's block starts (and, last, where they all end), the inner rows' places among them, and
+    the inner rows' shares of the way from the row before their run to the row after it."""
+    sizes = np.array([last - first + 3 for _, _, first, last in runs])
+    starts = np.concatenate(([0], np.cumsum(sizes)))
+    rows = np.concatenate([np.arange(first - 1, last + 2) for _, _, first, last in runs])
+    place = np.arange(starts[-1]) - np.repeat(starts[:-1], sizes)  # 0 .. size - 1 in each block
+    inner = np.flatnonzero((place > 0) & (place < np.repeat(sizes - 1, sizes)))
+    share = place[inner] / np.repeat(sizes - 1, sizes)[inner]
+    return rows, starts, inner, share
+
+
+def _split(off: np.ndarray, starts: np.ndarray, missing: np.ndarray) -> list[np.ndarray | None]:
+    """The inner rows' deviations run by run (each block loses its two outer rows), None where a
+    run misses a value."""
+    ends = np.cumsum(np.diff(starts) - 2)
+    return [None if gone else part for part, gone in zip(np.split(off, ends[:-1]), missing.tolist())]
+
+
+def _slerp_deviations(t: _Take, runs: list[Run]) -> list[np.ndarray | None]:
+    _, starts, inner, share = _blocks(runs)
+    q = np.concatenate([t.quaternions(joint, slice(first - 1, last + 2)) for joint, _, first, last in runs])
+    missing = np.add.reduceat(np.isnan(q).any(axis=1), starts[:-1]) > 0
+    sizes = np.diff(starts)
+    before, after = np.repeat(starts[:-1], sizes)[inner], np.repeat(starts[1:] - 1, sizes)[inner]
+    between = slerp(q[before], q[after], share)
+    return _split(_angle_deg(q[inner], between), starts, missing)
+
+
+def _line_deviations(t: _Take, runs: list[Run], turns: bool) -> list[np.ndarray | None]:
+    rows, starts, inner, share = _blocks(runs)
+    sizes = np.diff(starts)
+    columns = np.repeat(np.array([t.columns(joint, turns) for joint, *_ in runs]), sizes, axis=0)
+    block = t.motion.values[rows[:, None], columns]
+    missing = np.add.reduceat(np.isnan(block).any(axis=1), starts[:-1]) > 0
     if turns:
-        block = _unwrapped(block, t.motion.skeleton.period)
+        period = t.motion.skeleton.period
+        wraps = np.abs(np.diff(block, axis=0)) >= period / 2  # numpy's unwrap changes nothing below
+        wraps[starts[1:-1] - 1] = False  # a step from one run's block to the next is none
+        for k in np.flatnonzero(np.add.reduceat(wraps.any(axis=1), starts[:-1]) > 0):
+            block[starts[k] : starts[k + 1]] = np.unwrap(block[starts[k] : starts[k + 1]], axis=0, period=period)
     block = block * (t.degrees if turns else t.meters)
-    line = block[0] + share[:, None] * (block[-1] - block[0])
-    off = block[1:-1] - line
-    return np.abs(off).max(axis=1) if turns else np.linalg.norm(off, axis=1)
+    before, after = np.repeat(starts[:-1], sizes)[inner], np.repeat(starts[1:] - 1, sizes)[inner]
+    line = block[before] + share[:, None] * (block[after] - block[before])
+    off = block[inner] - line
+    return _split(np.abs(off).max(axis=1) if turns else np.linalg.norm(off, axis=1), starts, missing)
 
 
 def _unwrapped(block: np.ndarray, period: float) -> np.ndarray:
@@ -717,32 +769,39 @@ def _fastest_step(t: _Take, joint: str, *spans: tuple[int, int]) -> float:
     return float(np.nanmax(steps)) if not np.isnan(steps).all() else 0.0
 
 
-def _trimmed(t: _Take, joint: str, turns: bool, first: int, last: int, limit: float) -> tuple[int, int, float | None]:
-    """The run without the rows at its ends that lie on the path between the rows around them
+def _trimmed(t: _Take, runs: list[Run], limits: list[float]) -> list[tuple[int, int, float | None]]:
+    """Each run without the rows at its ends that lie on the path between the rows around them
     (the median of five beside a large spike can leave a fast-moving neighbour), and its largest
-    deviation (None where :func:`_deviations` has none)."""
-    while True:
-        off = _deviations(t, joint, turns, first, last)
-        if off is None:
-            return first, last, None
-        if first < last and off[0] <= limit:
-            first += 1
-        elif first < last and off[-1] <= limit:
-            last -= 1
-        else:
-            return first, last, float(off.max())
+    deviation (None where :func:`_deviations` has none): (first, last, deviation), every run
+    trimmed at once, a row at a time, while any still loses one."""
+    ends = [[first, last] for _, _, first, last in runs]
+    out: list[tuple[int, int, float | None]] = [(0, 0, None)] * len(runs)
+    pending = list(range(len(runs)))
+    while pending:
+        offs = _deviations(t, [(runs[i][0], runs[i][1], *ends[i]) for i in pending])
+        trimming = []
+        for i, off in zip(pending, offs):
+            first, last = ends[i]
+            if off is not None and first < last and (off[0] <= limits[i] or off[-1] <= limits[i]):
+                ends[i][0 if off[0] <= limits[i] else 1] += 1 if off[0] <= limits[i] else -1
+                trimming.append(i)
+            else:
+                out[i] = (first, last, None if off is None else float(off.max()))
+        pending = trimming
+    return out
 
 
 def _jitter(t: _Take, roughness: np.ndarray, counts: np.ndarray) -> list[Finding]:
     smooth = SMOOTH_ACCELERATION_DEG * t.dt**2 / 2
     with np.errstate(invalid="ignore", divide="ignore"):
         noise = np.sqrt(roughness / counts / 1.5)
+    levels = noise * np.where(t.turning, t.degrees, t.meters)
+    limits = np.where(t.turning, max(JITTER_DEG, smooth), JITTER_M)
     worst: dict[str, tuple[float, int]] = {}
-    for channel in t.channels:
-        level = t.physical(channel, float(noise[channel.index]))
-        limit = max(JITTER_DEG, smooth) if channel.turns else JITTER_M
-        if level > limit and level / limit > worst.get(channel.joint, (0.0, 0))[0]:
-            worst[channel.joint] = (level / limit, channel.index)
+    for c in np.flatnonzero(levels > limits).tolist():
+        ratio = float(levels[c]) / float(limits[c])
+        if ratio > worst.get(t.channels[c].joint, (0.0, 0))[0]:
+            worst[t.channels[c].joint] = (ratio, c)
     out = []
     for joint, (ratio, c) in sorted(worst.items()):
         channel = t.channels[c]
@@ -764,11 +823,9 @@ def _bones(t: _Take) -> list[Finding]:
     out = []
     skeleton = t.motion.skeleton
     above = set(_chain_to(skeleton, t.root))  # the body's joint and those above it carry no bone
-    for joint in skeleton.joint_names:
+    placed = skeleton.derived("check bones", lambda: _placed_joints(t.motion))
+    for joint, columns in placed:
         if joint in above:
-            continue
-        columns = t.motion.columns(joint, TRANSLATIONS) if set(TRANSLATIONS) <= set(skeleton.dofs(joint)) else []
-        if len(columns) != 3:
             continue
         length = np.linalg.norm(t.motion.values[:, columns], axis=1) * t.meters
         if not np.isfinite(length).any():
@@ -788,6 +845,16 @@ def _bones(t: _Take) -> list[Finding]:
     return out
 
 
+def _placed_joints(motion: Motion) -> list[tuple[str, list[int]]]:
+    """The joints with three position channels, and their columns."""
+    skeleton = motion.skeleton
+    return [
+        (joint, motion.columns(joint, TRANSLATIONS))
+        for joint in skeleton.joint_names
+        if set(TRANSLATIONS) <= set(skeleton.dofs(joint)) and len(motion.columns(joint, TRANSLATIONS)) == 3
+    ]
+
+
 def _chain_to(skeleton, joint: str) -> list[str]:
     chain = [joint]
     while not skeleton.is_root(chain[-1]):
@@ -801,6 +868,8 @@ def _speed(t: _Take) -> list[Finding]:
         return []
     window = max(1, round(0.25 * t.rate))
     steps = np.linalg.norm(np.diff(t.motion.values[:, columns], axis=0), axis=1) * t.meters * t.rate
+    if not np.nanmax(steps, initial=0.0) > RUN_SPEED:  # no median of them can be: the take is slower
+        return []
     # the median over 0.25 s: a teleport of a few frames is not a speed
     typical = median_filter1d(np.nan_to_num(steps), window | 1, mode="nearest")
     out = []
