@@ -132,7 +132,7 @@ class _Take:
     def unit(self, channel: _Channel) -> str:
         return "deg" if channel.turns else "m"
 
-    def quaternions(self, joint: str, rows: np.ndarray) -> np.ndarray:
+    def quaternions(self, joint: str, rows: np.ndarray | slice) -> np.ndarray:
         """The joint's rotations at the rows, of every row made once (candidates ask for the
         rows around them again and again)."""
         made = self._quaternions.get(joint)
@@ -665,14 +665,14 @@ def _deviations(t: _Take, runs: list[Run]) -> list[np.ndarray | None]:
     a take's candidates are many, and each alone costs a dozen numpy calls."""
     out: list[np.ndarray | None] = [None] * len(runs)
     inside = [i for i, (_, _, first, last) in enumerate(runs) if first >= 1 and last <= t.motion.frames - 2]
-    groups: dict[tuple, list[int]] = {}
+    groups: dict[tuple[bool, int], list[int]] = {}  # (turns, columns; 0 for a rotation of three angles): runs
     for i in inside:
         joint, turns = runs[i][:2]
-        key = ("slerp",) if turns and joint in t.triples else (turns, len(t.columns(joint, turns)))
+        key = (True, 0) if turns and joint in t.triples else (turns, len(t.columns(joint, turns)))
         groups.setdefault(key, []).append(i)
-    for key, members in groups.items():
+    for (turns, columns), members in groups.items():
         chosen = [runs[i] for i in members]
-        found = _slerp_deviations(t, chosen) if key == ("slerp",) else _line_deviations(t, chosen, key[0])
+        found = _line_deviations(t, chosen, turns) if columns else _slerp_deviations(t, chosen)
         for i, off in zip(members, found):
             out[i] = off
     return out
@@ -778,7 +778,7 @@ def _trimmed(t: _Take, runs: list[Run], limits: list[float]) -> list[tuple[int, 
     out: list[tuple[int, int, float | None]] = [(0, 0, None)] * len(runs)
     pending = list(range(len(runs)))
     while pending:
-        offs = _deviations(t, [(runs[i][0], runs[i][1], *ends[i]) for i in pending])
+        offs = _deviations(t, [(runs[i][0], runs[i][1], ends[i][0], ends[i][1]) for i in pending])
         trimming = []
         for i, off in zip(pending, offs):
             first, last = ends[i]
