@@ -15,7 +15,7 @@ from ._mtcore import lib
 from ._parallel import even_bounds, run_ranges, thread_count
 from ._status import check
 
-__all__ = ["DOFS", "JointTree", "forward_kinematics", "local_quaternions"]
+__all__ = ["DOFS", "JointTree", "Kinematics", "forward_kinematics", "local_quaternions"]
 
 DOFS = {
     "rx": lib.MT_DOF_RX,
@@ -133,6 +133,12 @@ def _values_of(values: np.ndarray, tree: JointTree) -> np.ndarray:
     if len(tree.dof_column) and tree.dof_column.max() >= values.shape[1]:
         raise ValueError(f"the tree reads column {tree.dof_column.max()} but values have {values.shape[1]} channels")
     return values
+
+
+Kinematics = tuple[np.ndarray, np.ndarray]
+"""Every joint's position (frames, joints, 3) and world rotation (frames, joints, 3, 3), as
+:func:`forward_kinematics` gives them with ``world=True``: what a caller that needs both for
+several purposes works out once and hands on."""
 
 
 def forward_kinematics(

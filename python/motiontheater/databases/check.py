@@ -29,6 +29,7 @@ import numpy as np
 
 from mtcore import check as kernel
 from mtcore import median_filter1d
+from mtcore.kinematics import forward_kinematics
 from mtcore.rotations import euler_to_quaternions, slerp, unroll_euler
 
 from ..editing.pipeline import Pipeline
@@ -38,7 +39,7 @@ from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 from ..model.units import HUMAN_HEIGHT
 from .check_arms import arm_findings
 from .check_feet import leg_findings
-from .check_pace import dropped_findings
+from .check_pace import BLOCK_FRAMES, dropped_findings
 from .findings import Finding
 
 SPIKE_DEG = 5.0
@@ -214,12 +215,17 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         }
         findings += _spikes(t, by_kind[kernel.SPIKE], by_kind[kernel.STEP], explained, spikes)
         findings += _jitter(t, found.roughness, found.smooth_rows)
-        dropped, findings = dropped_findings(motion, take, findings)
+        # the joints' places and turns, for the steps, the legs and the arms alike, where they fit a block
+        held = None
+        if motion.frames <= BLOCK_FRAMES:
+            positions, world, _ = forward_kinematics(motion.values, motion.skeleton.tree, world=True, workers=1)
+            held = (positions, world) if world is not None else None
+        dropped, findings = dropped_findings(motion, take, findings, held)
         findings += dropped
         findings += _bones(t)
         findings += _speed(t)
-        findings += leg_findings(motion, take, t.meters)
-        findings += arm_findings(motion, take)
+        findings += leg_findings(motion, take, t.meters, held)
+        findings += arm_findings(motion, take, held)
     return sorted(findings, key=lambda f: (f.first, -f.rank, f.kind, f.joints))
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtcore.kinematics import JointTree, forward_kinematics
+from mtcore.kinematics import JointTree, Kinematics, forward_kinematics
 
 from ..characters.rigs import recognise, wrist
 from ..feet.contacts import runs
@@ -34,13 +34,20 @@ HINGE = 0.8
 second moment along it) for the elbow to be a hinge the check can judge."""
 
 
-def arm_findings(motion: Motion, take: str) -> list[Finding]:
-    """The elbows of the take bent backwards past ELBOW_BACK_DEG."""
+def arm_findings(motion: Motion, take: str, kinematics: Kinematics | None = None) -> list[Finding]:
+    """The elbows of the take bent backwards past ELBOW_BACK_DEG; ``kinematics``: the take's
+    forward kinematics (positions, world rotations), where the caller has them."""
     skeleton = motion.skeleton
-    arms, kinematics = skeleton.derived("check arms", lambda: _arms(skeleton))
+    arms, (tree, turning, placing) = skeleton.derived("check arms", lambda: _arms(skeleton))
     if not len(arms) or motion.frames < 2:
         return []
-    turns = [_turns(motion.values[rows], *kinematics) for rows in _blocks(motion.frames)]
+    if kinematics is not None:  # the joints' own rows
+        turns = [_turns(*kinematics, arms[:, 1], _placing(skeleton, arms))]
+    else:  # a block at a time, of the joints above the wrists only
+        turns = [
+            _turns(*forward_kinematics(motion.values[rows], tree, world=True, workers=1)[:2], turning, placing)
+            for rows in _blocks(motion.frames)
+        ]
     names = skeleton.point_names
     out = []
     for i, (_, _, elbow, _) in enumerate(arms):
@@ -61,11 +68,18 @@ def arm_findings(motion: Motion, take: str) -> list[Finding]:
     return out
 
 
+def _placing(skeleton: Skeleton, arms: np.ndarray) -> np.ndarray:
+    """The joints placing each arm's shoulder, elbow and wrist (arms, 3): of an ASF bone, its
+    parent's end, where it starts (as positions(start=True))."""
+    placing = arms[:, [0, 2, 3]]
+    return placing if skeleton.convention == "bvh" else np.maximum(skeleton.tree.parent[placing], 0)
+
+
 def _arms(skeleton: Skeleton) -> tuple[np.ndarray, tuple[JointTree, np.ndarray, np.ndarray]]:
     """The arms the rig tables find, (arms, 4) joints: shoulder, the upper arm's turning joint,
     elbow and wrist; and what :func:`_turns` needs of them: the tree of the joints above the
     wrists (their forward kinematics need no more), and in it, the joint turning each upper arm
-    and the joints placing each shoulder, elbow and wrist (of an ASF bone, its parent's end)."""
+    and the joints placing each shoulder, elbow and wrist."""
     parts = recognise(skeleton).parts
     names = list(skeleton.point_names)
     arms = []
@@ -78,11 +92,8 @@ def _arms(skeleton: Skeleton) -> tuple[np.ndarray, tuple[JointTree, np.ndarray, 
                 arms.append((names.index(parts[f"{side}_upper_arm"][0]), names.index(turning), names.index(forearm),
                              names.index(end)))  # fmt: skip
     table = np.array(arms, dtype=np.intp).reshape(-1, 4)
-    tree = skeleton.tree
-    placing = table[:, [0, 2, 3]]
-    if skeleton.convention != "bvh":  # a bone starts at its parent's end, as positions(start=True)
-        placing = np.maximum(tree.parent[placing], 0)
-    pruned, where = tree.pruned(np.concatenate([table[:, 1], placing.ravel()]))
+    placing = _placing(skeleton, table)
+    pruned, where = skeleton.tree.pruned(np.concatenate([table[:, 1], placing.ravel()]))
     return table, (pruned, where[table[:, 1]], where[placing])
 
 
@@ -96,13 +107,12 @@ def _blocks(frames: int) -> list[slice]:
 
 
 def _turns(
-    values: np.ndarray, tree: JointTree, turning: np.ndarray, placing: np.ndarray
+    positions: np.ndarray, rotations: np.ndarray, turning: np.ndarray, placing: np.ndarray
 ) -> list[tuple[np.ndarray, np.ndarray]]:
-    """For each arm over the frames of ``values``: the turn from upper arm to forearm (the cross
-    product of the two, in the axes of the joint that turns the upper arm), and their dot product
-    (``tree``, ``turning`` and ``placing`` as :func:`_arms` gives them)."""
-    positions, rotations, _ = forward_kinematics(values, tree, world=True, workers=1)  # one pass for both
-    assert rotations is not None  # asked for
+    """For each arm over the frames of the joints' ``positions`` and world ``rotations``: the
+    turn from upper arm to forearm (the cross product of the two, in the axes of the joint that
+    turns the upper arm), and their dot product (``turning`` and ``placing`` the joints' rows
+    as :func:`_arms` gives them)."""
     out = []
     for upper, (shoulder, elbow, hand) in zip(turning, placing):
         arm = positions[:, elbow] - positions[:, shoulder]

@@ -18,6 +18,7 @@ import warnings
 import numpy as np
 
 from mtcore.check import LegCheck, leg_measures
+from mtcore.kinematics import Kinematics
 
 from ..feet.contacts import runs
 from ..feet.footskate import prepare
@@ -67,14 +68,15 @@ BLEND_SECONDS = 0.2 + 0.1
 beyond the frames it fixes, so that the adjustments fade within it."""
 
 
-def leg_findings(motion: Motion, take: str, meters: float) -> list[Finding]:
-    """The findings on the legs of a take whose length unit is ``meters`` metres."""
+def leg_findings(motion: Motion, take: str, meters: float, kinematics: Kinematics | None = None) -> list[Finding]:
+    """The findings on the legs of a take whose length unit is ``meters`` metres; ``kinematics``:
+    the take's forward kinematics, where the caller has them."""
     if motion.frames < 2:
         return []
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the take's unit and rig are the check's own findings
-            arrays, ground, mpu = prepare(motion, meters_per_unit=meters)
+            arrays, ground, mpu = prepare(motion, meters_per_unit=meters, kinematics=kinematics)
     except ValueError:
         return []  # no legs, or none that are numbers: nothing to judge here
     context = _Legs(motion, take, arrays, ground, mpu)

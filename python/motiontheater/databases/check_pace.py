@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from mtcore import check as kernel
+from mtcore.kinematics import Kinematics
 
 from ..model.motion import Motion
 from .findings import Finding
@@ -45,11 +46,13 @@ CONSEQUENCES = ("jump", "teleport", "spike")
 within a frame of a step with frames missing, the finding is the missing frames."""
 
 
-def dropped_findings(motion: Motion, take: str, found: list[Finding]) -> tuple[list[Finding], list[Finding]]:
+def dropped_findings(
+    motion: Motion, take: str, found: list[Finding], kinematics: Kinematics | None = None
+) -> tuple[list[Finding], list[Finding]]:
     """The steps of the take with frames missing between them (but beside the ``found``
     findings that explain an uneven step), and ``found`` without the jumps those missing frames
-    make."""
-    pace = step_pace(motion)
+    make; ``kinematics``: the take's forward kinematics, where the caller has them."""
+    pace = step_pace(motion, kinematics)
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = pace.paced / pace.moved
     steps = np.clip(np.round(np.nan_to_num(ratio)), 2.0, MOST_MISSING + 1.0)
@@ -83,14 +86,18 @@ def dropped_findings(motion: Motion, take: str, found: list[Finding]) -> tuple[l
     return out, kept
 
 
-def step_pace(motion: Motion) -> kernel.Pace:
+def step_pace(motion: Motion, kinematics: Kinematics | None = None) -> kernel.Pace:
     """The :func:`mtcore.check.pace` of the joints' positions (metres), each coordinate weighted
     by its noise: the frame-to-frame roughness over the take, at least NOISE_M."""
     rows = motion.frames
     if rows < 4:
         return kernel.Pace(np.zeros(rows), np.zeros(rows), np.zeros(rows))
     blocks = [(a, min(a + BLOCK_FRAMES, rows)) for a in range(0, rows, BLOCK_FRAMES)]
-    held = _positions(motion, 0, rows) if len(blocks) == 1 else None
+    held = None
+    if kinematics is not None:  # every row's, given: one block
+        held, blocks = (kinematics[0] * motion.skeleton.meters_per_unit).reshape(rows, -1), [(0, rows)]
+    elif len(blocks) == 1:
+        held = _positions(motion, 0, rows)
     squares, counts = np.zeros(3 * len(motion.skeleton.joint_names)), np.zeros(3 * len(motion.skeleton.joint_names))
     for a, b in blocks:  # rows a-1 .. b: the roughness of rows a .. b-1, each row's once
         p = held if held is not None else _positions(motion, max(a - 1, 0), min(b + 1, rows))

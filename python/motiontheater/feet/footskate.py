@@ -60,6 +60,7 @@ from typing import Annotated, Literal
 import numpy as np
 
 from mtcore import footskate as kernels
+from mtcore.kinematics import Kinematics
 
 from ..model import units
 from ..model.motion import Motion
@@ -105,13 +106,19 @@ def prepare(
     up: str | None = None,
     floor: float | None = None,
     meters_per_unit: float | None = None,
+    kinematics: Kinematics | None = None,
 ) -> tuple[LegArrays, Ground, float]:
     """A motion's legs as arrays, its ground, and its metres per file unit (the skeleton's, or
     ``meters_per_unit``).  ``legs``: resolved :class:`~motiontheater.feet.legs.Legs` (so that a
     cleaned motion is measured with the heels of its input), joint names, or None to find them.
     The motion is seen from its body (:func:`~motiontheater.model.rig.body_view`): a static joint
-    above the hips and position channels that only hold offsets are not the legs' concern."""
-    motion = body_view(motion).motion
+    above the hips and position channels that only hold offsets are not the legs' concern.
+    ``kinematics``: the motion's forward kinematics, where the caller has them (used where the
+    motion is its own body view)."""
+    view = body_view(motion).motion
+    if view is not motion:
+        kinematics = None
+    motion = view
     if meters_per_unit is None and motion.skeleton.length_source == "assumed":
         warnings.warn(
             f"the take's length unit is assumed ({units.label(motion.skeleton.length_unit)}): its size tells "
@@ -127,7 +134,7 @@ def prepare(
     if found.skeleton.joint_names != motion.skeleton.joint_names:
         raise ValueError("the legs given are of another skeleton than the motion's")
     _require_finite_legs(motion, found)
-    arrays = leg_arrays(motion, found, up=up, meters_per_unit=mpu)
+    arrays = leg_arrays(motion, found, up=up, meters_per_unit=mpu, kinematics=kinematics)
     return arrays, fit_ground(arrays, motion.frame_rate, mpu, up=up, floor=floor), mpu
 
 

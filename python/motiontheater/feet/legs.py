@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mtcore import footskate as kernels
-from mtcore.kinematics import forward_kinematics
+from mtcore.kinematics import JointTree, Kinematics, forward_kinematics
 
 from ..model.errors import UnknownNameError
 from ..model.motion import Motion
@@ -398,9 +398,16 @@ class LegArrays:
 _CHUNK = 16384  # frames of forward kinematics at a time: the joints' rotations stay in cache, not in memory
 
 
-def _upper_kinematics(values: np.ndarray, skeleton: Skeleton, legs: Legs) -> tuple[np.ndarray, np.ndarray]:
+def _upper_kinematics(
+    values: np.ndarray, skeleton: Skeleton, legs: Legs, kinematics: Kinematics | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Hip points (legs, frames, 3) and the world rotations of the hip joints' parents (legs,
-    frames, 3, 3), by forward kinematics of the joints above the legs only, in chunks of frames."""
+    frames, 3, 3): from ``kinematics`` where given, else by forward kinematics of the joints above
+    the legs only, in chunks of frames."""
+    if kinematics is not None:
+        positions, world = kinematics
+        hips = np.ascontiguousarray(positions[:, legs.points[:, 0]].transpose(1, 0, 2))
+        return hips, np.ascontiguousarray(world[:, legs.parents].transpose(1, 0, 2, 3))
     joints = (*map(int, legs.parents), *map(int, legs.points[:, 0]))
     upper, where = skeleton.derived(("pruned tree", joints), lambda: skeleton.tree.pruned(list(joints)))
     hip_rows = where[legs.points[:, 0]]
@@ -417,16 +424,9 @@ def _upper_kinematics(values: np.ndarray, skeleton: Skeleton, legs: Legs) -> tup
     return hips, parents
 
 
-def leg_arrays(
-    motion: Motion, legs: Legs, *, up: str | np.ndarray | None = None, meters_per_unit: float | None = None
-) -> LegArrays:
-    """The legs of a motion as arrays: forward kinematics of the joints above the legs (in C),
-    the legs' channels as angles, and the legs' points by ``leg_points``.  Heels the rest pose
-    could not give are derived from this take (see the module docstring), along ``up``
-    (:func:`choose_up`), with thresholds in metres by ``meters_per_unit`` (default the skeleton's)."""
-    skeleton = motion.skeleton
-    tree = skeleton.tree
-    hips, parents = _upper_kinematics(motion.values, skeleton, legs)
+def _leg_channels(tree: JointTree, legs: Legs) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+    """The legs' rotation channels: their columns (legs, 4, 3) in the order they apply (-1
+    unused), their axes (0 x, 1 y, 2 z; -1 unused) and each leg's joints' axis frames (4, 3, 3)."""
     n = len(legs)
     columns = np.full((n, 4, 3), -1, np.int64)
     axes = np.full((n, 4, 3), -1, np.intc)
@@ -438,10 +438,33 @@ def leg_arrays(
             rot = [(k, c) for k, c in zip(tree.dof_kind[a:b], tree.dof_column[a:b]) if k <= 2]
             for m, (k, c) in enumerate(rot):
                 axes[i, r, m], columns[i, r, m] = k, c
-    angles = np.zeros((n, motion.frames, 4, 3))
-    for i, r, m in zip(*np.nonzero(columns >= 0)):
-        np.multiply(motion.values[:, columns[i, r, m]], tree.angle_scale, out=angles[i, :, r, m])
     frames_axis = [np.stack([tree.axis[j] if j >= 0 else np.eye(3) for j in legs.rotators[i]]) for i in range(n)]
+    return columns, axes, frames_axis
+
+
+def leg_arrays(
+    motion: Motion,
+    legs: Legs,
+    *,
+    up: str | np.ndarray | None = None,
+    meters_per_unit: float | None = None,
+    kinematics: Kinematics | None = None,
+) -> LegArrays:
+    """The legs of a motion as arrays: forward kinematics of the joints above the legs (in C;
+    ``kinematics``, the motion's, where the caller has them), the legs' channels as angles, and
+    the legs' points by ``leg_points``.  Heels the rest pose could not give are derived from this
+    take (see the module docstring), along ``up`` (:func:`choose_up`), with thresholds in metres
+    by ``meters_per_unit`` (default the skeleton's)."""
+    skeleton = motion.skeleton
+    tree = skeleton.tree
+    hips, parents = _upper_kinematics(motion.values, skeleton, legs, kinematics)
+    n = len(legs)
+    columns, axes, frames_axis = skeleton.derived(
+        ("leg channels", legs.rotators.tobytes()), lambda: _leg_channels(tree, legs)
+    )
+    used = columns >= 0
+    gathered = motion.values[:, np.where(used, columns, 0)] * tree.angle_scale  # (frames, legs, 4, 3)
+    angles = np.ascontiguousarray(np.where(used, gathered, 0.0).transpose(1, 0, 2, 3))
 
     def chains_of(segments: np.ndarray) -> tuple:
         return tuple(kernels.LegChain(axis=frames_axis[i], axes=axes[i], segments=segments[i]) for i in range(n))
@@ -457,7 +480,9 @@ def leg_arrays(
         for i in map(int, np.flatnonzero(missing)):
             segments[i, 3] = _heel_from_take(points[i], feet[i], direction, motion.frame_rate, mpu, legs, i)
         legs = Legs(legs.skeleton, legs.legs, legs.rotators, legs.points, segments, legs.parents)
-    chains = chains_of(legs.segments)
+        chains = chains_of(legs.segments)
+    else:  # the rest pose's: the same on every take of the skeleton
+        chains = skeleton.derived(("leg chains", legs.segments.tobytes()), lambda: chains_of(legs.segments))
     points = kernels.leg_points(chains, hips, parents, angles)
     return LegArrays(legs, chains, hips, parents, angles, columns, points, tree.angle_scale)
 
