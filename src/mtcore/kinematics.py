@@ -15,7 +15,7 @@ from ._mtcore import lib
 from ._parallel import even_bounds, run_ranges, thread_count
 from ._status import check
 
-__all__ = ["DOFS", "JointTree", "Kinematics", "forward_kinematics", "local_quaternions"]
+__all__ = ["DOFS", "JointTree", "Kinematics", "forward_kinematics", "local_quaternions", "world_kinematics"]
 
 DOFS = {
     "rx": lib.MT_DOF_RX,
@@ -174,6 +174,14 @@ def forward_kinematics(
 
     run_ranges(lambda begin, end: lib.mt_forward_kinematics(*args, begin, end, *outs), bounds, "mt_forward_kinematics")
     return positions, world_out, local_out
+
+
+def world_kinematics(values: np.ndarray, tree: JointTree, *, workers: int | None = None) -> Kinematics:
+    """Every joint's position and world rotation (:data:`Kinematics`): :func:`forward_kinematics`
+    with ``world=True``."""
+    positions, world, _ = forward_kinematics(values, tree, world=True, workers=workers)
+    assert world is not None  # asked for
+    return positions, world
 
 
 def local_quaternions(values: np.ndarray, tree: JointTree, joints, turn: np.ndarray | None = None) -> np.ndarray:

@@ -29,7 +29,7 @@ import numpy as np
 
 from mtcore import check as kernel
 from mtcore import median_filter1d
-from mtcore.kinematics import forward_kinematics
+from mtcore.kinematics import world_kinematics
 from mtcore.rotations import euler_to_quaternions, slerp, unroll_euler
 
 from ..editing.pipeline import Pipeline
@@ -216,10 +216,9 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         findings += _spikes(t, by_kind[kernel.SPIKE], by_kind[kernel.STEP], explained, spikes)
         findings += _jitter(t, found.roughness, found.smooth_rows)
         # the joints' places and turns, for the steps, the legs and the arms alike, where they fit a block
-        held = None
-        if motion.frames <= BLOCK_FRAMES:
-            positions, world, _ = forward_kinematics(motion.values, motion.skeleton.tree, world=True, workers=1)
-            held = (positions, world) if world is not None else None
+        held = (
+            world_kinematics(motion.values, motion.skeleton.tree, workers=1) if motion.frames <= BLOCK_FRAMES else None
+        )
         dropped, findings = dropped_findings(motion, take, findings, held)
         findings += dropped
         findings += _bones(t)

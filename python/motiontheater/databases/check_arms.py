@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtcore.kinematics import JointTree, Kinematics, forward_kinematics
+from mtcore.kinematics import JointTree, Kinematics, world_kinematics
 
 from ..characters.rigs import recognise, wrist
 from ..feet.contacts import runs
@@ -42,10 +42,10 @@ def arm_findings(motion: Motion, take: str, kinematics: Kinematics | None = None
     if not len(arms) or motion.frames < 2:
         return []
     if kinematics is not None:  # the joints' own rows
-        turns = [_turns(*kinematics, arms[:, 1], _placing(skeleton, arms))]
+        turns = [_turns(kinematics, arms[:, 1], _placing(skeleton, arms))]
     else:  # a block at a time, of the joints above the wrists only
         turns = [
-            _turns(*forward_kinematics(motion.values[rows], tree, world=True, workers=1)[:2], turning, placing)
+            _turns(world_kinematics(motion.values[rows], tree, workers=1), turning, placing)
             for rows in _blocks(motion.frames)
         ]
     names = skeleton.point_names
@@ -106,13 +106,12 @@ def _blocks(frames: int) -> list[slice]:
     return [slice(a, min(a + BLOCK_FRAMES, frames)) for a in range(0, frames, BLOCK_FRAMES)]
 
 
-def _turns(
-    positions: np.ndarray, rotations: np.ndarray, turning: np.ndarray, placing: np.ndarray
-) -> list[tuple[np.ndarray, np.ndarray]]:
-    """For each arm over the frames of the joints' ``positions`` and world ``rotations``: the
-    turn from upper arm to forearm (the cross product of the two, in the axes of the joint that
-    turns the upper arm), and their dot product (``turning`` and ``placing`` the joints' rows
-    as :func:`_arms` gives them)."""
+def _turns(kinematics: Kinematics, turning: np.ndarray, placing: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """For each arm over the frames of the joints' positions and world rotations: the turn from
+    upper arm to forearm (the cross product of the two, in the axes of the joint that turns the
+    upper arm), and their dot product (``turning`` and ``placing`` the joints' rows as
+    :func:`_arms` gives them)."""
+    positions, rotations = kinematics
     out = []
     for upper, (shoulder, elbow, hand) in zip(turning, placing):
         arm = positions[:, elbow] - positions[:, shoulder]
