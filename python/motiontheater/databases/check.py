@@ -113,6 +113,9 @@ class _Take:
         self.root = body_joint(motion)  # the joint that carries the body (a static root above it is no body)
         self.channels, self.triples, self._columns = skeleton.derived("check channels", lambda: _channels(skeleton))
         self.turning = np.array([c.turns for c in self.channels], dtype=bool)  # the rotation channels
+        # each channel's joint, and its joint's rotation or position channels, numbered in the
+        # order of their names (the order events are joined in)
+        self.joints, self.kinds = skeleton.derived("check channel groups", lambda: _groups(self.channels))
         self._quaternions: dict[str, np.ndarray] = {}
 
     def frame(self, row: int) -> int:
@@ -161,6 +164,16 @@ def _channels(skeleton: Skeleton) -> tuple[list[_Channel], dict, dict[tuple[str,
     for c in channels:
         grouped.setdefault((c.joint, c.turns), []).append(c.index)
     return channels, triples, {key: np.array(columns, dtype=np.intp) for key, columns in grouped.items()}
+
+
+def _groups(channels: list[_Channel]) -> tuple[np.ndarray, np.ndarray]:
+    """Per channel: the rank of its joint's name, and of (its joint's name, whether it turns)."""
+    joints = sorted({c.joint for c in channels})
+    kinds = sorted({(c.joint, c.turns) for c in channels})
+    return (
+        np.array([joints.index(c.joint) for c in channels], dtype=np.intp),
+        np.array([kinds.index((c.joint, c.turns)) for c in channels], dtype=np.intp),
+    )
 
 
 def _angle_deg(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
@@ -267,8 +280,7 @@ def _joint_runs(
     channels, unless not ``apart``) where their rows overlap (within ``pad``): (joint, first row, last row, worst
     channel, its size)."""
     out: list[list] = []
-    group = np.array([f"{t.channels[c].joint} {t.channels[c].turns and apart}" for c in events[:, 0]])
-    order = np.lexsort((events[:, 1], group))
+    order = np.lexsort((events[:, 1], (t.kinds if apart else t.joints)[events[:, 0]]))
     for i in order:
         c, first, last = int(events[i, 0]), int(events[i, 1]), int(events[i, 2])
         joint, size = t.channels[c].joint, float(sizes[i])
@@ -285,7 +297,7 @@ def _joint_runs(
 
 def _repeats(t: _Take, events: np.ndarray, rows: int) -> list[Finding]:
     out = []
-    for _, first, last, _, _ in events:
+    for _, first, last, _, _ in events.tolist():
         count = last - first + 1
         seconds = count / t.rate
         held = (first <= 1 or last >= rows - 1) and seconds >= FILL_SECONDS

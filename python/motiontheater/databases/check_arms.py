@@ -116,8 +116,17 @@ def _turns(kinematics: Kinematics, turning: np.ndarray, placing: np.ndarray) -> 
     for upper, (shoulder, elbow, hand) in zip(turning, placing):
         arm = positions[:, elbow] - positions[:, shoulder]
         forearm = positions[:, hand] - positions[:, elbow]
-        turn = np.einsum("fji,fj->fi", rotations[:, upper], np.cross(arm, forearm))
+        turn = np.einsum("fji,fj->fi", rotations[:, upper], _cross(arm, forearm))
         out.append((turn, np.sum(arm * forearm, axis=-1)))
+    return out
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross products of rows of 3 (numpy's cross, written out: it moves axes for every call)."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
     return out
 
 

@@ -103,7 +103,8 @@ def body_joint(motion: Motion, still: set[int] | None = None) -> str:
     skeleton = motion.skeleton
     if skeleton.body is not None:
         return "root" if skeleton.is_root(skeleton.body) else skeleton.body
-    still = _still_columns(motion) if still is None else still
+    if still is None:  # of the position channels: the others do not say
+        still = _still_columns(motion, skeleton.derived("position columns", lambda: _position_columns(motion)))
     for joint in skeleton.joint_names:
         columns = [c for c, d in zip(motion.columns(joint), skeleton.dofs(joint)) if d in TRANSLATIONS]
         if any(c not in still for c in columns):
@@ -300,16 +301,28 @@ def standing_height(points: np.ndarray) -> float:
     return float((points[0, up] - finite[:, up].min()) / spans.max()) if spans.max() > 0 else 0.0
 
 
-def _still_columns(motion: Motion) -> set[int]:
-    """The columns that do not move over the take (to STILL of the figure's size, NaN-free)."""
-    values = motion.values
+def _position_columns(motion: Motion) -> list[int]:
+    skeleton = motion.skeleton
+    return [
+        c
+        for joint in skeleton.joint_names
+        for c, d in zip(motion.columns(joint), skeleton.dofs(joint))
+        if d in TRANSLATIONS
+    ]
+
+
+def _still_columns(motion: Motion, columns: list[int] | None = None) -> set[int]:
+    """The columns (of ``columns``, default all) that do not move over the take (to STILL of the
+    figure's size, NaN-free)."""
+    chosen = np.arange(motion.values.shape[1]) if columns is None else np.asarray(columns, dtype=np.intp)
+    values = motion.values if columns is None else motion.values[:, chosen]
     if not len(values):
-        return set(range(values.shape[1]))
+        return set(chosen.tolist())
     rest = motion.skeleton.rest_positions()
     with np.errstate(invalid="ignore"):  # a column held at an infinity spans NaN: not told still
         size = float(np.nanmax(np.ptp(rest, axis=0))) if len(rest) > 1 else 0.0
         spread = np.ptp(values, axis=0)
-    return {int(c) for c in np.flatnonzero(spread <= STILL * max(size, 1.0))}
+    return set(chosen[spread <= STILL * max(size, 1.0)].tolist())
 
 
 def _chain_above(skeleton: Skeleton, joint: str) -> list[str]:
