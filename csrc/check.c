@@ -1,6 +1,6 @@
 /*
  * check.c - what is wrong with a take's channels, in one pass over its rows
- * (mt_check_channels), and the pace of its steps (mt_check_pace; see mtcore.h).
+ * (mt_check_channels), and the pace of its steps (mt_check_roughness, mt_check_pace; see mtcore.h).
  *
  * The rows are walked in order and every channel carries its open events
  * from row to row, so that the values are read once, in the order they lie
@@ -249,6 +249,24 @@ int mt_check_pace(const double *values, size_t rows, size_t channels, size_t str
         moved[t] = m2;
         paced[t] = dm;
         stepped[t] = d2;
+    }
+    return MT_OK;
+}
+
+int mt_check_roughness(const double *values, size_t rows, size_t channels, size_t stride, double *squares,
+                       size_t *counts)
+{
+    if (stride < channels || (channels > 0 && (squares == NULL || counts == NULL)) ||
+        (rows > 0 && channels > 0 && values == NULL) || (channels > 0 && stride > SIZE_MAX / (rows > 0 ? rows : 1)))
+        return MT_EINVAL;
+    for (size_t t = 1; t + 1 < rows; t++) {
+        const double *a = values + (t - 1) * stride, *b = a + stride, *c = b + stride;
+        for (size_t k = 0; k < channels; k++) {
+            const double r = (a[k] + c[k]) * -0.5 + b[k];
+            const int finite = isfinite(r);
+            squares[k] += finite ? r * r : 0.0;
+            counts[k] += (size_t)finite;
+        }
     }
     return MT_OK;
 }

@@ -1081,6 +1081,16 @@ int mt_check_pace(const double *values, size_t rows, size_t channels, size_t str
                   double *moved, double *paced, double *stepped);
 
 /*
+ * How rough each channel of a take is (check.c), for the weights of mt_check_pace: over rows
+ * 1 .. rows - 2, r = (x[t-1] + x[t+1]) * -0.5 + x[t]; squares[k] += the sum of r^2 and counts[k]
+ * += how many rows' r are finite (the others, beside a gap or an infinity, are left out).  Adds to
+ * what squares and counts hold, so that a take's blocks (each with the row before and after it)
+ * add up to the whole take's.  Rows as mt_check_channels reads them (stride).
+ */
+int mt_check_roughness(const double *values, size_t rows, size_t channels, size_t stride, double *squares,
+                       size_t *counts);
+
+/*
  * Where the feet rest, and the floor they rest on (ground.c).  points (nlegs x frames x 5 x 3) as
  * mt_leg_points gives them; their contact points are heel, ball and toe tip, k = 0, 1, 2 in that
  * order; tips (nlegs): 1 where a leg has a toe tip; up: a signed coordinate axis.

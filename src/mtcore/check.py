@@ -30,6 +30,7 @@ __all__ = [
     "channel_events",
     "leg_measures",
     "pace",
+    "roughness",
 ]
 
 GAP, FROZEN, SPIKE, STEP, REPEAT = (
@@ -218,3 +219,17 @@ def leg_measures(
                                c_array(drift), c_array(depth), c_array(back))  # fmt: skip
     check(status, "mt_check_legs")
     return LegMeasures(drift, depth, back)
+
+
+def roughness(values: ArrayLike, squares: np.ndarray, counts: np.ndarray) -> None:
+    """Add to ``squares`` and ``counts`` (float64 and intp, one per channel) each channel's sum
+    of squared residuals from the mean of its two neighbours over the (rows, channels) values'
+    inner rows, and how many of those were finite (``mt_check_roughness``, csrc/mtcore.h)."""
+    x = np.ascontiguousarray(values, dtype=np.float64)
+    if x.ndim != 2:
+        raise ValueError(f"values must be two-dimensional (rows, channels), got shape {x.shape}")
+    rows, channels = x.shape
+    _checks.output(squares, "squares", (channels,))
+    _checks.output(counts, "counts", (channels,), np.uintp)
+    check(lib.mt_check_roughness(c_array(x), rows, channels, channels, c_array(squares), c_array(counts, "size_t[]")),
+          "mt_check_roughness")  # fmt: skip

@@ -27,7 +27,7 @@ from mtcore import rotations as rot
 from mtcore import search as mt_search
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
-from mtcore.check import channel_events, pace
+from mtcore.check import channel_events, pace, roughness
 from mtcore.check import leg_measures as check_legs
 from mtcore.combine import combine_frames
 from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
@@ -881,6 +881,12 @@ def check_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
+def fast_roughness(values, squares, counts):
+    squares, counts = squares.copy(), counts.copy()
+    roughness(values, squares, counts)
+    return squares, counts
+
+
 def fast_check(x, spike, step, min_run, begin, end):
     found = channel_events(x, spike, step, min_run, begin, end)
     return found.events, found.sizes, found.roughness, found.smooth_rows
@@ -975,6 +981,8 @@ TWINS: dict[str, Twin] = {
     "mt_check_pace": Twin(
         lambda x, w: tuple(vars(pace(x, w)).values()), check.pace_twin, check.pace_cases, close(1e-9)
     ),
+    # the sums added in another order than numpy's
+    "mt_check_roughness": Twin(fast_roughness, check.roughness_twin, check.roughness_cases, close(1e-12)),
     # acos in the knee's bend, the floor's heights and drifts summed as the contract says
     "mt_check_legs": Twin(
         lambda *case: tuple(vars(check_legs(*case)).values()),

@@ -202,3 +202,27 @@ def check_legs_cases(rng: np.random.Generator) -> list[tuple]:
                             math.cos(math.radians(45)), 90.0)  # fmt: skip
         out.append((points, hips, rng.uniform(0, 0.05, (legs, 3)), tips, settings))
     return out
+
+
+def roughness_twin(values, squares, counts):
+    """Each inner row's residual from the mean of its neighbours, one at a time; the finite ones summed."""
+    x = np.asarray(values, float)
+    squares, counts = squares.copy(), counts.copy()
+    for t in range(1, len(x) - 1):
+        for k in range(x.shape[1]):
+            r = (x[t - 1, k] + x[t + 1, k]) * -0.5 + x[t, k]
+            if math.isfinite(r):
+                squares[k] += r * r
+                counts[k] += 1
+    return squares, counts
+
+
+def roughness_cases(rng: np.random.Generator) -> list[tuple]:
+    """Takes of 0 to 60 rows with gaps and infinities, added to sums already held."""
+    out = []
+    for rows, channels in ((0, 2), (1, 3), (2, 1), (3, 2), (60, 5)):
+        x = rng.normal(size=(rows, channels)).cumsum(axis=0)
+        if rows > 10:
+            x[7, 1], x[20, 2], x[30:33, 4] = math.nan, math.inf, math.nan
+        out.append((x, rng.uniform(0, 5, channels), rng.integers(0, 9, channels).astype(np.uintp)))
+    return out

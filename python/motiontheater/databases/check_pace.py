@@ -98,19 +98,14 @@ def step_pace(motion: Motion, kinematics: Kinematics | None = None) -> kernel.Pa
         held, blocks = (kinematics[0] * motion.skeleton.meters_per_unit).reshape(rows, -1), [(0, rows)]
     elif len(blocks) == 1:
         held = _positions(motion, 0, rows)
-    squares, counts = np.zeros(3 * len(motion.skeleton.joint_names)), np.zeros(3 * len(motion.skeleton.joint_names))
-    for a, b in blocks:  # rows a-1 .. b: the roughness of rows a .. b-1, each row's once
-        p = held if held is not None else _positions(motion, max(a - 1, 0), min(b + 1, rows))
-        r = p[:-2] + p[2:]
-        r *= -0.5
-        r += p[1:-1]
-        sums = np.einsum("ij,ij->j", r, r)
-        count = np.full(len(sums), len(r))
-        for c in np.flatnonzero(~np.isfinite(sums)):  # a gap, or values no motion reaches: their rows left out
-            finite = np.isfinite(r[:, c])
-            sums[c], count[c] = np.sum(r[finite, c] ** 2), finite.sum()
-        squares += sums
-        counts += count
+    squares, counts = (
+        np.zeros(3 * len(motion.skeleton.joint_names)),
+        np.zeros(3 * len(motion.skeleton.joint_names), np.uintp),
+    )
+    for a, b in blocks:  # rows a-1 .. b: the roughness of rows a .. b-1, each row's once (a gap's left out)
+        kernel.roughness(
+            held if held is not None else _positions(motion, max(a - 1, 0), min(b + 1, rows)), squares, counts
+        )
     with np.errstate(invalid="ignore", divide="ignore"):
         noise = np.nan_to_num(squares / counts / 1.5)  # the variance of one coordinate
     # d - m = 1.5 x[t+1] - 1.5 x[t] + 0.5 x[t-1] - 0.5 x[t+2]: five times the variance of one
