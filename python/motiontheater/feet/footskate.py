@@ -141,6 +141,17 @@ def prepare(
 def _require_finite_legs(motion: Motion, legs: Legs) -> None:
     """ValueError unless some frame holds every channel that places the legs (the root's, the
     legs' and the joints' between them) as a number: a take of NaN has no feet to plant."""
+    skeleton = motion.skeleton
+    columns = skeleton.derived(("leg columns", legs.rotators.tobytes()), lambda: _placing_columns(motion, legs))
+    if motion.frames and not np.isfinite(motion.values[:, columns]).all(axis=1).any():
+        raise ValueError(
+            "no frame holds the legs as numbers (their channels are NaN or inf in every frame): there are "
+            "no feet to measure or plant; fill the gaps first (the fill_gaps step)"
+        )
+
+
+def _placing_columns(motion: Motion, legs: Legs) -> list[int]:
+    """The columns of the legs' joints and the joints above them."""
     skeleton, joints = motion.skeleton, set()
     for index in legs.rotators.ravel():
         if index < 0:
@@ -151,12 +162,7 @@ def _require_finite_legs(motion: Motion, legs: Legs) -> None:
             if joint == "root":
                 break
             joint = skeleton.parent(joint)
-    columns = [c for joint in joints for c in motion.columns(joint)]
-    if motion.frames and not np.isfinite(motion.values[:, columns]).all(axis=1).any():
-        raise ValueError(
-            "no frame holds the legs as numbers (their channels are NaN or inf in every frame): there are "
-            "no feet to measure or plant; fill the gaps first (the fill_gaps step)"
-        )
+    return [c for joint in joints for c in motion.columns(joint)]
 
 
 def contacts_of(
