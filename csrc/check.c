@@ -10,6 +10,7 @@
  * samples lie within the limit of it, so the median cannot lie beyond), and
  * that is nearly every sample of a real take.
  */
+#include "clones.h"
 #include "mtcore.h"
 
 #include <math.h>
@@ -113,6 +114,31 @@ static size_t mirrored(ptrdiff_t i, size_t rows)
     return (size_t)(i < 0 ? 0 : i > last ? last : i);
 }
 
+/* What one row tells of every channel, in a loop the compiler vectorises: each channel's
+   roughness, whether the row repeats the one before in every channel, and which channels are
+   quiet there (a number, moving, within the spike limit of both neighbours, no step): those
+   with no event open need nothing more, and that is nearly every channel of nearly every row. */
+static MT_CLONES int row_pass(const double *restrict x, const double *restrict before, const double *restrict after,
+                              const double *restrict earlier, size_t channels, int interior, int has_before,
+                              int has_after, const double *restrict spike_limit, const double *restrict step_limit,
+                              double *restrict roughness, size_t *restrict smooth_rows, unsigned char *restrict quiet)
+{
+    int same = 1;
+    for (size_t k = 0; k < channels; k++) {
+        const double v = x[k], b = before[k], a = after[k], limit = spike_limit[k], lim = step_limit[k];
+        const double rough = v - 0.5 * (b + a);
+        const int smooth = interior && fabs(rough) <= limit;
+        roughness[k] += smooth ? rough * rough : 0.0;
+        smooth_rows[k] += (size_t)smooth;
+        same &= v == b;
+        const double change = v - b;
+        const int step = (has_before || has_after) && (!has_before || fabs(change - (b - earlier[k])) > lim) &&
+                         (!has_after || fabs(change - (a - v)) > lim);
+        quiet[k] = (unsigned char)(v != b && fabs(v - b) <= limit && fabs(v - a) <= limit && !step);
+    }
+    return same;
+}
+
 int mt_check_channels(const double *values, size_t rows, size_t channels, size_t stride, size_t begin, size_t end,
                       const double *spike_limit, const double *step_limit, size_t min_run, size_t *events,
                       double *sizes, size_t capacity, size_t *count, double *roughness, size_t *smooth_rows)
@@ -129,8 +155,13 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
     if (channels == 0)
         return MT_OK;
     struct open *open = calloc(channels * OPEN_KINDS, sizeof *open);
-    if (open == NULL)
+    unsigned char *flags = calloc(2 * channels, 1); /* quiet in this row; an event open */
+    if (open == NULL || flags == NULL) {
+        free(open);
+        free(flags);
         return MT_ENOMEM;
+    }
+    unsigned char *quiet = flags, *busy = flags + channels;
     struct sink sink = {.events = events, .sizes = sizes, .capacity = capacity};
     struct open repeat = {0};
     for (size_t k = 0; k < channels; k++) {
@@ -139,23 +170,27 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
     }
 #define AT(t, k) values[(size_t)(t) * stride + (k)]
     for (size_t t = begin; t < end; t++) {
-        int same_row = t > 0;
+        const double *row = values + t * stride;
+        const double *before = t > 0 ? row - stride : row, *after = t + 1 < rows ? row + stride : row;
+        const double *earlier = t > 1 ? row - 2 * stride : before;
+        const int same_row = row_pass(row, before, after, earlier, channels, t > 0 && t + 1 < rows, t > 1, t + 1 < rows,
+                                      spike_limit, step_limit, roughness, smooth_rows, quiet) && t > 0;
         for (size_t k = 0; k < channels; k++) {
+            if (quiet[k] && !busy[k])
+                continue;
             struct open *o = open + k * OPEN_KINDS;
-            const double x = AT(t, k);
-            const double before = t > 0 ? AT(t - 1, k) : x;
-            const double after = t + 1 < rows ? AT(t + 1, k) : x;
-            same_row &= x == before;
+            const double x = row[k];
             if (x != x) {
                 extend(&o[GAP], t, 0.0);
                 close_frozen(&o[FROZEN], &sink, k, min_run, begin, end);
                 close_event(&o[SPIKE], &sink, k, MT_CHECK_SPIKE);
                 close_event(&o[STEP], &sink, k, MT_CHECK_STEP);
+                busy[k] = 1;
                 continue;
             }
             close_event(&o[GAP], &sink, k, MT_CHECK_GAP);
             /* a frozen run: rows equal to the row before; its first row is the one they repeat */
-            if (t > 0 && x == before) {
+            if (t > 0 && x == before[k]) {
                 if (!o[FROZEN].active)
                     extend(&o[FROZEN], t - 1, x);
                 o[FROZEN].last = t;
@@ -163,13 +198,8 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
                 close_frozen(&o[FROZEN], &sink, k, min_run, begin, end);
             }
             const double limit = spike_limit[k];
-            const double rough = x - 0.5 * (before + after);
-            if (t > 0 && t + 1 < rows && fabs(rough) <= limit) {
-                roughness[k] += rough * rough;
-                smooth_rows[k]++;
-            }
             double deviation = 0.0;
-            if (rows >= 3 && (fabs(x - before) > limit || fabs(x - after) > limit)) {
+            if (rows >= 3 && (fabs(x - before[k]) > limit || fabs(x - after[k]) > limit)) {
                 const double a = AT(mirrored((ptrdiff_t)t - 2, rows), k);
                 const double b = AT(mirrored((ptrdiff_t)t - 1, rows), k);
                 const double c = AT(mirrored((ptrdiff_t)t + 1, rows), k);
@@ -184,10 +214,10 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
             /* a step: the change into this row differs from both changes beside it */
             double jump = 0.0;
             if (t > 0) {
-                const double change = x - before;
+                const double change = x - before[k];
                 const int has_before = t > 1, has_after = t + 1 < rows;
-                const double change_before = has_before ? before - AT(t - 2, k) : change;
-                const double change_after = has_after ? after - x : change;
+                const double change_before = has_before ? before[k] - earlier[k] : change;
+                const double change_after = has_after ? after[k] - x : change;
                 const double lim = step_limit[k];
                 if ((has_before || has_after) && (!has_before || fabs(change - change_before) > lim) &&
                     (!has_after || fabs(change - change_after) > lim)) {
@@ -203,8 +233,9 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
                 extend(&o[STEP], t, jump);
             else
                 close_event(&o[STEP], &sink, k, MT_CHECK_STEP);
+            busy[k] = (unsigned char)(o[GAP].active | o[FROZEN].active | o[SPIKE].active | o[STEP].active);
         }
-        if (same_row && channels > 0)
+        if (same_row)
             extend(&repeat, t, 0.0);
         else
             close_event(&repeat, &sink, channels, MT_CHECK_REPEAT);
@@ -219,6 +250,7 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
     }
     close_event(&repeat, &sink, channels, MT_CHECK_REPEAT);
     free(open);
+    free(flags);
     *count = sink.count;
     return MT_OK;
 }

@@ -84,7 +84,7 @@ def channel_events(
     roughness = np.zeros(channels)
     smooth = np.zeros(channels, dtype=np.uintp)
     count = ffi.new("size_t *")
-    capacity = 64
+    capacity = 64 + rows  # seldom outgrown: a second pass over the values costs as much as the first
     while True:
         events = np.zeros((capacity, 5), dtype=np.uintp)
         sizes = np.zeros(capacity)
