@@ -85,18 +85,17 @@ def real_dtype(dtype: np.dtype, name: str, widest: str = "") -> np.dtype:
 def output(a, name: str, shape: tuple, dtype=np.float64, *, contiguous: bool = True) -> np.ndarray:
     """Check an output array given: a writeable ndarray of ``shape`` (as for :func:`real`) and, unless
     None, ``dtype``; C-contiguous unless told otherwise.  ValueError naming what is wrong."""
-    kind = "" if dtype is None else f" {np.dtype(dtype)}"
-    wanted = f"a writeable{' C-contiguous' if contiguous else ''}{kind} array of shape {_shown(shape)}"
-    if not isinstance(a, np.ndarray):
-        raise ValueError(f"{name} must be {wanted}, got {_got(a)}")
     problem = (
-        f"dtype {a.dtype}" if dtype is not None and a.dtype != dtype
+        _got(a) if not isinstance(a, np.ndarray)
+        else f"dtype {a.dtype}" if dtype is not None and a.dtype != dtype
         else f"shape {a.shape}" if not _fits(a, shape)
         else "a read-only array" if not a.flags.writeable
         else "an array that is not C-contiguous" if contiguous and not a.flags.c_contiguous
         else ""
     )  # fmt: skip
-    if problem:
+    if problem:  # the message made only when it is needed: outputs are checked on every call
+        kind = "" if dtype is None else f" {np.dtype(dtype)}"
+        wanted = f"a writeable{' C-contiguous' if contiguous else ''}{kind} array of shape {_shown(shape)}"
         raise ValueError(f"{name} must be {wanted}, got {problem}")
     return a
 

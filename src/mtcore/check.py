@@ -168,10 +168,10 @@ class LegCheck:
 
     def as_struct(self):
         """The settings as the kernel takes them (``struct mt_leg_check``)."""
-        up, slope = _checks.real(self.up, "up", (3,)), _checks.real(self.slope, "slope", (3,))
-        if not np.isfinite(up).all() or abs(float(np.linalg.norm(up)) - 1) > 1e-9:
+        up, slope = [float(v) for v in self.up], [float(v) for v in self.slope]
+        if len(up) != 3 or not abs(math.hypot(*up) - 1) <= 1e-9:
             raise ValueError(f"up must be a unit vector of 3, got {self.up}")
-        if not np.isfinite(slope).all() or abs(float(slope @ up)) > 1e-9:
+        if len(slope) != 3 or not abs(sum(a * b for a, b in zip(slope, up))) <= 1e-9:
             raise ValueError(f"slope must be a finite vector of 3 perpendicular to up, got {self.slope}")
         for name in ("level", "meters_per_unit", "frame_rate", "floor_height", "floor_speed", "foot_across", "folded"):
             if not math.isfinite(getattr(self, name)):
@@ -181,7 +181,7 @@ class LegCheck:
                 f"meters_per_unit and frame_rate must be positive, got {self.meters_per_unit}, {self.frame_rate}"
             )
         settings = ffi.new("struct mt_leg_check *")
-        settings.up, settings.slope = up.tolist(), slope.tolist()
+        settings.up, settings.slope = up, slope
         settings.window = _checks.integer(self.window, "window", 0)
         for name in ("level", "meters_per_unit", "frame_rate", "floor_height", "floor_speed", "foot_across", "folded"):
             setattr(settings, name, float(getattr(self, name)))

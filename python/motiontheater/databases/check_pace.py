@@ -69,7 +69,8 @@ def dropped_findings(
             quiet[max(a - 2, 0) : max(b + 3, 0)] = False
     out: list[Finding] = []
     made: set[int] = set()
-    for row in map(int, np.flatnonzero(taken & quiet & np.roll(quiet, -1))):
+    quiet[:-1] &= quiet[1:]  # and the row after
+    for row in map(int, np.flatnonzero(taken & quiet)):
         a, b = motion.first_frame + row, motion.first_frame + row + 1
         made.update((a - 1, a, b, b + 1))
         missing = int(steps[row]) - 1

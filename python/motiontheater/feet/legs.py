@@ -46,6 +46,7 @@ import itertools
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -121,9 +122,13 @@ class Legs:
         """Every joint the legs turn."""
         return tuple(name for leg in self.legs for name in leg.joints)
 
+    @cached_property
+    def _length(self) -> float:
+        return float(np.mean(np.linalg.norm(self.segments[:, :2], axis=-1).sum(axis=1)))
+
     def leg_length(self) -> float:
         """Mean over the legs of thigh plus shin length (hip to ankle at full extension), file units."""
-        return float(np.mean(np.linalg.norm(self.segments[:, :2], axis=-1).sum(axis=1)))
+        return self._length
 
 
 _SEPARATORS = re.compile(r"[\s_.\-]")
