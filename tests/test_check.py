@@ -266,7 +266,9 @@ def test_feet_in_the_floor_and_a_floor_away_from_zero_are_found_in_metres():
 
 def test_a_fast_smooth_turn_is_no_high_spike_and_a_pop_as_far_is():
     """LAFAN1's hands at 30 Hz turn 1,800 deg/s through excursions of 100 deg that a person sees
-    as a fast wrist: medium at most; the same hand popping 150 deg for two frames (4,500 deg/s) is high."""
+    as a fast wrist: medium at most; a forearm popping 150 deg for two frames (4,500 deg/s) is
+    high.  The hand popping as far is medium: its end site has no length, so its turn moves nothing
+    drawn (the viewer shows nothing; a skinned mesh would)."""
     lafan = real_files("bvh-producers/bvhTools_test2_lafan1.bvh")
     if not lafan:
         pytest.skip("the real-file corpus (../shared/data/bvh-producers) is absent")
@@ -274,11 +276,12 @@ def test_a_fast_smooth_turn_is_no_high_spike_and_a_pop_as_far_is():
     hands = [f for f in check_motion(take) if f.kind == "spike" and f.joints[0] in ("LeftHand", "RightHand")]
     assert hands and max(f.size for f in hands) > 70  # the excursions are found, as big as they are
     assert [f for f in hands if f.severity == "high"] == []
-    values = take.values.copy()
-    columns = take.columns("LeftHand", take.skeleton.dofs("LeftHand"))
-    values[600:602, columns[0]] += 150.0
-    popped = [f for f in check_motion(take.replace(values=values)) if f.kind == "spike" and f.first in (601, 602)]
-    assert [(f.joints, f.severity) for f in popped if f.joints == ("LeftHand",)] == [(("LeftHand",), "high")]
+    for joint, severity in (("LeftForeArm", "high"), ("LeftHand", "medium")):
+        values = take.values.copy()
+        columns = take.columns(joint, take.skeleton.dofs(joint))
+        values[600:602, columns[-3]] += 150.0  # its first rotation channel
+        found = [f for f in check_motion(take.replace(values=values)) if f.kind == "spike" and f.first in (601, 602)]
+        assert [(f.joints, f.severity) for f in found if f.joints == (joint,)] == [((joint,), severity)]
 
 
 def test_at_30_hz_a_swing_off_its_neighbours_path_is_low_and_a_turn_out_and_back_as_far_medium():
@@ -417,3 +420,71 @@ def test_a_take_of_nan_zeros_or_huge_values_is_checked_without_a_warning(path):
             warnings.simplefilter("error", RuntimeWarning)
             findings = check_motion(take.replace(values=values))
         assert all(f.kind in FINDING_KINDS for f in findings), name
+
+
+@pytest.mark.parametrize("frames", [1, 3, 20])
+def test_a_joint_of_two_angles_turned_over_is_one_spike_of_its_frames(frames):
+    """CMU's thumbs and hands have two angles (rx rz): an rz that crosses 90 deg and comes back
+    180 deg on turns the thumb over (no other pair of angles gives that rotation).  The check
+    finds one high spike of exactly the turned frames, none on the good frames beside them, and
+    its recipe puts the thumb back."""
+    take = mt.read_take(real_files("cmu/131_04-dance.amc")[0] if real_files("cmu/131_04-dance.amc") else _walk_path())
+    joint, first = "lthumb", 400
+    (rz,) = take.columns(joint, ("rz",))
+    values = take.values.copy()
+    values[first - 1 : first - 1 + frames, rz] += 180.0
+    turned = take.replace(values=values)
+    near = [
+        f for f in check_motion(turned) if joint in f.joints and first - 3 <= f.last and f.first <= first + frames + 2
+    ]
+    assert [(f.kind, f.first, f.last, f.severity) for f in near] == [("spike", first, first + frames - 1, "high")]
+    assert near[0].size == pytest.approx(180, abs=5)
+    fixed = recipe(near).apply(turned)
+    assert [
+        f for f in check_motion(fixed) if joint in f.joints and first - 3 <= f.last and f.first <= first + frames + 2
+    ] == []
+
+
+def test_a_turn_the_joints_below_turn_back_is_told_and_not_filled():
+    """A thigh turned 180 deg about its own bone for a few frames, the knee turned back by as
+    much: the angles jump, nothing drawn moves (a person sees nothing): medium, as angles that
+    are wrong for anyone who edits or retargets them, and no recipe fills the thigh alone (that
+    would put the leg out).  The same turn without the knee's is high, and filled."""
+    from scipy.spatial.transform import Rotation
+
+    walk = real_files("bvh/walk01.bvh")
+    if not walk:
+        pytest.skip("the real-file corpus (../shared/data/bvh) is absent")
+    take = mt.read_take(walk[0])
+    skeleton = take.skeleton
+    thigh, knee = "LeftUpLeg", "LeftLeg"
+    axis = (
+        skeleton.rest_positions()[skeleton.joint_names.index(knee)]
+        - skeleton.rest_positions()[skeleton.joint_names.index(thigh)]
+    )
+    twist = Rotation.from_rotvec(np.pi * axis / np.linalg.norm(axis))
+    rows = slice(40, 44)
+    for undone, severity in ((True, "medium"), (False, "high")):
+        values = take.values.copy()
+        for joint, turn in ((thigh, twist), (knee, twist.inv())) if undone else ((thigh, twist),):
+            dofs = [d for d in skeleton.dofs(joint) if d in ("rx", "ry", "rz")]
+            columns = take.columns(joint, tuple(dofs))
+            order = "".join(d[1] for d in dofs).upper()
+            rotation = Rotation.from_euler(order, values[rows, columns], degrees=True)
+            values[rows, columns] = (rotation * turn if joint == thigh else turn * rotation).as_euler(
+                order, degrees=True
+            )
+        turned = take.replace(values=values)
+        moved = np.abs(turned.positions() - take.positions()).max()
+        assert (moved < 1e-6) == undone
+        thighs = [f for f in check_motion(turned) if f.joints == (thigh,) and 38 <= f.first <= 45]
+        assert thighs and {f.severity for f in thighs} == {severity}, thighs
+        assert all(bool(f.fix) != undone for f in thighs)
+
+
+def test_a_rig_of_a_few_bones_has_no_unit_finding():
+    """A chain of four bones (sinusoidal.bvh) is no person: its size tells nothing of its unit."""
+    chain = real_files("bvh/sinusoidal.bvh")
+    if not chain:
+        pytest.skip("the real-file corpus (../shared/data/bvh) is absent")
+    assert [f for f in check_motion(mt.read_take(chain[0])) if f.kind == "unit"] == []

@@ -29,8 +29,8 @@ import numpy as np
 
 from mtcore import check as kernel
 from mtcore import median_filter1d
-from mtcore.kinematics import world_kinematics
-from mtcore.rotations import euler_to_quaternions, slerp, unroll_euler
+from mtcore.kinematics import Kinematics, world_kinematics
+from mtcore.rotations import euler_to_quaternions, quaternions_to_matrices, slerp, unroll_euler
 
 from ..editing.pipeline import Pipeline
 from ..model.motion import Motion
@@ -79,6 +79,13 @@ STEP_PAIR_SECONDS = 0.05
 POP_FRAMES = 3
 TELEPORT_M = 0.25
 """Metres: a root that leaves its neighbours by this for a few frames has teleported, however slow."""
+SEEN_M = 0.03
+"""Metres the points a joint turns must leave their path for a turn to be plain to see: a spike or
+jump of a rotation is high only if it moves them so far (a thumb flipped over moves its tip 4-9
+cm; a twist of the hand that moves the fingers 2 cm, nobody sees)."""
+UNSEEN_M = 0.005
+"""Metres below which a rotation's spike or jump moves nothing drawn (a hand whose end site has no
+length, a bone turned about itself): at most medium, which a skinned mesh would show."""
 SPIKE_TURN_DEG_S = 3_000.0
 """deg/s: a high spike turns faster than this between two frames, into it or out of it (a fast
 wrist at 30 Hz turns 1,800 deg/s through a smooth excursion; a pop turns 170 deg in one frame)."""
@@ -112,11 +119,16 @@ class _Take:
         self.degrees = 1.0 if skeleton.angle_unit == "deg" else 180.0 / math.pi  # degrees per file unit
         self.root = body_joint(motion)  # the joint that carries the body (a static root above it is no body)
         self.channels, self.triples, self._columns = skeleton.derived("check channels", lambda: _channels(skeleton))
+        # the joints whose rotation channels make a rotation (one, two or three of them): their
+        # rotations are judged, not their angles (a thumb's rz that crosses 90 deg and comes back
+        # 180 deg on is a turn, with no other pair of angles for it)
+        self.rotating = skeleton.derived("check rotations", lambda: _rotations(skeleton))
         self.turning = np.array([c.turns for c in self.channels], dtype=bool)  # the rotation channels
         # each channel's joint, and its joint's rotation or position channels, numbered in the
         # order of their names (the order events are joined in)
         self.joints, self.kinds = skeleton.derived("check channel groups", lambda: _groups(self.channels))
         self._quaternions: dict[str, np.ndarray] = {}
+        self.held: Kinematics | None = None  # the whole take's forward kinematics, where it fits a block
 
     def frame(self, row: int) -> int:
         return self.motion.first_frame + int(row)
@@ -141,14 +153,102 @@ class _Take:
         rows around them again and again)."""
         made = self._quaternions.get(joint)
         if made is None:
-            order, extrinsic, columns = self.triples[joint]
-            angles = self.motion.values[:, columns]
+            order, extrinsic, columns = self.rotating[joint]
+            angles = np.zeros((self.motion.frames, 3))
+            angles[:, : len(columns)] = self.motion.values[:, columns]  # the axes a joint lacks: turned by 0
             made = euler_to_quaternions(angles, order, extrinsic=extrinsic, degrees=self.degrees == 1.0)
             self._quaternions[joint] = made
         return made[rows]
 
+    def seen(self, joint: str, first: int, last: int) -> tuple[float, float]:
+        """How far the joint's rotation over rows first..last puts out the points it turns, in
+        metres: where they are, and where filling the joint alone would put them.  Where they
+        are: the farthest any of them lies, at a row of the stretch, from midway between where it
+        is in the rows before and after (a pop stands out so by its size, the ends of a
+        turn-over by half of it; smooth motion, however fast, by little; a turn that the joints
+        below turn back, by nothing).  Where filling would put them: how far they lie from where
+        the joint's rotation on the path between the rows around would put them, the joints below
+        as they are (a hand whose end has no length turns nothing; a thigh turned about itself
+        that the knee turns back looks right, and filling the thigh alone would put the leg
+        out).  (0, 0) where it turns none."""
+        p = self._turned_points(joint, first - 1, last + 2)
+        if p is None:
+            return 0.0, 0.0
+        off = float(np.nan_to_num(np.linalg.norm(p[1:-1] - 0.5 * (p[:-2] + p[2:]), axis=-1)).max())
+        length = last - first + 2  # steps from row first - 1 to row last + 1
+        share = np.arange(1, length) / length
+        q = self.quaternions(joint, np.array([first - 1, last + 1]))
+        path = slerp(np.broadcast_to(q[0], (len(share), 4)), np.broadcast_to(q[1], (len(share), 4)), share)
+        return off, self._moved(joint, np.arange(first, last + 1), path)
+
+    def seen_jump(self, joint: str, at: int) -> float:
+        """How far the joint's rotation jumping into row ``at`` (2 <= at <= rows - 2) and staying
+        puts out the points it turns, in metres: the lesser of how much longer their step into
+        the row is than their steps before and after it, and how far they lie from where the
+        rotation going on at its pace would put them."""
+        p = self._turned_points(joint, at - 2, at + 2)
+        if p is None:
+            return 0.0
+        steps = np.nan_to_num(np.linalg.norm(np.diff(p, axis=0), axis=-1))  # into rows at - 1, at, at + 1
+        jumped = float(np.max(steps[1] - np.maximum(steps[0], steps[2]), initial=0.0))
+        q = self.quaternions(joint, np.array([at - 2, at - 1]))
+        return min(jumped, self._moved(joint, np.array([at]), slerp(q[0], q[1], np.array([2.0]))))
+
+    def _moved(self, joint: str, rows: np.ndarray, instead: np.ndarray) -> float:
+        """How far the points the joint turns lie at the rows from where its rotations
+        ``instead`` (quaternions, one per row) would put them, in metres: their offsets from the
+        joint, in its channels' axes, turned by the difference of the two rotations."""
+        skeleton = self.motion.skeleton
+        tree, j = skeleton.tree, skeleton.joint_names.index(joint)
+        points = skeleton.derived(("turned points", joint), lambda: _turned(skeleton, joint))
+        places, turns = (
+            self.held if self.held is not None else world_kinematics(self.motion.values[rows], tree, workers=1)
+        )
+        at = rows if self.held is not None else np.arange(len(rows))
+        origin = j if skeleton.convention == "bvh" or tree.parent[j] < 0 else int(tree.parent[j])
+        offsets = places[at][:, points] - places[at, origin][:, None]  # (rows, points, 3), world axes
+        frame = turns[at, j] @ tree.axis[j]  # the joint's channels' axes in the world
+        local = np.einsum("rji,rpj->rpi", frame, offsets)
+        actual = self.quaternions(joint, rows)
+        error = quaternions_to_matrices(_conjugate(actual)) @ quaternions_to_matrices(instead)
+        shift = np.einsum("rij,rpj->rpi", error, local) - local
+        return float(np.nan_to_num(np.linalg.norm(shift, axis=-1)).max(initial=0.0)) * self.meters
+
+    def _turned_points(self, joint: str, first: int, stop: int) -> np.ndarray | None:
+        """The places (rows, points, 3) in metres of the points the joint's rotation moves, rows
+        first..stop-1 (within the take); None where it moves none."""
+        skeleton = self.motion.skeleton
+        points = skeleton.derived(("turned points", joint), lambda: _turned(skeleton, joint))
+        if not len(points):
+            return None
+        if self.held is not None:
+            places = self.held[0][first:stop]
+        else:
+            places = self.motion.replace(values=self.motion.values[first:stop]).positions()
+        return places[:, points] * self.meters
+
+
+def _conjugate(q: np.ndarray) -> np.ndarray:
+    return q * np.array([1.0, -1.0, -1.0, -1.0])
+
 
 _NONE = np.zeros(0, np.intp)
+
+
+def _turned(skeleton: Skeleton, joint: str) -> np.ndarray:
+    """The points (indices of ``joint_names``) that the joint's rotation moves: those below it,
+    and an ASF bone's own end."""
+    parent = skeleton.tree.parent
+    j = skeleton.joint_names.index(joint)
+    bvh = skeleton.convention == "bvh"
+    below = []
+    for i in range(len(parent)):
+        k = int(parent[i]) if bvh else i  # a BVH joint's own place is its parent's doing
+        while k >= 0 and k != j:
+            k = int(parent[k])
+        if k == j:
+            below.append(i)
+    return np.array(below, dtype=np.intp)
 
 
 def _channels(skeleton: Skeleton) -> tuple[list[_Channel], dict, dict[tuple[str, bool], np.ndarray]]:
@@ -164,6 +264,22 @@ def _channels(skeleton: Skeleton) -> tuple[list[_Channel], dict, dict[tuple[str,
     for c in channels:
         grouped.setdefault((c.joint, c.turns), []).append(c.index)
     return channels, triples, {key: np.array(columns, dtype=np.intp) for key, columns in grouped.items()}
+
+
+def _rotations(skeleton: Skeleton) -> dict[str, tuple[str, bool, np.ndarray]]:
+    """The joints whose one, two or three rotation channels make a rotation: joint -> (order,
+    extrinsic, columns), the order of three axes that their channels' axes begin (those of a
+    joint with fewer than three channels turned by 0)."""
+    extrinsic = skeleton.convention != "bvh"
+    out = {}
+    for joint in skeleton.joint_names:
+        start, dofs = skeleton.first_column(joint), skeleton.dofs(joint)
+        turns = [(start + i, dof[1]) for i, dof in enumerate(dofs) if dof in ROTATIONS]
+        axes = "".join(axis for _, axis in turns)
+        order = axes + "".join(a for a in "xyz" if a not in axes)[: 3 - len(axes)]
+        if 1 <= len(turns) <= 3 and order[0] != order[1] and order[1] != order[2]:
+            out[joint] = (order, extrinsic, np.array([c for c, _ in turns], dtype=np.intp))
+    return out
 
 
 def _groups(channels: list[_Channel]) -> tuple[np.ndarray, np.ndarray]:
@@ -208,6 +324,9 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         rows = motion.frames
         min_run = max(3, round(FROZEN_SECONDS * t.rate))
         found = kernel.channel_events(motion.values, spikes, steps, min_run)
+        # the joints' places and turns, for the spikes, steps, legs and arms alike, where they fit a block
+        if motion.frames <= BLOCK_FRAMES:
+            t.held = world_kinematics(motion.values, motion.skeleton.tree, workers=1)
         ev, sizes = found.events, found.sizes
         by_kind = {kind: (ev[ev[:, 3] == kind], sizes[ev[:, 3] == kind]) for kind in kernel.KINDS}
         repeats = by_kind[kernel.REPEAT][0]
@@ -228,10 +347,7 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         }
         findings += _spikes(t, by_kind[kernel.SPIKE], by_kind[kernel.STEP], explained, spikes)
         findings += _jitter(t, found.roughness, found.smooth_rows)
-        # the joints' places and turns, for the steps, the legs and the arms alike, where they fit a block
-        held = (
-            world_kinematics(motion.values, motion.skeleton.tree, workers=1) if motion.frames <= BLOCK_FRAMES else None
-        )
+        held = t.held
         dropped, findings = dropped_findings(motion, take, findings, held)
         findings += dropped
         findings += _bones(t)
@@ -433,7 +549,7 @@ def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
             shift = delta[beside] if inverted and beside < len(delta) else delta[first : last + 1]
             whole = bool(np.all(np.isclose(shift / 360, np.round(shift / 360), atol=1e-6)))
             edge = first if first > 0 else min(last + 1, len(angles) - 1)
-            if joint in t.triples and edge:
+            if joint in t.rotating and edge:
                 q = t.quaternions(joint, np.array([edge - 1, edge]))
                 if _angle_deg(q[0], q[1]) > FLIP_DEG / 2:
                     continue  # the rotation jumps too (a pop that unrolling changes): spikes and jumps judge it
@@ -538,47 +654,35 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     jumps: list[tuple[str, int, float, int, bool]] = []  # (joint, row, degrees, channel, not a spike's)
     for (c, first, last, _, at), size in zip(events[stay], sizes[stay]):
         channel = t.channels[int(c)]
+        if channel.turns and channel.joint in t.rotating:
+            # every row of a step: a turn-over's jumps out and back, a frame or two apart, make one
+            # step of the angles with its peak at one of them
+            quiet = bool(near_spike[int(c), max(first - 1, 0) : last + 2].any())
+            limit = max(JUMP_DEG, limits[int(c)] * t.degrees)
+            for row in range(max(first, 2), min(last, rows - 2) + 1):
+                if (channel.joint, row) in seen or (channel.joint, True, t.frame(row)) in explained:
+                    continue
+                seen.add((channel.joint, row))
+                pop, jump = _rotation_step(t, channel.joint, row, limit)
+                if pop is not None and not quiet and (channel.joint, pop) not in popped:
+                    popped.add((channel.joint, pop))
+                    off = _deviations(t, [(channel.joint, True, pop, pop)])[0]
+                    if off is not None and float(off[0]) > limit:
+                        out.append(_turning_spike(t, channel.joint, channel.name, pop, pop, float(off[0]), limit))
+                elif pop is None and jump > limit:
+                    jumps.append((channel.joint, row, jump, int(c), not quiet))
+            continue
         if (channel.joint, channel.turns, t.frame(at)) in explained or (
-            channel.turns and channel.joint not in t.triples and abs(t.physical(channel, size)) > FLIP_DEG
+            channel.turns and abs(t.physical(channel, size)) > FLIP_DEG
         ):
-            continue  # of a joint of three angles, the rotation tells a jump from a flip below
-        # the jumps into and out of a spike are the spike's (of a joint of three angles, they
-        # still tell how long a turn-over lasted, below)
-        quiet = bool(near_spike[int(c), max(first - 1, 0) : last + 2].any())
-        if quiet and not (channel.turns and channel.joint in t.triples):
+            continue  # the unrolled angles tell a wrap by whole turns (above)
+        # the jumps into and out of a spike are the spike's
+        if near_spike[int(c), max(first - 1, 0) : last + 2].any():
             continue
         if channel.turns:
-            if (channel.joint, at) in seen:
-                continue
-            if channel.joint in t.triples and at > 1 and at < rows - 1:
-                q = t.quaternions(channel.joint, np.array([at - 2, at - 1, at, at + 1]))
-                turn = _angle_deg(q[1:], q[:-1])
-                limit = max(JUMP_DEG, limits[int(c)] * t.degrees)
-                # the rotation leaves for one frame and comes back: a pop of that frame (whose Euler
-                # angles jump by other amounts on the way out and back), found from either jump
-                pop = next(
-                    (
-                        row
-                        for row, k in ((at - 1, 0), (at, 1))
-                        if min(turn[k], turn[k + 1]) > limit
-                        and _angle_deg(q[k], q[k + 2]) < 0.5 * min(turn[k], turn[k + 1])
-                    ),
-                    None,
-                )
-                if pop is not None:
-                    if not quiet and (channel.joint, pop) not in popped:
-                        popped.add((channel.joint, pop))
-                        off = _deviations(t, [(channel.joint, True, pop, pop)])[0]
-                        if off is not None and float(off[0]) > limit:
-                            out.append(_turning_spike(t, channel.joint, channel.name, pop, pop, float(off[0]), limit))
-                    continue
-                jump = float(turn[1] - 0.5 * (turn[0] + turn[2]))
-                if not jump > limit:
-                    continue
-            else:
-                jump = abs(t.physical(channel, size))
-            seen.add((channel.joint, at))
-            jumps.append((channel.joint, at, jump, int(c), not quiet))
+            if (channel.joint, at) not in seen:
+                seen.add((channel.joint, at))
+                jumps.append((channel.joint, at, abs(t.physical(channel, size)), int(c), True))
         elif channel.joint == t.root:
             distance = abs(t.physical(channel, size))
             out.append(
@@ -589,6 +693,19 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
                 )
             )  # fmt: skip
     return _excursions(t, out, jumps, limits)
+
+
+def _rotation_step(t: _Take, joint: str, row: int, limit: float) -> tuple[int | None, float]:
+    """What the joint's rotation does into row ``row`` (2 <= row <= rows - 2): the row of a pop
+    (the rotation leaves for one frame and comes back, whatever its Euler angles do on the way
+    out and back), found from the jump out or back, or None and the degrees it turns into the
+    row more than the mean of its turns into the rows before and after."""
+    q = t.quaternions(joint, np.arange(row - 2, row + 2))
+    turn = _angle_deg(q[1:], q[:-1])
+    for pop, k in ((row - 1, 0), (row, 1)):
+        if min(turn[k], turn[k + 1]) > limit and _angle_deg(q[k], q[k + 2]) < 0.5 * min(turn[k], turn[k + 1]):
+            return pop, 0.0
+    return None, float(turn[1] - 0.5 * (turn[0] + turn[2]))
 
 
 def _excursions(
@@ -611,19 +728,28 @@ def _excursions(
         if off is None:
             continue
         paired.update({(joint, a), (joint, b)})
+        # the spikes found within it, or beside it (the median of five around a frame beside it
+        # holds its frames): its own
         out = [
-            f for f in out if not (f.kind == "spike" and f.joints == (joint,) and t.frame(a) <= f.first <= t.frame(b))
+            f
+            for f in out
+            if not (
+                f.kind == "spike" and f.joints == (joint,) and f.last >= t.frame(a) - 2 and f.first <= t.frame(b) + 1
+            )
         ]
         limit = t.physical(t.channels[c], limits[c])
         out.append(_turning_spike(t, joint, t.channels[c].name, a, b - 1, float(off.max()), limit))
     for joint, at, jump, c, shown in jumps:
         if (joint, at) in paired or not shown:
             continue
+        seen = t.seen_jump(joint, at) if joint in t.rotating and 1 < at < t.motion.frames - 1 else math.inf
         severity = "high" if jump > 90 else "medium" if jump > 30 else "low"
+        severity = "low" if seen < UNSEEN_M else "medium" if severity == "high" and seen <= SEEN_M else severity
+        moved = f", moving what it turns {seen * 100:.2g} cm" if math.isfinite(seen) else ""
         out.append(
             Finding(
                 t.name, "jump", (joint,), t.frame(at), t.frame(at), severity, round(jump, 6), "deg",
-                f"{joint} turns {jump:.3g} deg more in one frame than in the frames beside it, and stays",
+                f"{joint} turns {jump:.3g} deg more in one frame than in the frames beside it{moved}, and stays",
                 t.channels[c].name,
             )
         )  # fmt: skip
@@ -632,8 +758,8 @@ def _excursions(
 
 def _apart(t: _Take, joint: str, first: int, last: int) -> float:
     """How far the joint's rotation at row ``last`` lies from row ``first``'s, in degrees (of a
-    joint with fewer than three angles, its angles' largest change, unwrapped)."""
-    if joint in t.triples:
+    joint whose channels make no rotation, its angles' largest change, unwrapped)."""
+    if joint in t.rotating:
         q = t.quaternions(joint, np.array([first, last]))
         return float(_angle_deg(q[0], q[1]))
     columns = t.columns(joint, True)
@@ -662,11 +788,31 @@ def _turning_spike(
         deviation > 2 * limit
         or (first > 0 and last < t.motion.frames - 1 and deviation > _apart(t, joint, first - 1, last + 1))
     )
-    severity = "high" if high else "medium" if medium else "low"
+    off, filled = t.seen(joint, first, last)
+    seen = min(off, filled)
+    # the take looks right, or nearly (the joints below turn it back, or it is the path the motion
+    # takes), and filling this joint alone would put out what it turns four times as far: told,
+    # not filled; medium where the angles are turned over (wrong for anyone who edits or
+    # retargets them), else low
+    undone = off <= 2 * SEEN_M and filled > 4 * off + SEEN_M
+    severity = (
+        ("medium" if high else "low") if seen < UNSEEN_M  # a twist nothing drawn shows: for a skinned mesh
+        else ("medium" if deviation > FLIP_DEG else "low") if undone
+        else "medium" if high and seen <= SEEN_M
+        else "high" if high
+        else "medium" if medium
+        else "low"
+    )  # fmt: skip
+    what = (
+        f"but what it turns stays within {off * 100:.2g} cm of its path (the joints below turn it back, or the "
+        f"motion goes so): told, not filled, which would move them {filled * 100:.2g} cm"
+        if undone
+        else f"moving what it turns {seen * 100:.2g} cm off its path"
+    )
     return Finding(
         t.name, "spike", (joint,), t.frame(first), t.frame(last), severity, round(deviation, 6), "deg",
-        f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s)",
-        channel, _fill(t, first, last, [joint]),
+        f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s), {what}",
+        channel, () if undone else _fill(t, first, last, [joint]),
     )  # fmt: skip
 
 
@@ -685,7 +831,7 @@ def _deviations(t: _Take, runs: list[Run]) -> list[np.ndarray | None]:
     groups: dict[tuple[bool, int], list[int]] = {}  # (turns, columns; 0 for a rotation of three angles): runs
     for i in inside:
         joint, turns = runs[i][:2]
-        key = (True, 0) if turns and joint in t.triples else (turns, len(t.columns(joint, turns)))
+        key = (True, 0) if turns and joint in t.rotating else (turns, len(t.columns(joint, turns)))
         groups.setdefault(key, []).append(i)
     for (turns, columns), members in groups.items():
         chosen = [runs[i] for i in members]
@@ -766,14 +912,14 @@ def _fastest(t: _Take, joint: str, first: int, last: int) -> float:
     """The fastest the joint turns from one frame to the next from the row before rows
     first..last to the row after them, in degrees per second (inf without three rotation
     channels, where the check has no other measure than the channel's own)."""
-    return _fastest_step(t, joint, (first - 1, last + 1)) * t.rate if joint in t.triples else math.inf
+    return _fastest_step(t, joint, (first - 1, last + 1)) * t.rate if joint in t.rotating else math.inf
 
 
 def _fastest_step(t: _Take, joint: str, *spans: tuple[int, int]) -> float:
     """The most the joint turns from one frame to the next within the spans of rows (first,
     last) of the take, in degrees (0 where it has no three rotation channels or no span two of
     those rows): the rotations of every span's rows made at once."""
-    if joint not in t.triples:
+    if joint not in t.rotating:
         return 0.0
     cut = [np.arange(max(a, 0), min(b, t.motion.frames - 1) + 1) for a, b in spans]
     cut = [rows for rows in cut if len(rows) >= 2]
@@ -906,7 +1052,7 @@ def _speed(t: _Take) -> list[Finding]:
 UNIT_FACTORS = (10.0, 0.1, 100.0, 0.01, 1000.0, 0.001, 2.54, 1 / 2.54, 25.4, 1 / 25.4)
 """The factors a length unit is usually off by (a named unit for another)."""
 HUMAN_JOINTS = 10
-"""A skeleton with fewer joints may be no person: its size suggests no unit."""
+"""A skeleton with fewer joints may be no person: its size tells nothing wrong with its unit."""
 TYPICAL_HEIGHT_M = 1.75
 """Metres: of the factors that make the character human-sized, the recipe takes the one that
 makes it nearest this."""
@@ -915,10 +1061,9 @@ makes it nearest this."""
 def _unit(t: _Take) -> list[Finding]:
     sizing = t.motion.skeleton.sizing()
     height = sizing.told_by * t.meters
-    if HUMAN_HEIGHT[0] <= height < HUMAN_HEIGHT[1] or height == 0:
-        return []
-    human = len(t.motion.skeleton.joint_names) >= HUMAN_JOINTS
-    fits = [f for f in UNIT_FACTORS if human and HUMAN_HEIGHT[0] <= height * f < HUMAN_HEIGHT[1]]
+    if HUMAN_HEIGHT[0] <= height < HUMAN_HEIGHT[1] or height == 0 or len(t.motion.skeleton.joint_names) < HUMAN_JOINTS:
+        return []  # a person's size, or no person (a chain of a few bones) whose size could tell
+    fits = [f for f in UNIT_FACTORS if HUMAN_HEIGHT[0] <= height * f < HUMAN_HEIGHT[1]]
     fits.sort(key=lambda f: abs(math.log(height * f / TYPICAL_HEIGHT_M)))  # the likeliest first
     unit = t.motion.skeleton.length_unit or "inch"
     return [
