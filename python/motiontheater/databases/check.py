@@ -659,11 +659,11 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
             # step of the angles with its peak at one of them
             quiet = bool(near_spike[int(c), max(first - 1, 0) : last + 2].any())
             limit = max(JUMP_DEG, limits[int(c)] * t.degrees)
-            for row in range(max(first, 2), min(last, rows - 2) + 1):
+            span = range(max(first, 2), min(last, rows - 2) + 1)
+            for row, (pop, jump) in zip(span, _rotation_steps(t, channel.joint, span, limit) if span else ()):
                 if (channel.joint, row) in seen or (channel.joint, True, t.frame(row)) in explained:
                     continue
                 seen.add((channel.joint, row))
-                pop, jump = _rotation_step(t, channel.joint, row, limit)
                 if pop is not None and not quiet and (channel.joint, pop) not in popped:
                     popped.add((channel.joint, pop))
                     off = _deviations(t, [(channel.joint, True, pop, pop)])[0]
@@ -695,17 +695,27 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     return _excursions(t, out, jumps, limits)
 
 
-def _rotation_step(t: _Take, joint: str, row: int, limit: float) -> tuple[int | None, float]:
-    """What the joint's rotation does into row ``row`` (2 <= row <= rows - 2): the row of a pop
-    (the rotation leaves for one frame and comes back, whatever its Euler angles do on the way
-    out and back), found from the jump out or back, or None and the degrees it turns into the
-    row more than the mean of its turns into the rows before and after."""
-    q = t.quaternions(joint, np.arange(row - 2, row + 2))
-    turn = _angle_deg(q[1:], q[:-1])
-    for pop, k in ((row - 1, 0), (row, 1)):
-        if min(turn[k], turn[k + 1]) > limit and _angle_deg(q[k], q[k + 2]) < 0.5 * min(turn[k], turn[k + 1]):
-            return pop, 0.0
-    return None, float(turn[1] - 0.5 * (turn[0] + turn[2]))
+def _rotation_steps(t: _Take, joint: str, rows: range, limit: float) -> list[tuple[int | None, float]]:
+    """What the joint's rotation does into each row (2 <= row <= rows - 2 of the take): the row of
+    a pop (the rotation leaves for one frame and comes back, whatever its Euler angles do on the
+    way out and back), found from the jump out or back, or None and the degrees it turns into
+    the row more than the mean of its turns into the rows before and after."""
+    q = t.quaternions(joint, np.arange(rows[0] - 2, rows[-1] + 2))
+    turn = _angle_deg(q[1:], q[:-1])  # turn[k]: into row rows[0] - 1 + k
+    back = _angle_deg(q[2:], q[:-2])  # back[k]: from row rows[0] - 2 + k to two rows on
+    out: list[tuple[int | None, float]] = []
+    for i, row in enumerate(rows):
+        pop = next(
+            (
+                row - 1 + side
+                for side in (0, 1)
+                if min(turn[i + side], turn[i + side + 1]) > limit
+                and back[i + side] < 0.5 * min(turn[i + side], turn[i + side + 1])
+            ),
+            None,
+        )
+        out.append((pop, 0.0) if pop is not None else (None, float(turn[i + 1] - 0.5 * (turn[i] + turn[i + 2]))))
+    return out
 
 
 def _excursions(
@@ -742,9 +752,13 @@ def _excursions(
     for joint, at, jump, c, shown in jumps:
         if (joint, at) in paired or not shown:
             continue
-        seen = t.seen_jump(joint, at) if joint in t.rotating and 1 < at < t.motion.frames - 1 else math.inf
         severity = "high" if jump > 90 else "medium" if jump > 30 else "low"
-        severity = "low" if seen < UNSEEN_M else "medium" if severity == "high" and seen <= SEEN_M else severity
+        turned = severity != "low" and joint in t.rotating and 1 < at < t.motion.frames - 1
+        seen = t.seen_jump(joint, at) if turned else math.inf
+        if seen < UNSEEN_M:  # a twist nothing drawn shows: for a skinned mesh
+            severity = "medium" if severity == "high" else "low"
+        elif severity == "high" and seen <= SEEN_M:
+            severity = "medium"
         moved = f", moving what it turns {seen * 100:.2g} cm" if math.isfinite(seen) else ""
         out.append(
             Finding(
@@ -788,6 +802,12 @@ def _turning_spike(
         deviation > 2 * limit
         or (first > 0 and last < t.motion.frames - 1 and deviation > _apart(t, joint, first - 1, last + 1))
     )
+    if not (high or medium):  # low, whatever it moves
+        return Finding(
+            t.name, "spike", (joint,), t.frame(first), t.frame(last), "low", round(deviation, 6), "deg",
+            f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s)",
+            channel, _fill(t, first, last, [joint]),
+        )  # fmt: skip
     off, filled = t.seen(joint, first, last)
     seen = min(off, filled)
     # the take looks right, or nearly (the joints below turn it back, or it is the path the motion
@@ -798,10 +818,8 @@ def _turning_spike(
     severity = (
         ("medium" if high else "low") if seen < UNSEEN_M  # a twist nothing drawn shows: for a skinned mesh
         else ("medium" if deviation > FLIP_DEG else "low") if undone
-        else "medium" if high and seen <= SEEN_M
-        else "high" if high
-        else "medium" if medium
-        else "low"
+        else "high" if high and seen > SEEN_M
+        else "medium"
     )  # fmt: skip
     what = (
         f"but what it turns stays within {off * 100:.2g} cm of its path (the joints below turn it back, or the "
