@@ -41,6 +41,7 @@ from .check_arms import arm_findings
 from .check_feet import leg_findings
 from .check_pace import BLOCK_FRAMES, dropped_findings
 from .findings import Finding
+from .pieces import check_frames
 
 SPIKE_DEG = 5.0
 """Degrees a joint's rotation must leave the median of the five frames around it to be a spike."""
@@ -129,6 +130,7 @@ class _Take:
         self.joints, self.kinds = skeleton.derived("check channel groups", lambda: _groups(self.channels))
         self._quaternions: dict[str, np.ndarray] = {}
         self.held: Kinematics | None = None  # the whole take's forward kinematics, where it fits a block
+        self.begins, self.ends = True, True  # whether these frames begin and end the take
 
     def frame(self, row: int) -> int:
         return self.motion.first_frame + int(row)
@@ -310,11 +312,27 @@ def _limits(take: _Take) -> tuple[np.ndarray, np.ndarray]:
 
 
 def check_motion(motion: Motion, take: str = "") -> list[Finding]:
-    """Every finding of the take (named ``take`` in them), sorted by first frame, severity and kind."""
+    """Every finding of the take (named ``take`` in them), sorted by first frame, severity and
+    kind; a long take checked a piece at a time (:mod:`.pieces`)."""
+    return check_blocks(motion.replace(values=motion.values[:0]), [motion.values], take)
+
+
+def check_blocks(template: Motion, blocks: Iterable[np.ndarray], take: str = "") -> list[Finding]:
+    """:func:`check_motion` of the take whose frames come as ``blocks`` of rows, in order (a take
+    read a piece at a time: :func:`~motiontheater.formats.amc.open_amc`), with ``template``'s
+    skeleton, rate and first frame."""
+    found = check_frames(template, blocks, lambda piece, begins, ends: _check_piece(piece, take, begins, ends))
+    return sorted(found, key=lambda f: (f.first, -f.rank, f.kind, f.joints))
+
+
+def _check_piece(motion: Motion, take: str, begins: bool, ends: bool) -> list[Finding]:
+    """The findings of a piece of a take, ``begins`` and ``ends`` saying whether it begins and
+    ends the take (a held pose at an end, a rest pose before the capture)."""
     infinite = np.isinf(motion.values)
     if infinite.any():  # a number too large to write, read as infinity: a value missing, as NaN is
         motion = motion.replace(values=np.where(infinite, np.nan, motion.values))
     t = _Take(motion, take)
+    t.begins, t.ends = begins, ends
     findings = _unit(t)
     for finding in findings:  # lengths are judged in the unit the fix makes them
         for name, options in finding.fix:
@@ -354,7 +372,7 @@ def check_motion(motion: Motion, take: str = "") -> list[Finding]:
         findings += _speed(t)
         findings += leg_findings(motion, take, t.meters, held)
         findings += arm_findings(motion, take, held)
-    return sorted(findings, key=lambda f: (f.first, -f.rank, f.kind, f.joints))
+    return findings
 
 
 def _edges_of(finding: Finding) -> Iterable[int]:
@@ -416,7 +434,7 @@ def _repeats(t: _Take, events: np.ndarray, rows: int) -> list[Finding]:
     for _, first, last, _, _ in events.tolist():
         count = last - first + 1
         seconds = count / t.rate
-        held = (first <= 1 or last >= rows - 1) and seconds >= FILL_SECONDS
+        held = ((first <= 1 and t.begins) or (last >= rows - 1 and t.ends)) and seconds >= FILL_SECONDS
         severity = "low" if held else "medium"
         what = "the take starts or ends with a held pose" if held else "dropped frames filled by repeating one"
         out.append(
@@ -541,7 +559,7 @@ def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
         finite = np.isfinite(angles).all(axis=1)
         runs = _runs(off)
         # every frame but the first few off their triple: the first frames (a rest pose) are the flipped ones
-        inverted = len(runs) == 1 and runs[0][0] <= LEAD_FRAMES and runs[0][1] == len(off) - 1
+        inverted = t.begins and t.ends and len(runs) == 1 and runs[0][0] <= LEAD_FRAMES and runs[0][1] == len(off) - 1
         if inverted:
             off = finite & ~off
         for first, last in _runs(off):

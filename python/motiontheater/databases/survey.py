@@ -5,20 +5,26 @@ report's plot, and the fix recipes written beside them."""
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .._io import output
-from ..formats.table import read_take
+from ..formats.amc import open_amc
+from ..formats.table import format_of, read_skeleton, read_take, skeleton_for
 from ..model.errors import FormatError
 from ..model.rig import choose_body
 from .batch import Progress, find_takes, run_each
-from .check import check_motion, recipe
+from .check import check_blocks, check_motion, recipe
 from .findings import Finding
 
+STREAM_ABOVE = 16 << 20
+"""Bytes of AMC above which a take is checked a piece at a time as it is read (its frames never
+held at once): the check's memory does not grow with the take."""
+READ_BYTES = 8 << 20
+"""Bytes of text such a take is read at a time."""
 CURVE_POINTS = 200
 """The most samples of a finding's plot: longer stretches are decimated."""
 CURVE_SECONDS = 0.5
@@ -71,13 +77,15 @@ class CheckJob:
 
 
 def check_job(job: CheckJob) -> TakeCheck:
-    """Read and check one take; a take that cannot be read is one finding that says why."""
+    """Read and check one take; a take that cannot be read is one finding that says why.  An AMC
+    take larger than STREAM_ABOVE is read a piece at a time as it is checked, so that memory does
+    not grow with the take (its findings then have no curves and it gets no viewer page)."""
     try:
+        if job.bytes > STREAM_ABOVE and format_of(job.take).suffix == ".amc":
+            return _streamed(job)
         motion = read_take(job.take, job.asf, job.frame_rate, job.unit, workers=1)
     except (FormatError, ValueError, OSError, MemoryError) as e:
-        reason = str(e) if job.take in str(e) else f"{job.take}: {e}"
-        unreadable = Finding(job.take, "unreadable", (), 0, -1, "high", 0.0, "", reason)
-        return TakeCheck(job.take, job.relative, (unreadable,), (None,), bytes=job.bytes)
+        return _unreadable(job, e)
     if job.body is not None:  # a joint the take lacks is the caller's mistake: it stops the run
         motion = choose_body(motion, job.body)
     findings = tuple(check_motion(motion, job.take))
@@ -90,6 +98,35 @@ def check_job(job: CheckJob) -> TakeCheck:
         write_page([motion], view, names=[job.relative])
     return TakeCheck(
         job.take, job.relative, findings, curves, motion.frames, motion.frame_rate, job.bytes, motion.first_frame, view
+    )
+
+
+def _unreadable(job: CheckJob, e: Exception) -> TakeCheck:
+    reason = str(e) if job.take in str(e) else f"{job.take}: {e}"
+    unreadable = Finding(job.take, "unreadable", (), 0, -1, "high", 0.0, "", reason)
+    return TakeCheck(job.take, job.relative, (unreadable,), (None,), bytes=job.bytes)
+
+
+def _streamed(job: CheckJob) -> TakeCheck:
+    """Check an AMC take read a piece at a time (:func:`~motiontheater.formats.amc.open_amc`)."""
+    companion = skeleton_for(job.take, job.asf)
+    assert companion is not None  # an AMC's
+    take = open_amc(job.take, read_skeleton(companion, job.unit), job.frame_rate, read_bytes=READ_BYTES)
+    template = take.motion if job.body is None else choose_body(take.motion, job.body)
+    frames = 0
+
+    def counted() -> Iterator[np.ndarray]:
+        nonlocal frames
+        for values in take.pieces():
+            frames += len(values)
+            yield values
+
+    findings = tuple(check_blocks(template, counted(), job.take))
+    if not frames:
+        raise ValueError(f"{job.take}: the take holds no frames")
+    curves = (None,) * len(findings) if job.curves else ()
+    return TakeCheck(
+        job.take, job.relative, findings, curves, frames, template.frame_rate, job.bytes, template.first_frame
     )
 
 

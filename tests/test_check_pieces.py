@@ -1,0 +1,96 @@
+"""A take of any length is checked a piece at a time, and an AMC larger than a threshold as it
+is read: what is found is what checking it whole finds, and the memory it takes does not grow
+with the take."""
+
+import collections
+import re
+import tracemalloc
+
+import numpy as np
+import pytest
+
+import motiontheater as mt
+from corpus import DATA, real_files
+from motiontheater.databases import pieces, survey
+from motiontheater.databases.check import check_motion
+
+LONG = [
+    p
+    for p in real_files("cmu/*.amc") + real_files("cmu/*.bvh")
+    if p.name in ("01_01.amc", "135_06-martialArts.amc", "01_01.bvh")
+]
+
+
+def _key(f):
+    return (f.kind, f.joints, f.first, f.last, f.severity)
+
+
+@pytest.mark.parametrize("path", LONG, ids=lambda p: p.name)
+def test_a_take_checked_in_pieces_finds_what_it_does_whole(path, monkeypatch):
+    """Pieces of 1,000 frames (8 s at 120 Hz), each read with 3 s of its neighbours: every medium
+    and high finding is the one the whole take gives, and the low ones but for a few (at the
+    seams, and a channel dead in some pieces, whose joint holds still in others)."""
+    take = mt.read_take(path)
+    monkeypatch.setattr(pieces, "PIECE_FRAMES", 10**9)
+    whole = set(map(_key, check_motion(take)))
+    monkeypatch.setattr(pieces, "PIECE_FRAMES", 1000)
+    cut = set(map(_key, check_motion(take)))
+    assert {k for k in whole if k[4] != "low"} == {k for k in cut if k[4] != "low"}
+    assert len(whole ^ cut) <= 0.1 * len(whole)
+
+
+def test_a_finding_that_runs_over_pieces_is_one():
+    """A gap of 1,100 frames (9 s) across three pieces, longer than a piece and the frames read
+    around it, and a hold across the seam of two: one finding each, over its frames, as the whole
+    take gives."""
+    take = mt.read_take(LONG[0]) if LONG else pytest.skip("the real-file corpus (../shared/data/cmu) is absent")
+    values = take.values.copy()
+    (column,) = take.columns("lhumerus", ("rx",))
+    values[500:900, column] = values[500, column]
+    values[1200:2300, take.columns("rradius", ("rx",))[0]] = np.nan
+    held = take.replace(values=values)
+    whole = check_motion(held)
+    old = pieces.PIECE_FRAMES
+    try:
+        pieces.PIECE_FRAMES = 700
+        cut = check_motion(held)
+    finally:
+        pieces.PIECE_FRAMES = old
+    for kind, joint in (("frozen", "lhumerus"), ("gap", "rradius")):
+        got = [(f.first, f.last, f.severity, f.size) for f in cut if f.kind == kind and f.joints == (joint,)]
+        want = [(f.first, f.last, f.severity, f.size) for f in whole if f.kind == kind and f.joints == (joint,)]
+        assert got == want and len(got) == 1, (kind, got, want)
+
+
+def _repeated(frames: int) -> bytes:
+    """cmu/01_01.amc with its frames repeated and renumbered up to ``frames`` frames."""
+    text = (DATA / "cmu" / "01_01.amc").read_bytes()
+    first = re.search(rb"(?m)^1\s*$", text).start()
+    blocks = re.split(rb"(?m)^\d+\s*\r?\n", text[first:])[1:]
+    return text[:first] + b"".join(b"%d\r\n" % (i + 1) + blocks[i % len(blocks)] for i in range(frames))
+
+
+def test_an_amc_read_as_it_is_checked_takes_memory_that_does_not_grow_with_it(tmp_path, monkeypatch):
+    """A take four times as long takes no more memory to check (it is read a piece at a time),
+    and what is found in it is what reading it whole finds."""
+    if not real_files("cmu/01_01.amc"):
+        pytest.skip("the real-file corpus (../shared/data/cmu) is absent")
+    monkeypatch.setattr(pieces, "PIECE_FRAMES", 1000)
+    peaks, found = {}, {}
+    for frames in (6000, 24000):
+        path = tmp_path / f"long{frames}.amc"
+        path.write_bytes(_repeated(frames))
+        (job,) = survey.plan([str(path)], asf=str(DATA / "cmu" / "01.asf"))
+        monkeypatch.setattr(survey, "STREAM_ABOVE", 0)
+        monkeypatch.setattr(survey, "READ_BYTES", 1 << 20)  # a megabyte of text at a time
+        tracemalloc.start()
+        streamed = survey.check_job(job)
+        peaks[frames] = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        monkeypatch.setattr(survey, "STREAM_ABOVE", 1 << 60)
+        whole = survey.check_job(job)
+        assert streamed.frames == whole.frames == frames
+        assert streamed.findings == whole.findings
+        found[frames] = collections.Counter(f.kind for f in streamed.findings)
+    assert peaks[24000] < 1.25 * peaks[6000], peaks
+    assert found[24000]["teleport"] > found[6000]["teleport"] > 0  # the seams of the repeats, found all along
