@@ -299,7 +299,7 @@ def _apply(args: argparse.Namespace) -> int:
     target = output(args, source)
     if pipeline.exporter is None:
         take_suffix(target)
-    motion = take_of(args, source)
+    motion = take_of(args, source, whole_frames=pipeline.whole_frames)
     result = pipeline.apply(motion)
     if pipeline.exporter is not None:
         pipeline.write(result, target)
@@ -309,6 +309,8 @@ def _apply(args: argparse.Namespace) -> int:
     # a check's recipe may hold hundreds of steps: each run of one step told once, with its count
     runs = [(name, len(list(run))) for name, run in itertools.groupby(entry.name for entry in pipeline.entries)]
     names = ", ".join(name if count == 1 else f"{name} x{count}" for name, count in runs) or "no steps"
+    if pipeline.whole_frames:
+        names = f"the file's whole frames read, {names}"
     print(f"{args.recipe} ({names}) on {motion.frames} frames of {source}: wrote {written}")
     return 0
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from ..formats.table import read_take
+from ..formats.table import read_take, read_take_frames
 from ..model.motion import Motion
 from ..model.rig import choose_body
 from ..model.units import UNIT_HELP
@@ -41,9 +41,13 @@ def add_take_options(parser: argparse.ArgumentParser, *, frames: bool = False, u
         parser.add_argument("--frames", type=frame_range, metavar="A:B", help="only frames A to B of the take")
 
 
-def take_of(args: argparse.Namespace, path: str) -> Motion:
-    """The take at ``path``, read as the options of :func:`add_take_options` say."""
-    motion = read_take(path, args.asf, args.frame_rate, args.unit)
+def take_of(args: argparse.Namespace, path: str, *, whole_frames: bool = False) -> Motion:
+    """The take at ``path``, read as the options of :func:`add_take_options` say; with
+    ``whole_frames``, the frames a file that breaks off holds whole (a recipe's whole_frames)."""
+    if whole_frames:
+        motion = read_take_frames(path, args.asf, args.frame_rate, args.unit)[0]
+    else:
+        motion = read_take(path, args.asf, args.frame_rate, args.unit)
     return motion if args.body is None else choose_body(motion, args.body)
 
 

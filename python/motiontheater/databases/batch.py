@@ -556,10 +556,13 @@ def _notes_into(notes: list[tuple[int, str]]) -> Generator[None]:
 
 
 def _read(job: Job) -> Motion:
-    reader = format_of(job.input).read
-    assert reader is not None
+    row = format_of(job.input)
     skeleton = read_skeleton(job.skeleton, job.unit) if job.skeleton else None
-    motion = reader(job.input, skeleton, job.frame_rate, job.unit, 1)
+    if job.pipeline.whole_frames and row.read_frames is not None:  # a file that breaks off: its whole frames
+        motion = row.read_frames(job.input, skeleton, job.frame_rate, job.unit, 1)[0]
+    else:
+        assert row.read is not None
+        motion = row.read(job.input, skeleton, job.frame_rate, job.unit, 1)
     return motion if job.body is None else choose_body(motion, job.body)
 
 

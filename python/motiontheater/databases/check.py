@@ -33,6 +33,7 @@ from mtcore.kinematics import Kinematics, world_kinematics
 from mtcore.rotations import euler_to_quaternions, quaternions_to_matrices, slerp, unroll_euler
 
 from ..editing.pipeline import Pipeline
+from ..formats.cut import Cut
 from ..model.motion import Motion
 from ..model.rig import body_joint
 from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
@@ -1113,14 +1114,32 @@ def _unit(t: _Take) -> list[Finding]:
     ]  # fmt: skip
 
 
+def header_finding(motion: Motion, cut: Cut, take: str = "") -> Finding:
+    """The finding of a take whose file disagrees with its header (``cut``, as
+    :func:`~motiontheater.formats.table.read_take_frames` found it; ``motion`` its whole frames),
+    fixed by reading the whole frames and writing them anew (a recipe's whole_frames)."""
+    declared = motion.frames + 1 if cut.declared is None else cut.declared
+    first, last = sorted(
+        (motion.first_frame + min(declared, cut.held), motion.first_frame + max(declared, cut.held) - 1)
+    )
+    seconds = (last - first + 1) / motion.frame_rate
+    return Finding(
+        take, "header", (), first, last, "high", round(seconds, 6), "s",
+        f"{cut.reason} (line {cut.line}); the rest is checked on the {motion.frames} whole frames",
+        fix=(("whole_frames", {}),),
+    )  # fmt: skip
+
+
 def recipe(findings: Iterable[Finding], severities: tuple[str, ...] = ("medium", "high")) -> Pipeline:
     """The steps that fix the findings of ``severities`` (those with a fix): unit first, then
     flips, then the frames filled, then smoothing, then the feet, each confined to its frames and
-    joints."""
+    joints; a file that breaks off read for its whole frames."""
     order = ("scale", "unroll", "fill_gaps", "butterworth", "cleanup")
     entries = [step for f in findings if f.severity in severities for step in f.fix]
+    whole = any(name == "whole_frames" for name, _ in entries)
+    entries = [e for e in entries if e[0] != "whole_frames"]
     entries.sort(key=lambda e: order.index(e[0]) if e[0] in order else len(order))
-    pipeline = Pipeline()
+    pipeline = Pipeline(whole_frames=whole)
     seen = []
     for name, options in entries:
         if (name, options) in seen:

@@ -29,6 +29,7 @@ KINDS = {
     "floor": "the feet rest on a floor away from level zero",
     "knee": "a knee bent backwards past what knees do",
     "elbow": "an elbow bent backwards past what elbows do",
+    "header": "the file disagrees with its header: it breaks off before the frames it says it holds (a frame cut short), or goes on past them",
     "unreadable": "the file cannot be read as a take",
 }
 """Every kind of finding, and what it means."""
@@ -40,7 +41,9 @@ class Finding:
     ``joints`` the joints concerned as the file spells them, ``size`` how large it is in
     ``unit`` (deg, m, m/s, s, Hz, mm, or "" for a count); ``channel`` the worst channel
     ("joint dof") where there is one, ``detail`` a sentence for a person, and ``fix`` the steps
-    that repair it, each (step name, options) as a recipe writes them (empty: none is known)."""
+    that repair it, each (step name, options) as a recipe writes them (empty: none is known;
+    ``("whole_frames", {})``, a file's whole frames read and written anew, is the recipe's
+    ``whole_frames = true``)."""
 
     take: str
     kind: str

@@ -13,11 +13,11 @@ import numpy as np
 
 from .._io import output
 from ..formats.amc import open_amc
-from ..formats.table import format_of, read_skeleton, read_take, skeleton_for
+from ..formats.table import format_of, read_skeleton, read_take_frames, skeleton_for
 from ..model.errors import FormatError
 from ..model.rig import choose_body
 from .batch import Progress, find_takes, run_each
-from .check import check_blocks, check_motion, recipe
+from .check import check_blocks, check_motion, header_finding, recipe
 from .findings import Finding
 
 STREAM_ABOVE = 16 << 20
@@ -83,12 +83,14 @@ def check_job(job: CheckJob) -> TakeCheck:
     try:
         if job.bytes > STREAM_ABOVE and format_of(job.take).suffix == ".amc":
             return _streamed(job)
-        motion = read_take(job.take, job.asf, job.frame_rate, job.unit, workers=1)
+        motion, cut = read_take_frames(job.take, job.asf, job.frame_rate, job.unit, workers=1)
     except (FormatError, ValueError, OSError, MemoryError) as e:
         return _unreadable(job, e)
     if job.body is not None:  # a joint the take lacks is the caller's mistake: it stops the run
         motion = choose_body(motion, job.body)
     findings = tuple(check_motion(motion, job.take))
+    if cut is not None:
+        findings = (header_finding(motion, cut, job.take), *findings)
     curves = tuple(_curve(motion, f) for f in findings) if job.curves else ()
     view = None
     if job.views is not None and any(f.severity != "low" for f in findings):

@@ -62,9 +62,14 @@ class Pipeline:
     """Steps applied in order, each to the result of the one before; the inputs are never modified.
 
     ``Pipeline().then("median3", frames=(1, 300)).then("slerp", frames=(100, 150))``.
+    ``whole_frames``: the takes it is applied to are read for the frames their files hold whole,
+    where a file breaks off or goes on past its header (what ``motiontheater check`` finds as
+    kind "header"; :func:`~motiontheater.formats.table.read_take_frames`), so that what is
+    written is whole; a recipe says ``whole_frames = true``.
     """
 
     entries: tuple[Entry, ...] = ()
+    whole_frames: bool = False
 
     def then(self, name: str, **options: Any) -> Pipeline:
         """This pipeline with the step ``name`` added (its options checked now; StepError if wrong)."""
@@ -75,7 +80,7 @@ class Pipeline:
         defaults = {o.name: o.default for o in step.all_options}
         # an option given as None where None is its default says nothing (and TOML has no None)
         given = tuple((key, bound[key]) for key in options if not (bound[key] is None and defaults[key] is None))
-        return Pipeline((*self.entries, Entry(name, given)))
+        return Pipeline((*self.entries, Entry(name, given)), self.whole_frames)
 
     @property
     def exporter(self) -> Entry | None:
@@ -107,7 +112,7 @@ class Pipeline:
 
     def to_toml(self) -> str:
         """The recipe text of this pipeline; :meth:`from_toml` reads it back to an equal pipeline."""
-        blocks = []
+        blocks = ["whole_frames = true\n"] if self.whole_frames else []
         for entry in self.entries:
             lines = ["[[step]]", f"run = {toml_value(entry.name)}"]
             lines += [f"{key} = {toml_value(value)}" for key, value in entry.options]
@@ -121,10 +126,15 @@ class Pipeline:
             recipe = tomllib.loads(text)
         except tomllib.TOMLDecodeError as e:
             raise StepError(f"{where}: not a valid TOML recipe: {e}") from None
-        unknown = sorted(set(recipe) - {"step"})
+        unknown = sorted(set(recipe) - {"step", "whole_frames"})
         if unknown or not isinstance(recipe.get("step", []), list):
-            raise StepError(f"{where}: a recipe holds [[step]] tables only, found {', '.join(unknown)}")
-        pipeline = cls()
+            raise StepError(
+                f"{where}: a recipe holds [[step]] tables and whole_frames = true only, found {', '.join(unknown)}"
+            )
+        whole = recipe.get("whole_frames", False)
+        if not isinstance(whole, bool):
+            raise StepError(f"{where}: whole_frames must be true or false, got {whole!r}")
+        pipeline = cls(whole_frames=whole)
         for n, table in enumerate(recipe.get("step", []), start=1):
             if not isinstance(table.get("run"), str):
                 raise StepError(f'{where}: step {n} needs run = "<step name>"')

@@ -12,13 +12,14 @@ from pathlib import Path
 import numpy as np
 
 from mtcore import format_frames, format_number, scan_frames
-from mtcore.errors import ChangedFileError
+from mtcore.errors import ChangedFileError, TruncatedError
 from mtcore.text import copy_text, frame_line, line_breaks
 
 from .._io import LINE_BREAK, Source, Text, TextStyle, decode, encode, mapped_source, open_regular, output
 from ..model.errors import FormatError, SequenceError
 from ..model.motion import DEFAULT_FRAME_RATE, Motion
 from ..model.skeleton import Skeleton
+from .cut import Cut
 
 READ_BYTES = 8 << 20  # bytes read at a time when a take is streamed
 HEAD_BYTES = 4 << 20  # the most of a take read to find its header and first frame
@@ -110,14 +111,36 @@ def read_amc(
     or missing bone.  Files of several megabytes are scanned on all cores;
     ``workers=1`` keeps to the calling thread (as batch jobs in processes should).
     """
+    return _read_source(source, skeleton, frame_rate, workers, whole_frames=False)[0]
+
+
+def read_amc_frames(
+    source: Source, skeleton: Skeleton, frame_rate: float | None = None, *, workers: int | None = None
+) -> tuple[Motion, Cut | None]:
+    """:func:`read_amc`, but of a file that breaks off in its last frame (a capture or a copy
+    cut short), the frames before it, and where it breaks off (None for a whole file).  Such a
+    motion has no file to be written back from: it is written anew, whole."""
+    return _read_source(source, skeleton, frame_rate, workers, whole_frames=True)
+
+
+def _read_source(
+    source: Source, skeleton: Skeleton, frame_rate: float | None, workers: int | None, *, whole_frames: bool
+) -> tuple[Motion, Cut | None]:
     with mapped_source(source) as (data, name):
         try:
-            motion = _read(data, name, skeleton, frame_rate, workers)
+            try:
+                return _read(data, name, skeleton, frame_rate, workers).read_from(source), None
+            except TruncatedError as e:
+                if not whole_frames:
+                    raise
+                last = frame_line(data, 0, len(data), last=True)  # the frame the file breaks off in
+                motion = _read(copy_text(data, 0, max(last, 0)), name, skeleton, frame_rate, workers)
+                reason = f"the file breaks off in its last frame: the {motion.frames} frames before it are whole"
+                return motion, Cut(reason, e.line, motion.frames)
         except ChangedFileError:
             raise ChangedFileError(
                 f"{name}: the file changed while it was read; read it again when it is whole"
             ) from None
-    return motion.read_from(source)
 
 
 def _read_header(

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mtcore.errors import CountError, FormatError, MissingError, TruncatedError
+from mtcore.errors import CountError, FormatError, MissingError, SequenceError, TruncatedError
 from mtcore.text import format_number, format_table, parse_number, scan_table
 
 from .._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
@@ -24,6 +24,7 @@ from ..model.rates import rate_of_frame_time
 from ..model.rig import STANDING, sampled_poses, standing_frame, standing_height
 from ..model.skeleton import Bone, Root, Skeleton, canonical_hierarchy, name_problem, settle_length_unit
 from ..model.units import size_up_poses
+from .cut import Cut
 
 CHANNELS = {
     "xposition": "tx",
@@ -58,17 +59,34 @@ def read_bvh(source: Source, *, unit: str | None = None, frame_rate: float | Non
     input raises a :class:`~mtcore.errors.FormatError` subclass naming the
     file and line.
     """
+    return _read_source(source, unit, frame_rate, whole_frames=False)[0]
+
+
+def read_bvh_frames(
+    source: Source, *, unit: str | None = None, frame_rate: float | None = None
+) -> tuple[Motion, Cut | None]:
+    """:func:`read_bvh`, but of a file whose MOTION section disagrees with its header (fewer
+    rows than ``Frames:`` says, more, or a last row cut short), the rows it holds whole, and how
+    it disagrees (None for a whole file).  Such a motion has no file to be written back from: it
+    is written anew, with a header that says its frames."""
+    return _read_source(source, unit, frame_rate, whole_frames=True)
+
+
+def _read_source(
+    source: Source, unit: str | None, frame_rate: float | None, *, whole_frames: bool
+) -> tuple[Motion, Cut | None]:
     data, name = read_source(source)
     try:
-        motion = _read(data)
+        motion, cut = _read(data, whole_frames)
     except FormatError as e:
         raise e.at(name) from None
-    motion = motion.replace(skeleton=settle_length_unit(_posed(motion), unit)).read_from(source)
+    motion = motion.replace(skeleton=settle_length_unit(_posed(motion), unit))
+    motion = motion if cut is not None else motion.read_from(source)
     if frame_rate is None:
-        return motion
+        return motion, cut
     if not 0 < frame_rate < float("inf"):
         raise ValueError(f"the frame rate must be a positive number of frames per second, got {frame_rate!r}")
-    return motion.replace(frame_rate=float(frame_rate))  # no longer the file's: written with its own Frame Time
+    return motion.replace(frame_rate=float(frame_rate)), cut  # no longer the file's: written with its own Frame Time
 
 
 def _posed(motion: Motion) -> Skeleton:
@@ -91,7 +109,7 @@ def _posed(motion: Motion) -> Skeleton:
     return replace(skeleton, posed=posed) if posed.unit is not None else skeleton
 
 
-def _read(data) -> Motion:
+def _read(data, whole_frames: bool = False) -> tuple[Motion, Cut | None]:
     motion_at = re.search(rb"^[ \t]*MOTION[ \t]*\r?$", data, re.MULTILINE)
     if motion_at is None:
         raise MissingError("no MOTION section", data.count(b"\n") + 1)
@@ -123,12 +141,25 @@ def _read(data) -> Motion:
             f"the header says {frames} frames but the {len(data) - start} bytes after it hold at most {room}",
             motion_line + 1,
         )
+    cut = None
     try:
         values = scan_table(data, frames, columns, start=start)
+    except (TruncatedError, CountError, SequenceError) as e:
+        rows, end, short = _whole_rows(data, start, columns)
+        if not whole_frames or (isinstance(e, CountError) and not short):
+            raise e.at(None, lines_before) from None  # a row of the wrong length amid the others: no cut
+        values = scan_table(data[:end], rows, columns, start=start)
+        cut = Cut(
+            f"the header says {frames} frames but the file holds {rows} whole"
+            + (", and a row after them cut short" if short else ""),
+            lines_before + min(rows, frames) + 1,  # where it breaks off, or where the rows past its count begin
+            rows,
+            frames,
+        )
     except FormatError as e:
         raise e.at(None, lines_before) from None
     values.flags.writeable = False
-    return Motion(
+    motion = Motion(
         skeleton,
         values,
         frame_rate=frame_rate,
@@ -137,6 +168,24 @@ def _read(data) -> Motion:
         line_order=None,
         style=TextStyle.of(data),
     )
+    return motion, cut
+
+
+def _whole_rows(data: bytes, start: int, columns: int) -> tuple[int, int, bool]:
+    """The rows of a MOTION section (from ``start``) that hold a number for every channel, up
+    to the first that does not: how many, the offset just past them, and whether a row after
+    them is cut short (the file's last, of fewer numbers)."""
+    rows, offset, short = 0, start, False
+    for line in data[start:].splitlines(keepends=True):
+        words = len(line.split())
+        if words == columns:
+            rows, offset = rows + 1, offset + len(line)
+        elif words:
+            short = words < columns and not data[offset + len(line) :].strip()  # the last line: cut short
+            break
+        else:
+            offset += len(line)
+    return rows, offset, short
 
 
 def _line_of(data: bytes, match: re.Match) -> int:

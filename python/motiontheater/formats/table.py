@@ -23,12 +23,14 @@ import numpy as np
 from .._io import output, read_source, regular_file
 from ..model.motion import Motion
 from ..model.skeleton import Skeleton, settle_length_unit
-from .amc import read_amc, skeleton_path_for, write_amc
+from .amc import read_amc, read_amc_frames, skeleton_path_for, write_amc
 from .asf import read_asf, write_asf
-from .bvh import read_bvh, write_bvh
+from .bvh import read_bvh, read_bvh_frames, write_bvh
+from .cut import Cut
 from .gltf_read import animation_names, read_gltf
 
 ReadTake = Callable[..., Motion]  # (path, skeleton or None, frame_rate, unit, workers) -> Motion
+ReadFrames = Callable[..., tuple[Motion, Cut | None]]  # the same, and where the file breaks off
 
 
 @dataclass(frozen=True)
@@ -42,7 +44,8 @@ class Format:
     ``companion`` is the suffix of the skeleton file a take needs beside it, or None;
     ``states_unit`` whether its files state their length unit (a BVH file does not);
     ``takes`` the names of the takes a file holds where it may hold several (glTF's animations;
-    ``read`` gives the first).
+    ``read`` gives the first); ``read_frames`` reads as ``read`` does but keeps the frames of a
+    file that breaks off (:func:`read_take_frames`), where the format can break off so.
     """
 
     suffix: str
@@ -55,6 +58,7 @@ class Format:
     companion: str | None = None
     states_unit: bool = True
     takes: Callable[[str | os.PathLike], list[str]] | None = None
+    read_frames: ReadFrames | None = None
 
     @property
     def holds_takes(self) -> bool:
@@ -70,6 +74,14 @@ def _read_bvh(path, skeleton, frame_rate, unit, workers) -> Motion:
     return read_bvh(path, unit=unit, frame_rate=frame_rate)
 
 
+def _amc_frames(path, skeleton, frame_rate, unit, workers) -> tuple[Motion, Cut | None]:
+    return read_amc_frames(path, skeleton, frame_rate, workers=workers)
+
+
+def _bvh_frames(path, skeleton, frame_rate, unit, workers) -> tuple[Motion, Cut | None]:
+    return read_bvh_frames(path, unit=unit, frame_rate=frame_rate)
+
+
 def _bvh_skeleton(path) -> Skeleton:
     return read_bvh(path).skeleton
 
@@ -81,8 +93,17 @@ def _read_gltf(path, skeleton, frame_rate, unit, workers) -> Motion:
 
 FORMATS: dict[str, Format] = {
     ".asf": Format(".asf", "ASF", "asf", read_skeleton=read_asf, write_skeleton=write_asf),
-    ".amc": Format(".amc", "ASF/AMC", "asf", _read_amc, write_amc, companion=".asf"),
-    ".bvh": Format(".bvh", "BVH", "bvh", _read_bvh, write_bvh, read_skeleton=_bvh_skeleton, states_unit=False),
+    ".amc": Format(".amc", "ASF/AMC", "asf", _read_amc, write_amc, companion=".asf", read_frames=_amc_frames),
+    ".bvh": Format(
+        ".bvh",
+        "BVH",
+        "bvh",
+        _read_bvh,
+        write_bvh,
+        read_skeleton=_bvh_skeleton,
+        states_unit=False,
+        read_frames=_bvh_frames,
+    ),
     # glTF takes are read as BVH motions and written by the export step (views/export.py)
     ".glb": Format(".glb", "glTF binary", "bvh", _read_gltf, takes=animation_names),
     ".gltf": Format(".gltf", "glTF", "bvh", _read_gltf, takes=animation_names),
@@ -201,6 +222,28 @@ def read_take(
     skeleton = None if companion is None else read_skeleton(companion, unit)
     assert row.read is not None
     return require_frames(row.read(path, skeleton, frame_rate, unit, workers), path)
+
+
+def read_take_frames(
+    path: str | os.PathLike,
+    asf: str | os.PathLike | None = None,
+    frame_rate: float | None = None,
+    unit: str | None = None,
+    *,
+    workers: int | None = None,
+) -> tuple[Motion, Cut | None]:
+    """:func:`read_take`, but of a file that breaks off before its header says it ends, or goes
+    on past it (a BVH of fewer or more rows than ``Frames:`` says, a last frame cut short), the
+    frames it holds whole, and how it disagrees (None for a whole file, or a format that cannot
+    break off so)."""
+    row = format_of(path)
+    if row.read_frames is None:
+        return read_take(path, asf, frame_rate, unit, workers=workers), None
+    regular_file(path)
+    companion = skeleton_for(path, asf)
+    skeleton = None if companion is None else read_skeleton(companion, unit)
+    motion, cut = row.read_frames(path, skeleton, frame_rate, unit, workers)
+    return require_frames(motion, path), cut
 
 
 def require_frames(motion: Motion, path: str | os.PathLike) -> Motion:
