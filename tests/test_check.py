@@ -28,7 +28,7 @@ VARIANTS = {
     "in mm": lambda take: take.with_units(length_factor=1000 * take.skeleton.meters_per_unit, length="mm"),
 }
 TRIALS = 3  # injections of each kind per take and variant
-UNITS = {"deg", "m", "m/s", "s", "Hz", ""}
+UNITS = {"deg", "m", "m/s", "s", "Hz", "%", ""}
 
 
 def _variant(path, name, tmp_path, take=None):
@@ -488,3 +488,29 @@ def test_a_rig_of_a_few_bones_has_no_unit_finding():
     if not chain:
         pytest.skip("the real-file corpus (../shared/data/bvh) is absent")
     assert [f for f in check_motion(mt.read_take(chain[0])) if f.kind == "unit"] == []
+
+
+@pytest.mark.parametrize(
+    ("turn", "axis", "severity"),
+    [
+        (None, None, None),
+        ((90.0, 0.0, 0.0), "z", "low"),
+        ((180.0, 0.0, 0.0), "-y", "high"),
+        ((0.0, 0.0, 90.0), "-x", "medium"),
+    ],
+)
+def test_a_take_that_does_not_stand_along_y_is_told(turn, axis, severity):
+    """walk01 (y-up) under a static joint turned so that it stands along z (as z-up exporters
+    write it: low, motiontheater reads it standing), upside down (high) or along x (medium)."""
+    walk = real_files("bvh/walk01.bvh")
+    if not walk:
+        pytest.skip("the real-file corpus (../shared/data/bvh) is absent")
+    take = mt.read_take(walk[0])
+    turned = with_static_root(take, turn=turn, keep_world=False) if turn else take
+    found = [f for f in check_motion(turned) if f.kind == "up"]
+    if axis is None:
+        assert found == []
+    else:
+        assert [(f.severity, f.unit) for f in found] == [(severity, "%")]
+        assert ("upside down" if axis == "-y" else f"along {axis}") in found[0].detail
+        assert found[0].size == pytest.approx(100.0)

@@ -38,6 +38,8 @@ PENETRATION_M = 0.05
 """Metres a heel, ball or toe tip must sink below where it rests on the floor, for
 PENETRATION_SECONDS or more, to be in the floor."""
 PENETRATION_SECONDS = 0.1
+UPRIGHT_SHARE = 0.8
+"""The share of a take's frames that must stand along another axis than y for the check to say so."""
 FLOOR_M = 0.15
 """Metres the floor the feet rest on may lie from level zero before the check says so (a joint
 centre rests a few centimetres above the sole)."""
@@ -80,7 +82,14 @@ def leg_findings(motion: Motion, take: str, meters: float, kinematics: Kinematic
     except ValueError:
         return []  # no legs, or none that are numbers: nothing to judge here
     context = _Legs(motion, take, arrays, ground, mpu)
-    return context.skates() + context.penetrations() + context.floor() + context.knees() + context.rhythm()
+    return (
+        context.upright()
+        + context.skates()
+        + context.penetrations()
+        + context.floor()
+        + context.knees()
+        + context.rhythm()
+    )
 
 
 class _Legs:
@@ -157,6 +166,50 @@ class _Legs:
                     )
                 )  # fmt: skip
         return out
+
+    def upright(self) -> list[Finding]:
+        """The axis the character stands along (the hips above the ankles), where it is not y,
+        the up axis of ASF/AMC (Acclaim's convention) and the one BVH readers take: upside down
+        (high), along x (medium), along z (medium for ASF/AMC; low for BVH, where z-up exports
+        are common and motiontheater reads them standing).  Told where it stands so in
+        UPRIGHT_SHARE of its frames (a take that lies down for a while stands otherwise)."""
+        rise = (self.arrays.hips - self.arrays.points[:, :, 1]).reshape(-1, 3)
+        rise = rise[np.isfinite(rise).all(axis=1)]
+        if not len(rise):
+            return []
+        axis = np.argmax(np.abs(rise), axis=1)
+        signed = axis * 2 + (rise[np.arange(len(rise)), axis] < 0)  # 0 x, 1 -x, 2 y, 3 -y, 4 z, 5 -z
+        counts = np.bincount(signed, minlength=6)
+        most = int(np.argmax(counts))
+        share = counts[most] / len(rise)
+        if most == 2 or share < UPRIGHT_SHARE:
+            return []
+        name = ("-" if most % 2 else "") + "xyz"[most // 2]
+        bvh = self.motion.skeleton.convention == "bvh"
+        if name == "-y":
+            severity, what = "high", "upside down: readers show it standing on its head"
+        elif name in ("x", "-x"):
+            severity, what = "medium", "along x, which no reader takes as up: they show it lying on its side"
+        elif bvh:
+            severity, what = (
+                "low",
+                (
+                    f"along {name}, as z-up exports write it: motiontheater reads it standing, but BVH readers "
+                    "that take y as up (Blender's importer, three.js's BVHLoader) show it lying down"
+                ),
+            )
+        else:
+            severity, what = (
+                "medium",
+                f"along {name}: ASF/AMC is y-up (Acclaim's convention), so readers show it lying down",
+            )
+        return [
+            Finding(
+                self.take, "up", (), self.motion.first_frame, self.motion.last_frame, severity,
+                round(share * 100, 2), "%",
+                f"the character stands {what} (its hips above its ankles along {name} in {share:.0%} of the frames)",
+            )
+        ]  # fmt: skip
 
     def floor(self) -> list[Finding]:
         level = self.ground.level * self.mpu

@@ -23,6 +23,7 @@ KINDS = {
     "jitter": "high-frequency noise on a joint's channels",
     "bone": "the length of a bone with position channels drifts",
     "unit": "a height no person has in the length unit in effect",
+    "up": "the character does not stand along y, the up axis readers take (upside down, along x, z-up)",
     "rate": "a Frame Time that disagrees with the motion's own rhythm (the speed a steady walk's strides make)",
     "skate": "a planted foot slides along the floor",
     "penetration": "a foot goes into the floor",
@@ -39,7 +40,7 @@ KINDS = {
 class Finding:
     """One problem of a take.  ``first`` and ``last`` are frame numbers as the file numbers them,
     ``joints`` the joints concerned as the file spells them, ``size`` how large it is in
-    ``unit`` (deg, m, m/s, s, Hz, mm, or "" for a count); ``channel`` the worst channel
+    ``unit`` (deg, m, m/s, s, Hz, mm, % of the frames, or "" for a count); ``channel`` the worst channel
     ("joint dof") where there is one, ``detail`` a sentence for a person, and ``fix`` the steps
     that repair it, each (step name, options) as a recipe writes them (empty: none is known;
     ``("whole_frames", {})``, a file's whole frames read and written anew, is the recipe's
