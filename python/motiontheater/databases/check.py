@@ -255,8 +255,9 @@ def _turned(skeleton: Skeleton, joint: str) -> np.ndarray:
 
 
 def _channels(skeleton: Skeleton) -> tuple[list[_Channel], dict, dict[tuple[str, bool], np.ndarray]]:
-    """The channels; the joints with three rotation channels: joint -> (order, extrinsic,
-    columns); and each joint's rotation and position columns: (joint, turns) -> columns."""
+    """The channels; the joints with three rotation channels, whose Euler angles may flip to
+    another triple: joint -> (order, extrinsic, columns); and each joint's rotation and position
+    columns: (joint, turns) -> columns."""
     channels = [_Channel(i, j, d) for i, (j, d) in enumerate(skeleton.channels)]
     triples = {
         skeleton.channels[int(row[0])][0]: (order, extrinsic, row)
@@ -865,7 +866,7 @@ def _deviations(t: _Take, runs: list[Run]) -> list[np.ndarray | None]:
     a take's candidates are many, and each alone costs a dozen numpy calls."""
     out: list[np.ndarray | None] = [None] * len(runs)
     inside = [i for i, (_, _, first, last) in enumerate(runs) if first >= 1 and last <= t.motion.frames - 2]
-    groups: dict[tuple[bool, int], list[int]] = {}  # (turns, columns; 0 for a rotation of three angles): runs
+    groups: dict[tuple[bool, int], list[int]] = {}  # (turns, columns; 0 for a joint's rotation): runs
     for i in inside:
         joint, turns = runs[i][:2]
         key = (True, 0) if turns and joint in t.rotating else (turns, len(t.columns(joint, turns)))
@@ -941,20 +942,20 @@ PACE_FRAMES = 3
 
 def _pace(t: _Take, joint: str, first: int, last: int) -> float:
     """The most the joint turns from one frame to the next over the PACE_FRAMES frames before
-    rows first..last and after them, in degrees (0 where it has no three rotation channels)."""
+    rows first..last and after them, in degrees (0 where its channels make no rotation)."""
     return _fastest_step(t, joint, (first - PACE_FRAMES, first - 1), (last + 1, last + PACE_FRAMES))
 
 
 def _fastest(t: _Take, joint: str, first: int, last: int) -> float:
     """The fastest the joint turns from one frame to the next from the row before rows
-    first..last to the row after them, in degrees per second (inf without three rotation
-    channels, where the check has no other measure than the channel's own)."""
+    first..last to the row after them, in degrees per second (inf where its channels make no
+    rotation, where the check has no other measure than the channel's own)."""
     return _fastest_step(t, joint, (first - 1, last + 1)) * t.rate if joint in t.rotating else math.inf
 
 
 def _fastest_step(t: _Take, joint: str, *spans: tuple[int, int]) -> float:
     """The most the joint turns from one frame to the next within the spans of rows (first,
-    last) of the take, in degrees (0 where it has no three rotation channels or no span two of
+    last) of the take, in degrees (0 where its channels make no rotation or no span holds two of
     those rows): the rotations of every span's rows made at once."""
     if joint not in t.rotating:
         return 0.0
