@@ -167,9 +167,9 @@ class _Take:
         """How far the joint's rotation over rows first..last puts out the points it turns, in
         metres: where they are, and where filling the joint alone would put them.  Where they
         are: the farthest any of them lies, at a row of the stretch, from midway between where it
-        is in the rows before and after (a pop stands out so by its size, the ends of a
-        turn-over by half of it; smooth motion, however fast, by little; a turn that the joints
-        below turn back, by nothing).  Where filling would put them: how far they lie from where
+        is in the rows before and after, twice that over a stretch of several rows (a pop stands
+        out so by its size, the ends of a turn-over by half of it; smooth motion, however fast,
+        by little; a turn that the joints below turn back, by nothing).  Where filling would put them: how far they lie from where
         the joint's rotation on the path between the rows around would put them, the joints below
         as they are (a hand whose end has no length turns nothing; a thigh turned about itself
         that the knee turns back looks right, and filling the thigh alone would put the leg
@@ -178,6 +178,7 @@ class _Take:
         if p is None:
             return 0.0, 0.0
         off = float(np.nan_to_num(np.linalg.norm(p[1:-1] - 0.5 * (p[:-2] + p[2:]), axis=-1)).max())
+        off *= 2 if last > first else 1  # the ends of a turn-over of several frames stand out by half of it
         length = last - first + 2  # steps from row first - 1 to row last + 1
         share = np.arange(1, length) / length
         q = self.quaternions(joint, np.array([first - 1, last + 1]))
