@@ -20,7 +20,6 @@ rescaled (``scale``), jitter low-passed (``butterworth`` at Winter's cut-off), s
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -185,18 +184,23 @@ class _Take:
         path = slerp(np.broadcast_to(q[0], (len(share), 4)), np.broadcast_to(q[1], (len(share), 4)), share)
         return off, self._moved(joint, np.arange(first, last + 1), path)
 
-    def seen_jump(self, joint: str, at: int) -> float:
+    def seen_jump(self, joint: str, at: int) -> tuple[float, float, float]:
         """How far the joint's rotation jumping into row ``at`` (2 <= at <= rows - 2) and staying
         puts out the points it turns, in metres: the lesser of how much longer their step into
-        the row is than their steps before and after it, and how far they lie from where the
-        rotation going on at its pace would put them."""
+        the row is than twice their steps before and after it (a snap; an arm flung out fast at 30
+        Hz takes steps as long beside it), and how far they lie from where the rotation going on
+        at its pace would put them; and, of the point that jumps most, its step into the row and
+        the longer of its steps beside.  (0, 0, 0) where it turns no point."""
         p = self._turned_points(joint, at - 2, at + 2)
         if p is None:
-            return 0.0
+            return 0.0, 0.0, 0.0
         steps = np.nan_to_num(np.linalg.norm(np.diff(p, axis=0), axis=-1))  # into rows at - 1, at, at + 1
-        jumped = float(np.max(steps[1] - np.maximum(steps[0], steps[2]), initial=0.0))
+        beside = np.maximum(steps[0], steps[2])
+        worst = int(np.argmax(steps[1] - 2 * beside))
+        jumped = max(float(steps[1, worst] - 2 * beside[worst]), 0.0)
         q = self.quaternions(joint, np.array([at - 2, at - 1]))
-        return min(jumped, self._moved(joint, np.array([at]), slerp(q[0], q[1], np.array([2.0]))))
+        moved = self._moved(joint, np.array([at]), slerp(q[0], q[1], np.array([2.0])))
+        return min(jumped, moved), float(steps[1, worst]), float(beside[worst])
 
     def _moved(self, joint: str, rows: np.ndarray, instead: np.ndarray) -> float:
         """How far the points the joint turns lie at the rows from where its rotations
@@ -596,16 +600,19 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _pops(t: _Take, steps: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Jumps that a jump back within STEP_PAIR_SECONDS undoes, joined into excursions (channel,
-    first, last, SPIKE, peak) with the first jump's size; and the jumps that stay."""
+    """Jumps of a channel that a jump back within STEP_PAIR_SECONDS undoes, joined into
+    excursions (channel, first, last, SPIKE, peak) with the first jump's size; and the jumps that
+    stay.  Not of a joint's rotation channels: its rotation pairs its jumps (:func:`_excursions`)."""
     events, sizes = steps
     window = max(STEP_PAIR_SECONDS * t.rate, POP_FRAMES)
     pops, popsizes, kept = [], [], np.ones(len(events), bool)
     for i in range(len(events) - 1):
         (c0, f0, *_), (c1, f1, *_) = events[i], events[i + 1]
         s0, s1 = sizes[i], sizes[i + 1]
+        channel = t.channels[int(c0)]
         if (
-            kept[i]
+            not (channel.turns and channel.joint in t.rotating)
+            and kept[i]
             and c0 == c1
             and 0 < f1 - f0 <= window
             and s0 * s1 < 0
@@ -678,20 +685,20 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
         if channel.turns and channel.joint in t.rotating:
             # every row of a step: a turn-over's jumps out and back, a frame or two apart, make one
             # step of the angles with its peak at one of them
-            quiet = bool(near_spike[int(c), max(first - 1, 0) : last + 2].any())
             limit = max(JUMP_DEG, limits[int(c)] * t.degrees)
             span = range(max(first, 2), min(last, rows - 2) + 1)
             for row, (pop, jump) in zip(span, _rotation_steps(t, channel.joint, span, limit) if span else ()):
                 if (channel.joint, row) in seen or (channel.joint, True, t.frame(row)) in explained:
                     continue
                 seen.add((channel.joint, row))
-                if pop is not None and not quiet and (channel.joint, pop) not in popped:
+                if pop is not None and (channel.joint, pop) not in popped:
                     popped.add((channel.joint, pop))
                     off = _deviations(t, [(channel.joint, True, pop, pop)])[0]
                     if off is not None and float(off[0]) > limit:
+                        out = _instead(t, out, channel.joint, pop, pop + 1)
                         out.append(_turning_spike(t, channel.joint, channel.name, pop, pop, float(off[0]), limit))
                 elif pop is None and jump > limit:
-                    jumps.append((channel.joint, row, jump, int(c), not quiet))
+                    jumps.append((channel.joint, row, jump, int(c), True))
             continue
         if (channel.joint, channel.turns, t.frame(at)) in explained or (
             channel.turns and abs(t.physical(channel, size)) > FLIP_DEG
@@ -750,37 +757,34 @@ def _excursions(
     paired: set[tuple[str, int]] = set()
     longest = round(FILL_SECONDS * t.rate)
     jumps = sorted(jumps)
-    for (joint, a, size_a, c, _), (other, b, size_b, _, _) in itertools.pairwise(jumps):
-        if other != joint or not 1 < b - a <= longest or (joint, a) in paired:
+    for (joint, a, size_a, c, _), (_, b, size_b, _, _) in _pairs(jumps, longest):
+        if any(j == joint and a <= row <= b for j, row in paired):  # around an excursion paired already
             continue
-        if _apart(t, joint, a - 1, b) >= 0.5 * min(size_a, size_b):
+        # back where it left, or, over a few frames, where it was going at its pace (at 30 Hz a
+        # fast forearm turns 60 degrees over the three frames of a pop)
+        if min(_apart(t, joint, a - 1, b), _gone(t, joint, a, b)) >= 0.5 * min(size_a, size_b):
             continue
         off = _deviations(t, [(joint, True, a, b - 1)])[0]
         if off is None:
             continue
         paired.update({(joint, a), (joint, b)})
-        # the spikes found within it, or beside it (the median of five around a frame beside it
-        # holds its frames): its own
-        out = [
-            f
-            for f in out
-            if not (
-                f.kind == "spike" and f.joints == (joint,) and f.last >= t.frame(a) - 2 and f.first <= t.frame(b) + 1
-            )
-        ]
+        out = _instead(t, out, joint, a, b)
         limit = t.physical(t.channels[c], limits[c])
         out.append(_turning_spike(t, joint, t.channels[c].name, a, b - 1, float(off.max()), limit))
     for joint, at, jump, c, shown in jumps:
         if (joint, at) in paired or not shown:
             continue
+        if joint in t.rotating:  # a rotation that jumps and stays: the spikes the median finds beside it are its
+            out = _instead(t, out, joint, at, at, below=jump)
         severity = "high" if jump > 90 else "medium" if jump > 30 else "low"
         turned = severity != "low" and joint in t.rotating and 1 < at < t.motion.frames - 1
-        seen = t.seen_jump(joint, at) if turned else math.inf
-        if seen < UNSEEN_M:  # a twist nothing drawn shows: for a skinned mesh
+        seen, step, beside = t.seen_jump(joint, at) if turned else (math.inf, 0.0, 0.0)
+        if seen < UNSEEN_M:  # a twist nothing drawn shows (a skinned mesh would), or fast motion
             severity = "medium" if severity == "high" else "low"
         elif severity == "high" and seen <= SEEN_M:
             severity = "medium"
-        moved = f", moving what it turns {seen * 100:.2g} cm" if math.isfinite(seen) else ""
+        moved = f" (what it turns moves {step * 100:.2g} cm into that frame, {beside * 100:.2g} cm beside it)"
+        moved = moved if turned else ""
         out.append(
             Finding(
                 t.name, "jump", (joint,), t.frame(at), t.frame(at), severity, round(jump, 6), "deg",
@@ -789,6 +793,50 @@ def _excursions(
             )
         )  # fmt: skip
     return out
+
+
+def _gone(t: _Take, joint: str, a: int, b: int) -> float:
+    """How far, in degrees, the joint's rotation at row b lies from where its pace over rows a - 2
+    and a - 1 would have taken it, where b is at most POP_FRAMES rows on from a (inf otherwise,
+    and where the take has no row a - 2)."""
+    if b - a > POP_FRAMES or a < 2 or joint not in t.rotating:
+        return math.inf
+    q = t.quaternions(joint, np.array([a - 2, a - 1, b]))
+    return float(_angle_deg(q[2], slerp(q[0], q[1], np.array([float(b - a + 2)]))[0]))
+
+
+def _pairs(jumps: list[tuple[str, int, float, int, bool]], longest: int) -> list[tuple[tuple, tuple]]:
+    """Each jump (sorted by joint and row) with each later jump of its joint more than one row and
+    at most ``longest`` rows on, the pairs nearest together first: a jump back may come after
+    others (a two-frame pop, whose middle frame jumps too), and an excursion within a longer
+    stretch between two jumps is the excursion."""
+    pairs = []
+    for i, (joint, a, *_) in enumerate(jumps):
+        for later in jumps[i + 1 :]:
+            if later[0] != joint or later[1] - a > longest:
+                break
+            if later[1] - a > 1:
+                pairs.append((jumps[i], later))
+    return sorted(pairs, key=lambda pair: (pair[1][1] - pair[0][1], pair[0][0], pair[0][1]))
+
+
+def _instead(t: _Take, out: list[Finding], joint: str, first: int, back: int, below: float = math.inf) -> list[Finding]:
+    """The findings without the spikes of the joint's rotation (of at most ``below`` degrees)
+    found within or beside rows first..back - 1, which a turn out at row first and back at row
+    ``back`` makes: the median of five around a frame beside it holds its frames, and the line
+    between the frames around a stretch that holds one of its jumps leaves the frames between."""
+    return [
+        f
+        for f in out
+        if not (
+            f.kind == "spike"
+            and f.joints == (joint,)
+            and f.unit == "deg"
+            and f.size <= below
+            and f.last >= t.frame(first) - 2
+            and f.first <= t.frame(back) + 1
+        )
+    ]
 
 
 def _apart(t: _Take, joint: str, first: int, last: int) -> float:
