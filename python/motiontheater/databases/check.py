@@ -680,6 +680,8 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     events, sizes = steps
     seen, popped = set(), set()  # (joint, row): a joint's jump or pop shows in several of its channels
     jumps: list[tuple[str, int, float, int, bool]] = []  # (joint, row, degrees, channel, not a spike's)
+    exact: list[Finding] = []  # the spikes the rotation's own jumps bound, in place of the candidates beside
+    windows: list[Window] = []
     for (c, first, last, _, at), size in zip(events[stay], sizes[stay]):
         channel = t.channels[int(c)]
         if channel.turns and channel.joint in t.rotating:
@@ -695,8 +697,8 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
                     popped.add((channel.joint, pop))
                     off = _deviations(t, [(channel.joint, True, pop, pop)])[0]
                     if off is not None and float(off[0]) > limit:
-                        out = _instead(t, out, channel.joint, pop, pop + 1)
-                        out.append(_turning_spike(t, channel.joint, channel.name, pop, pop, float(off[0]), limit))
+                        windows.append((channel.joint, pop, pop + 1, math.inf, len(exact)))
+                        exact.append(_turning_spike(t, channel.joint, channel.name, pop, pop, float(off[0]), limit))
                 elif pop is None and jump > limit:
                     jumps.append((channel.joint, row, jump, int(c), True))
             continue
@@ -720,7 +722,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
                     channel.name,
                 )
             )  # fmt: skip
-    return _excursions(t, out, jumps, limits)
+    return _excursions(t, out, jumps, limits, exact, windows)
 
 
 def _rotation_steps(t: _Take, joint: str, rows: range, limit: float) -> list[tuple[int | None, float]]:
@@ -747,35 +749,38 @@ def _rotation_steps(t: _Take, joint: str, rows: range, limit: float) -> list[tup
 
 
 def _excursions(
-    t: _Take, out: list[Finding], jumps: list[tuple[str, int, float, int, bool]], limits: np.ndarray
+    t: _Take,
+    out: list[Finding],
+    jumps: list[tuple[str, int, float, int, bool]],
+    limits: np.ndarray,
+    exact: list[Finding],
+    windows: list[Window],
 ) -> list[Finding]:
     """The findings with the jumps added: a jump of a joint's rotation that a jump within
     FILL_SECONDS brings back to where it left (a thigh turned over for a third of a second, and
     the knee below it) is a spike of the frames between, fixed by filling them, in place of the
-    spikes found within them; the others are jumps that stay, unless they lead into or out of a
-    spike."""
+    spikes found within and beside them (as ``exact`` spikes, pops of one frame, are in place of
+    those in their ``windows``); the others are jumps that stay, unless they lead into or out of
+    a spike."""
     paired: set[tuple[str, int]] = set()
-    longest = round(FILL_SECONDS * t.rate)
-    jumps = sorted(jumps)
-    for (joint, a, size_a, c, _), (_, b, size_b, _, _) in _pairs(jumps, longest):
+    pairs = _pairs(sorted(jumps), round(FILL_SECONDS * t.rate))
+    for ((joint, a, size_a, c, _), (_, b, size_b, _, _)), back in zip(pairs, _returns(t, pairs)):
         if any(j == joint and a <= row <= b for j, row in paired):  # around an excursion paired already
             continue
-        # back where it left, or, over a few frames, where it was going at its pace (at 30 Hz a
-        # fast forearm turns 60 degrees over the three frames of a pop)
-        if min(_apart(t, joint, a - 1, b), _gone(t, joint, a, b)) >= 0.5 * min(size_a, size_b):
+        if back >= 0.5 * min(size_a, size_b):
             continue
         off = _deviations(t, [(joint, True, a, b - 1)])[0]
         if off is None:
             continue
         paired.update({(joint, a), (joint, b)})
-        out = _instead(t, out, joint, a, b)
+        windows.append((joint, a, b, math.inf, len(exact)))
         limit = t.physical(t.channels[c], limits[c])
-        out.append(_turning_spike(t, joint, t.channels[c].name, a, b - 1, float(off.max()), limit))
-    for joint, at, jump, c, shown in jumps:
+        exact.append(_turning_spike(t, joint, t.channels[c].name, a, b - 1, float(off.max()), limit))
+    for joint, at, jump, c, shown in sorted(jumps):
         if (joint, at) in paired or not shown:
             continue
         if joint in t.rotating:  # a rotation that jumps and stays: the spikes the median finds beside it are its
-            out = _instead(t, out, joint, at, at, below=jump)
+            windows.append((joint, at, at, jump, len(exact)))
         severity = "high" if jump > 90 else "medium" if jump > 30 else "low"
         turned = severity != "low" and joint in t.rotating and 1 < at < t.motion.frames - 1
         seen, step, beside = t.seen_jump(joint, at) if turned else (math.inf, 0.0, 0.0)
@@ -785,24 +790,42 @@ def _excursions(
             severity = "medium"
         moved = f" (what it turns moves {step * 100:.2g} cm into that frame, {beside * 100:.2g} cm beside it)"
         moved = moved if turned else ""
-        out.append(
+        exact.append(
             Finding(
                 t.name, "jump", (joint,), t.frame(at), t.frame(at), severity, round(jump, 6), "deg",
                 f"{joint} turns {jump:.3g} deg more in one frame than in the frames beside it{moved}, and stays",
                 t.channels[c].name,
             )
         )  # fmt: skip
+    return _instead(t, out + exact, windows, len(out))
+
+
+def _returns(t: _Take, pairs: list[tuple[tuple, tuple]]) -> list[float]:
+    """For each pair of jumps (rows a and b) of a joint: how far, in degrees, its rotation at row
+    b lies from where it was at row a - 1 or, over at most POP_FRAMES rows, from where its pace
+    over rows a - 2 and a - 1 would have taken it (at 30 Hz a fast forearm turns 60 degrees over
+    the three frames of a pop), whichever is nearer; every pair of a joint at once."""
+    out = [math.inf] * len(pairs)
+    by_joint: dict[str, list[int]] = {}
+    for i, ((joint, *_), _) in enumerate(pairs):
+        by_joint.setdefault(joint, []).append(i)
+    for joint, members in by_joint.items():
+        a = np.array([pairs[i][0][1] for i in members])
+        b = np.array([pairs[i][1][1] for i in members])
+        if joint not in t.rotating:
+            for i, x, y in zip(members, a.tolist(), b.tolist()):
+                out[i] = _apart(t, joint, x - 1, y)
+            continue
+        q = t.quaternions(joint, np.concatenate([a - 1, b, np.maximum(a - 2, 0)]))
+        before, after, earlier = q[: len(a)], q[len(a) : 2 * len(a)], q[2 * len(a) :]
+        back = _angle_deg(before, after)
+        near = (b - a <= POP_FRAMES) & (a >= 2)
+        if near.any():
+            paced = slerp(earlier[near], before[near], (b - a + 2)[near].astype(float))
+            back[near] = np.minimum(back[near], _angle_deg(after[near], paced))
+        for i, value in zip(members, back.tolist()):
+            out[i] = value
     return out
-
-
-def _gone(t: _Take, joint: str, a: int, b: int) -> float:
-    """How far, in degrees, the joint's rotation at row b lies from where its pace over rows a - 2
-    and a - 1 would have taken it, where b is at most POP_FRAMES rows on from a (inf otherwise,
-    and where the take has no row a - 2)."""
-    if b - a > POP_FRAMES or a < 2 or joint not in t.rotating:
-        return math.inf
-    q = t.quaternions(joint, np.array([a - 2, a - 1, b]))
-    return float(_angle_deg(q[2], slerp(q[0], q[1], np.array([float(b - a + 2)]))[0]))
 
 
 def _pairs(jumps: list[tuple[str, int, float, int, bool]], longest: int) -> list[tuple[tuple, tuple]]:
@@ -820,22 +843,32 @@ def _pairs(jumps: list[tuple[str, int, float, int, bool]], longest: int) -> list
     return sorted(pairs, key=lambda pair: (pair[1][1] - pair[0][1], pair[0][0], pair[0][1]))
 
 
-def _instead(t: _Take, out: list[Finding], joint: str, first: int, back: int, below: float = math.inf) -> list[Finding]:
-    """The findings without the spikes of the joint's rotation (of at most ``below`` degrees)
-    found within or beside rows first..back - 1, which a turn out at row first and back at row
-    ``back`` makes: the median of five around a frame beside it holds its frames, and the line
-    between the frames around a stretch that holds one of its jumps leaves the frames between."""
+Window = tuple[str, int, int, float, int]
+"""A joint, the row a rotation turns out at and the row it is back (the same row for a jump that
+stays), the most degrees a spike there may turn to be of it, and how many findings were made
+before it (those made after it are not of it)."""
+
+
+def _instead(t: _Take, found: list[Finding], windows: list[Window], candidates: int) -> list[Finding]:
+    """The findings without the spikes of a joint's rotation found within or beside a window made
+    after them (of at most its degrees): the median of five around a frame beside a turn-over
+    holds its frames, and the line between the frames around a stretch that holds one of its
+    jumps leaves the frames between.  The first ``candidates`` findings were made before every
+    window; each after them was made with the window of the same place in ``windows``."""
+    by_joint: dict[str, list[Window]] = {}
+    for window in windows:
+        by_joint.setdefault(window[0], []).append(window)
+
+    def beside(f: Finding, made: int) -> bool:
+        return any(
+            after > made and f.size <= below and f.last >= t.frame(first) - 2 and f.first <= t.frame(back) + 1
+            for _, first, back, below, after in by_joint.get(f.joints[0], ())
+        )
+
     return [
         f
-        for f in out
-        if not (
-            f.kind == "spike"
-            and f.joints == (joint,)
-            and f.unit == "deg"
-            and f.size <= below
-            and f.last >= t.frame(first) - 2
-            and f.first <= t.frame(back) + 1
-        )
+        for made, f in enumerate(found)
+        if not (f.kind == "spike" and len(f.joints) == 1 and f.unit == "deg" and beside(f, made - candidates))
     ]
 
 
