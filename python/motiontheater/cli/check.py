@@ -115,7 +115,7 @@ CHECK = Verb(
     description=(
         "Check every AMC and BVH take under the inputs, on all cores, and list what is wrong with each: where "
         "(frames as the file numbers them, joints as it spells them), how badly (low, medium, high) and how large, "
-        "in degrees, metres, m/s, seconds or Hz. The kinds of finding: "
+        "in degrees, metres, m/s, seconds, Hz or % of the frames. The kinds of finding: "
         + "; ".join(f"{k}: {v}" for k, v in KINDS.items())
         + ". -o writes a report: an HTML page with a table to sort and a plot of each finding's worst channel (its "
         "links open a viewer page of the take at the finding's frame; the pages go in a folder beside the report), "
