@@ -20,6 +20,7 @@ rescaled (``scale``), jitter low-passed (``butterworth`` at Winter's cut-off), s
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -39,7 +40,7 @@ from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 from ..model.units import HUMAN_HEIGHT
 from .check_arms import arm_findings
 from .check_feet import leg_findings
-from .check_pace import BLOCK_FRAMES, dropped_findings
+from .check_pace import dropped_findings
 from .findings import Finding
 from .pieces import check_frames
 
@@ -129,7 +130,10 @@ class _Take:
         # order of their names (the order events are joined in)
         self.joints, self.kinds = skeleton.derived("check channel groups", lambda: _groups(self.channels))
         self._quaternions: dict[str, np.ndarray] = {}
-        self.held: Kinematics | None = None  # the whole take's forward kinematics, where it fits a block
+        self.held: Kinematics | None = None  # the forward kinematics of these frames
+        self.unsettled: dict[
+            int, tuple[Finding, int, int, float, bool]
+        ] = {}  # turning spikes: what they move settles them
         self.begins, self.ends = True, True  # whether these frames begin and end the take
 
     def frame(self, row: int) -> int:
@@ -162,27 +166,41 @@ class _Take:
             self._quaternions[joint] = made
         return made[rows]
 
-    def seen(self, joint: str, first: int, last: int) -> tuple[float, float]:
-        """How far the joint's rotation over rows first..last puts out the points it turns, in
-        metres: where they are, and where filling the joint alone would put them.  Where they
-        are: the farthest any of them lies, at a row of the stretch, from midway between where it
-        is in the rows before and after, twice that over a stretch of several rows (a pop stands
-        out so by its size, the ends of a turn-over by half of it; smooth motion, however fast,
-        by little; a turn that the joints below turn back, by nothing).  Where filling would put them: how far they lie from where
-        the joint's rotation on the path between the rows around would put them, the joints below
-        as they are (a hand whose end has no length turns nothing; a thigh turned about itself
-        that the knee turns back looks right, and filling the thigh alone would put the leg
-        out).  (0, 0) where it turns none."""
-        p = self._turned_points(joint, first - 1, last + 2)
-        if p is None:
-            return 0.0, 0.0
-        off = float(np.nan_to_num(np.linalg.norm(p[1:-1] - 0.5 * (p[:-2] + p[2:]), axis=-1)).max())
-        off *= 2 if last > first else 1  # the ends of a turn-over of several frames stand out by half of it
-        length = last - first + 2  # steps from row first - 1 to row last + 1
-        share = np.arange(1, length) / length
-        q = self.quaternions(joint, np.array([first - 1, last + 1]))
-        path = slerp(np.broadcast_to(q[0], (len(share), 4)), np.broadcast_to(q[1], (len(share), 4)), share)
-        return off, self._moved(joint, np.arange(first, last + 1), path)
+    def seen(self, runs: list[tuple[str, int, int]]) -> list[tuple[float, float]]:
+        """For each run (joint, first row, last row; within the take, a row on either side): how
+        far the joint's rotation over the rows puts out the points it turns, in metres: where they
+        are, and where filling the joint alone would put them.  Where they are: the farthest any
+        of them lies, at a row of the stretch, from midway between where it is in the rows before
+        and after, twice that over a stretch of several rows (a pop stands out so by its size,
+        the ends of a turn-over by half of it; smooth motion, however fast, by little; a turn
+        that the joints below turn back, by nothing).  Where filling would put them: how far they
+        lie from where the joint's rotation on the path between the rows around would put them,
+        the joints below as they are (a hand whose end has no length turns nothing; a thigh
+        turned about itself that the knee turns back looks right, and filling the thigh alone
+        would put the leg out).  (0, 0) where it turns none.  Every run of a joint at once."""
+        out = [(0.0, 0.0)] * len(runs)
+        by_joint: dict[str, list[int]] = {}
+        for i, (joint, _, _) in enumerate(runs):
+            by_joint.setdefault(joint, []).append(i)
+        for joint, members in by_joint.items():
+            if not len(self._points(joint)):
+                continue
+            first = np.array([runs[i][1] for i in members])
+            last = np.array([runs[i][2] for i in members])
+            chosen: list[tuple[str, bool, int, int]] = [(joint, True, int(a), int(b)) for a, b in zip(first, last)]
+            rows, starts, inner, share = _blocks(chosen)
+            p = self._places(joint, rows)
+            off = np.nan_to_num(np.linalg.norm(p[inner] - 0.5 * (p[inner - 1] + p[inner + 1]), axis=-1)).max(axis=1)
+            ends = np.cumsum(np.diff(starts) - 2)  # each run's inner rows end here
+            offs = np.maximum.reduceat(off, ends - (last - first + 1)) * np.where(last > first, 2, 1)
+            q = self.quaternions(joint, np.concatenate([first - 1, last + 1]))
+            sizes = last - first + 1
+            path = slerp(np.repeat(q[: len(first)], sizes, axis=0), np.repeat(q[len(first) :], sizes, axis=0), share)
+            moved = self._shifts(joint, rows[inner], path)
+            filled = np.maximum.reduceat(moved, ends - sizes)
+            for i, a, b in zip(members, offs.tolist(), filled.tolist()):
+                out[i] = (a, b)
+        return out
 
     def seen_jump(self, joint: str, at: int) -> tuple[float, float, float]:
         """How far the joint's rotation jumping into row ``at`` (2 <= at <= rows - 2) and staying
@@ -191,49 +209,46 @@ class _Take:
         Hz takes steps as long beside it), and how far they lie from where the rotation going on
         at its pace would put them; and, of the point that jumps most, its step into the row and
         the longer of its steps beside.  (0, 0, 0) where it turns no point."""
-        p = self._turned_points(joint, at - 2, at + 2)
-        if p is None:
+        if not len(self._points(joint)):
             return 0.0, 0.0, 0.0
+        p = self._places(joint, np.arange(at - 2, at + 2))
         steps = np.nan_to_num(np.linalg.norm(np.diff(p, axis=0), axis=-1))  # into rows at - 1, at, at + 1
         beside = np.maximum(steps[0], steps[2])
         worst = int(np.argmax(steps[1] - 2 * beside))
         jumped = max(float(steps[1, worst] - 2 * beside[worst]), 0.0)
         q = self.quaternions(joint, np.array([at - 2, at - 1]))
-        moved = self._moved(joint, np.array([at]), slerp(q[0], q[1], np.array([2.0])))
+        moved = float(self._shifts(joint, np.array([at]), slerp(q[0], q[1], np.array([2.0])))[0])
         return min(jumped, moved), float(steps[1, worst]), float(beside[worst])
 
-    def _moved(self, joint: str, rows: np.ndarray, instead: np.ndarray) -> float:
-        """How far the points the joint turns lie at the rows from where its rotations
-        ``instead`` (quaternions, one per row) would put them, in metres: their offsets from the
+    def _shifts(self, joint: str, rows: np.ndarray, instead: np.ndarray) -> np.ndarray:
+        """At each of the rows, how far the point the joint turns farthest from where its rotation
+        ``instead`` (a quaternion per row) would put it lies, in metres: their offsets from the
         joint, in its channels' axes, turned by the difference of the two rotations."""
         skeleton = self.motion.skeleton
         tree, j = skeleton.tree, skeleton.joint_names.index(joint)
-        points = skeleton.derived(("turned points", joint), lambda: _turned(skeleton, joint))
-        places, turns = (
-            self.held if self.held is not None else world_kinematics(self.motion.values[rows], tree, workers=1)
-        )
-        at = rows if self.held is not None else np.arange(len(rows))
+        places, turns = self._kinematics(rows)
         origin = j if skeleton.convention == "bvh" or tree.parent[j] < 0 else int(tree.parent[j])
-        offsets = places[at][:, points] - places[at, origin][:, None]  # (rows, points, 3), world axes
-        frame = turns[at, j] @ tree.axis[j]  # the joint's channels' axes in the world
+        offsets = places[:, self._points(joint)] - places[:, origin][:, None]  # (rows, points, 3), world axes
+        frame = turns[:, j] @ tree.axis[j]  # the joint's channels' axes in the world
         local = np.einsum("rji,rpj->rpi", frame, offsets)
         actual = self.quaternions(joint, rows)
         error = quaternions_to_matrices(_conjugate(actual)) @ quaternions_to_matrices(instead)
         shift = np.einsum("rij,rpj->rpi", error, local) - local
-        return float(np.nan_to_num(np.linalg.norm(shift, axis=-1)).max(initial=0.0)) * self.meters
+        return np.nan_to_num(np.linalg.norm(shift, axis=-1)).max(axis=1, initial=0.0) * self.meters
 
-    def _turned_points(self, joint: str, first: int, stop: int) -> np.ndarray | None:
-        """The places (rows, points, 3) in metres of the points the joint's rotation moves, rows
-        first..stop-1 (within the take); None where it moves none."""
+    def _points(self, joint: str) -> np.ndarray:
         skeleton = self.motion.skeleton
-        points = skeleton.derived(("turned points", joint), lambda: _turned(skeleton, joint))
-        if not len(points):
-            return None
+        return skeleton.derived(("turned points", joint), lambda: _turned(skeleton, joint))
+
+    def _kinematics(self, rows: np.ndarray) -> Kinematics:
+        """Every joint's place and world turn at the rows (of the take held, or worked out)."""
         if self.held is not None:
-            places = self.held[0][first:stop]
-        else:
-            places = self.motion.replace(values=self.motion.values[first:stop]).positions()
-        return places[:, points] * self.meters
+            return self.held[0][rows], self.held[1][rows]
+        return world_kinematics(self.motion.values[rows], self.motion.skeleton.tree, workers=1)
+
+    def _places(self, joint: str, rows: np.ndarray) -> np.ndarray:
+        """The places (rows, points, 3) in metres of the points the joint's rotation moves."""
+        return self._kinematics(rows)[0][:, self._points(joint)] * self.meters
 
 
 def _conjugate(q: np.ndarray) -> np.ndarray:
@@ -349,9 +364,8 @@ def _check_piece(motion: Motion, take: str, begins: bool, ends: bool) -> list[Fi
         rows = motion.frames
         min_run = max(3, round(FROZEN_SECONDS * t.rate))
         found = kernel.channel_events(motion.values, spikes, steps, min_run)
-        # the joints' places and turns, for the spikes, steps, legs and arms alike, where they fit a block
-        if motion.frames <= BLOCK_FRAMES:
-            t.held = world_kinematics(motion.values, motion.skeleton.tree, workers=1)
+        # the joints' places and turns, for the spikes, steps, legs and arms alike (a piece's at most)
+        t.held = world_kinematics(motion.values, motion.skeleton.tree, workers=1)
         ev, sizes = found.events, found.sizes
         by_kind = {kind: (ev[ev[:, 3] == kind], sizes[ev[:, 3] == kind]) for kind in kernel.KINDS}
         repeats = by_kind[kernel.REPEAT][0]
@@ -722,7 +736,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
                     channel.name,
                 )
             )  # fmt: skip
-    return _excursions(t, out, jumps, limits, exact, windows)
+    return _settled(t, _excursions(t, out, jumps, limits, exact, windows))
 
 
 def _rotation_steps(t: _Take, joint: str, rows: range, limit: float) -> list[tuple[int | None, float]]:
@@ -904,36 +918,46 @@ def _turning_spike(
         deviation > 2 * limit
         or (first > 0 and last < t.motion.frames - 1 and deviation > _apart(t, joint, first - 1, last + 1))
     )
-    if not (high or medium):  # low, whatever it moves
-        return Finding(
-            t.name, "spike", (joint,), t.frame(first), t.frame(last), "low", round(deviation, 6), "deg",
-            f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s)",
-            channel, _fill(t, first, last, [joint]),
+    finding = Finding(
+        t.name, "spike", (joint,), t.frame(first), t.frame(last), "low", round(deviation, 6), "deg",
+        f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s)",
+        channel, _fill(t, first, last, [joint]),
+    )  # fmt: skip
+    if high or medium:  # what it moves settles it (low, whatever it moves, otherwise)
+        t.unsettled[id(finding)] = (finding, first, last, deviation, high)
+    return finding
+
+
+def _settled(t: _Take, found: list[Finding]) -> list[Finding]:
+    """The findings with each turning spike that its angles make medium or high settled by what it
+    moves (:meth:`_Take.seen`, for all of them at once): high only where what it turns leaves its
+    path by more than SEEN_M; at most medium where it moves nothing drawn; told and not filled
+    where the take looks right and filling the joint alone would not."""
+    todo = [(i, t.unsettled[id(f)]) for i, f in enumerate(found) if id(f) in t.unsettled]
+    seen = t.seen([(f.joints[0], first, last) for _, (f, first, last, _, _) in todo])
+    out = list(found)
+    for (i, (f, first, last, deviation, high)), (off, filled) in zip(todo, seen):
+        nearest = min(off, filled)
+        # the take looks right, or nearly (the joints below turn it back, or it is the path the
+        # motion takes), and filling this joint alone would put out what it turns four times as
+        # far: told, not filled; medium where the angles are turned over (wrong for anyone who
+        # edits or retargets them), else low
+        undone = off <= 2 * SEEN_M and filled > 4 * off + SEEN_M
+        severity = (
+            ("medium" if high else "low") if nearest < UNSEEN_M  # a twist nothing drawn shows: for a skinned mesh
+            else ("medium" if deviation > FLIP_DEG else "low") if undone
+            else "high" if high and nearest > SEEN_M
+            else "medium"
         )  # fmt: skip
-    off, filled = t.seen(joint, first, last)
-    seen = min(off, filled)
-    # the take looks right, or nearly (the joints below turn it back, or it is the path the motion
-    # takes), and filling this joint alone would put out what it turns four times as far: told,
-    # not filled; medium where the angles are turned over (wrong for anyone who edits or
-    # retargets them), else low
-    undone = off <= 2 * SEEN_M and filled > 4 * off + SEEN_M
-    severity = (
-        ("medium" if high else "low") if seen < UNSEEN_M  # a twist nothing drawn shows: for a skinned mesh
-        else ("medium" if deviation > FLIP_DEG else "low") if undone
-        else "high" if high and seen > SEEN_M
-        else "medium"
-    )  # fmt: skip
-    what = (
-        f"but what it turns stays within {off * 100:.2g} cm of its path (the joints below turn it back, or the "
-        f"motion goes so): told, not filled, which would move them {filled * 100:.2g} cm"
-        if undone
-        else f"moving what it turns {seen * 100:.2g} cm off its path"
-    )
-    return Finding(
-        t.name, "spike", (joint,), t.frame(first), t.frame(last), severity, round(deviation, 6), "deg",
-        f"{joint} turns {deviation:.3g} deg away from its neighbours for {last - first + 1} frame(s), {what}",
-        channel, () if undone else _fill(t, first, last, [joint]),
-    )  # fmt: skip
+        what = (
+            f"but what it turns stays within {off * 100:.2g} cm of its path (the joints below turn it back, or the "
+            f"motion goes so): told, not filled, which would move them {filled * 100:.2g} cm"
+            if undone
+            else f"moving what it turns {nearest * 100:.2g} cm off its path"
+        )
+        out[i] = dataclasses.replace(f, severity=severity, detail=f"{f.detail}, {what}", fix=() if undone else f.fix)
+    t.unsettled.clear()
+    return out
 
 
 Run = tuple[str, bool, int, int]
