@@ -130,6 +130,7 @@ class _Take:
         # order of their names (the order events are joined in)
         self.joints, self.kinds = skeleton.derived("check channel groups", lambda: _groups(self.channels))
         self._quaternions: dict[str, np.ndarray] = {}
+        self._turns: dict[tuple[str, int], np.ndarray] = {}
         self.held: Kinematics | None = None  # the forward kinematics of these frames
         self.unsettled: dict[
             int, tuple[Finding, int, int, float, bool]
@@ -165,6 +166,15 @@ class _Take:
             made = euler_to_quaternions(angles, order, extrinsic=extrinsic, degrees=self.degrees == 1.0)
             self._quaternions[joint] = made
         return made[rows]
+
+    def turns(self, joint: str, apart: int = 1) -> np.ndarray:
+        """The degrees the joint's rotation turns from each row to the row ``apart`` rows on
+        ((rows - apart,): entry k from row k), every row's worked out once."""
+        made = self._turns.get((joint, apart))
+        if made is None:
+            q = self.quaternions(joint, slice(None))
+            made = self._turns[joint, apart] = _angle_deg(q[apart:], q[:-apart])
+        return made
 
     def seen(self, runs: list[tuple[str, int, int]]) -> list[tuple[float, float]]:
         """For each run (joint, first row, last row; within the take, a row on either side): how
@@ -744,9 +754,8 @@ def _rotation_steps(t: _Take, joint: str, rows: range, limit: float) -> list[tup
     a pop (the rotation leaves for one frame and comes back, whatever its Euler angles do on the
     way out and back), found from the jump out or back, or None and the degrees it turns into
     the row more than the mean of its turns into the rows before and after."""
-    q = t.quaternions(joint, np.arange(rows[0] - 2, rows[-1] + 2))
-    turn = _angle_deg(q[1:], q[:-1])  # turn[k]: into row rows[0] - 1 + k
-    back = _angle_deg(q[2:], q[:-2])  # back[k]: from row rows[0] - 2 + k to two rows on
+    turn = t.turns(joint)[rows[0] - 2 : rows[-1] + 1]  # turn[k]: into row rows[0] - 1 + k
+    back = t.turns(joint, 2)[rows[0] - 2 : rows[-1]]  # back[k]: from row rows[0] - 2 + k to two rows on
     out: list[tuple[int | None, float]] = []
     for i, row in enumerate(rows):
         pop = next(
@@ -869,14 +878,14 @@ def _instead(t: _Take, found: list[Finding], windows: list[Window], candidates: 
     holds its frames, and the line between the frames around a stretch that holds one of its
     jumps leaves the frames between.  The first ``candidates`` findings were made before every
     window; each after them was made with the window of the same place in ``windows``."""
-    by_joint: dict[str, list[Window]] = {}
-    for window in windows:
-        by_joint.setdefault(window[0], []).append(window)
+    by_joint: dict[str, list[tuple[int, int, float, int]]] = {}  # frames a spike beside it may reach
+    for joint, first, back, below, after in windows:
+        by_joint.setdefault(joint, []).append((t.frame(first) - 2, t.frame(back) + 1, below, after))
 
     def beside(f: Finding, made: int) -> bool:
         return any(
-            after > made and f.size <= below and f.last >= t.frame(first) - 2 and f.first <= t.frame(back) + 1
-            for _, first, back, below, after in by_joint.get(f.joints[0], ())
+            after > made and f.size <= below and f.last >= low and f.first <= high
+            for low, high, below, after in by_joint.get(f.joints[0], ())
         )
 
     return [
@@ -1062,18 +1071,16 @@ def _fastest(t: _Take, joint: str, first: int, last: int) -> float:
 def _fastest_step(t: _Take, joint: str, *spans: tuple[int, int]) -> float:
     """The most the joint turns from one frame to the next within the spans of rows (first,
     last) of the take, in degrees (0 where its channels make no rotation or no span holds two of
-    those rows): the rotations of every span's rows made at once."""
+    those rows).  NaN steps (a gap) are left out."""
     if joint not in t.rotating:
         return 0.0
-    cut = [np.arange(max(a, 0), min(b, t.motion.frames - 1) + 1) for a, b in spans]
-    cut = [rows for rows in cut if len(rows) >= 2]
-    if not cut:
+    turns = t.turns(joint)  # entry k: from row k to row k + 1
+    steps = [turns[max(a, 0) : min(b, t.motion.frames - 1)] for a, b in spans]
+    steps = [s for s in steps if len(s)]
+    if not steps:
         return 0.0
-    q = t.quaternions(joint, np.concatenate(cut))
-    steps = _angle_deg(q[1:], q[:-1])
-    ends = np.cumsum([len(rows) for rows in cut])[:-1]
-    steps[ends - 1] = np.nan  # the step from one span's last row to the next span's first is none
-    return float(np.nanmax(steps)) if not np.isnan(steps).all() else 0.0
+    fastest = np.concatenate(steps)
+    return float(np.nanmax(fastest)) if not np.isnan(fastest).all() else 0.0
 
 
 def _trimmed(t: _Take, runs: list[Run], limits: list[float]) -> list[tuple[int, int, float | None]]:
