@@ -117,8 +117,10 @@ def page(checks: Sequence[TakeCheck], least: str = "low", views: dict[str, str] 
             view = views.get(check.take)
             if view is not None and finding.first >= check.first_frame:
                 joint = f"&joint={finding.joints[0]}" if len(finding.joints) == 1 else ""
-                href = html.escape(f"{view}#frame={finding.first}{joint}", quote=True)
-                take = f'<a href="{href}" title="open the viewer at frame {finding.first}">{take}</a>'
+                # a file cut short: its findings past the frames it holds open at the last it holds
+                at = min(finding.first, check.first_frame + max(check.frames - 1, 0))
+                href = html.escape(f"{view}#frame={at}{joint}", quote=True)
+                take = f'<a href="{href}" title="open the viewer at frame {at}">{take}</a>'
             frames = (
                 ""
                 if finding.last < finding.first
