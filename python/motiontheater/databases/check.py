@@ -706,6 +706,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     jumps: list[tuple[str, int, float, int, bool]] = []  # (joint, row, degrees, channel, not a spike's)
     exact: list[Finding] = []  # the spikes the rotation's own jumps bound, in place of the candidates beside
     windows: list[Window] = []
+    pops_seen: list[tuple[str, str, int, float]] = []  # (joint, channel, row, limit) of each pop
     for (c, first, last, _, at), size in zip(events[stay], sizes[stay]):
         channel = t.channels[int(c)]
         if channel.turns and channel.joint in t.rotating:
@@ -719,10 +720,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
                 seen.add((channel.joint, row))
                 if pop is not None and (channel.joint, pop) not in popped:
                     popped.add((channel.joint, pop))
-                    off = _deviations(t, [(channel.joint, True, pop, pop)])[0]
-                    if off is not None and float(off[0]) > limit:
-                        windows.append((channel.joint, pop, pop + 1, math.inf, len(exact)))
-                        exact.append(_turning_spike(t, channel.joint, channel.name, pop, pop, float(off[0]), limit))
+                    pops_seen.append((channel.joint, channel.name, pop, limit))
                 elif pop is None and jump > limit:
                     jumps.append((channel.joint, row, jump, int(c), True))
             continue
@@ -746,6 +744,11 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
                     channel.name,
                 )
             )  # fmt: skip
+    offs = _deviations(t, [(joint, True, pop, pop) for joint, _, pop, _ in pops_seen]) if pops_seen else []
+    for (joint, name, pop, limit), off in zip(pops_seen, offs):
+        if off is not None and float(off[0]) > limit:
+            windows.append((joint, pop, pop + 1, math.inf, len(exact)))
+            exact.append(_turning_spike(t, joint, name, pop, pop, float(off[0]), limit))
     return _settled(t, _excursions(t, out, jumps, limits, exact, windows))
 
 
@@ -787,12 +790,12 @@ def _excursions(
     a spike."""
     paired: set[tuple[str, int]] = set()
     pairs = _pairs(sorted(jumps), round(FILL_SECONDS * t.rate))
-    for ((joint, a, size_a, c, _), (_, b, size_b, _, _)), back in zip(pairs, _returns(t, pairs)):
+    # the pairs whose second jump brings the joint back
+    pairs = [pair for pair, back in zip(pairs, _returns(t, pairs)) if back < 0.5 * min(pair[0][2], pair[1][2])]
+    offs = _deviations(t, [(a[0], True, a[1], b[1] - 1) for a, b in pairs]) if pairs else []
+    for ((joint, a, _, c, _), (_, b, _, _, _)), off in zip(pairs, offs):
         if any(j == joint and a <= row <= b for j, row in paired):  # around an excursion paired already
             continue
-        if back >= 0.5 * min(size_a, size_b):
-            continue
-        off = _deviations(t, [(joint, True, a, b - 1)])[0]
         if off is None:
             continue
         paired.update({(joint, a), (joint, b)})

@@ -292,8 +292,9 @@ def _stride(alternation: np.ndarray) -> int | None:
     energy = float(x @ x)
     if n < 8 or not energy > 0:
         return None
-    spectrum = np.fft.rfft(x, 2 * n)
-    alike = np.fft.irfft(spectrum * np.conj(spectrum))[:n] / energy
+    size = 1 << (2 * n - 1).bit_length()  # no wrap-around, and a length pocketfft is fast at
+    spectrum = np.fft.rfft(x, size)
+    alike = np.fft.irfft(spectrum.real**2 + spectrum.imag**2, size)[:n] / energy
     alike /= 1 - np.arange(n) / n  # the share of the take each lag compares
     below = np.flatnonzero(alike[: n // 2] < 0)
     if not len(below):
