@@ -49,6 +49,7 @@ from ..formats.table import (
     companion_path,
     file_bytes,
     format_of,
+    read_file,
     read_skeleton,
     require_frames,
     skeleton_for,
@@ -556,13 +557,9 @@ def _notes_into(notes: list[tuple[int, str]]) -> Generator[None]:
 
 
 def _read(job: Job) -> Motion:
-    row = format_of(job.input)
     skeleton = read_skeleton(job.skeleton, job.unit) if job.skeleton else None
-    if job.pipeline.whole_frames and row.read_frames is not None:  # a file that breaks off: its whole frames
-        motion = row.read_frames(job.input, skeleton, job.frame_rate, job.unit, 1)[0]
-    else:
-        assert row.read is not None
-        motion = row.read(job.input, skeleton, job.frame_rate, job.unit, 1)
+    # with the recipe's whole_frames, a file that breaks off: its whole frames
+    motion, _ = read_file(job.input, skeleton, job.frame_rate, job.unit, 1, whole_frames=job.pipeline.whole_frames)
     return motion if job.body is None else choose_body(motion, job.body)
 
 

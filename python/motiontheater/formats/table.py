@@ -216,12 +216,7 @@ def read_take(
     its header states none, and a BVH's in place of its Frame Time.  ``unit`` is its length unit
     (m, cm, mm, in, or a number L for inch / L) when given: a BVH's is detected from its size
     otherwise, an ASF's is its ``:units length``.  The take must hold at least one frame."""
-    row = format_of(path)
-    regular_file(path)
-    companion = skeleton_for(path, asf)
-    skeleton = None if companion is None else read_skeleton(companion, unit)
-    assert row.read is not None
-    return require_frames(row.read(path, skeleton, frame_rate, unit, workers), path)
+    return _read_take(path, asf, frame_rate, unit, workers, whole_frames=False)[0]
 
 
 def read_take_frames(
@@ -236,14 +231,43 @@ def read_take_frames(
     on past it (a BVH of fewer or more rows than ``Frames:`` says, a last frame cut short), the
     frames it holds whole, and how it disagrees (None for a whole file, or a format that cannot
     break off so)."""
-    row = format_of(path)
-    if row.read_frames is None:
-        return read_take(path, asf, frame_rate, unit, workers=workers), None
+    return _read_take(path, asf, frame_rate, unit, workers, whole_frames=True)
+
+
+def _read_take(
+    path: str | os.PathLike,
+    asf: str | os.PathLike | None,
+    frame_rate: float | None,
+    unit: str | None,
+    workers: int | None,
+    *,
+    whole_frames: bool,
+) -> tuple[Motion, Cut | None]:
+    format_of(path)  # an unknown suffix is told before a missing file
     regular_file(path)
     companion = skeleton_for(path, asf)
     skeleton = None if companion is None else read_skeleton(companion, unit)
-    motion, cut = row.read_frames(path, skeleton, frame_rate, unit, workers)
+    motion, cut = read_file(path, skeleton, frame_rate, unit, workers, whole_frames=whole_frames)
     return require_frames(motion, path), cut
+
+
+def read_file(
+    path: str | os.PathLike,
+    skeleton: Skeleton | None,
+    frame_rate: float | None,
+    unit: str | None,
+    workers: int | None,
+    *,
+    whole_frames: bool = False,
+) -> tuple[Motion, Cut | None]:
+    """The motion of a take file by its format's reader, its skeleton read already (an AMC's;
+    None where the file holds its own), and None; with ``whole_frames``, where the format can
+    break off, the frames it holds whole and where it breaks off (:func:`read_take_frames`)."""
+    row = format_of(path)
+    if whole_frames and row.read_frames is not None:
+        return row.read_frames(path, skeleton, frame_rate, unit, workers)
+    assert row.read is not None
+    return row.read(path, skeleton, frame_rate, unit, workers), None
 
 
 def require_frames(motion: Motion, path: str | os.PathLike) -> Motion:
