@@ -7,7 +7,9 @@
  * the point rests around each frame, and once for its drift over the runs of frames on the
  * floor.
  */
+#include "lanes.h"
 #include "mtcore.h"
+#include "speed.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -15,27 +17,10 @@
 
 enum { KNEE, ANKLE, BALL, HEEL, TIP, POINTS };
 
-static double dot(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static double length(const double *a)
-{
-    return sqrt(dot(a, a));
-}
-
 static void difference(const double *a, const double *b, double *out)
 {
     for (int c = 0; c < 3; c++)
         out[c] = a[c] - b[c];
-}
-
-static void cross(const double *a, const double *b, double *out)
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
 /* Degrees the knee bends backwards at one frame (see mtcore.h), NaN comparing false. */
@@ -45,13 +30,13 @@ static double knee_back(const double *hip, const double *p, const struct mt_leg_
     difference(p + 3 * KNEE, hip, thigh);
     difference(p + 3 * ANKLE, p + 3 * KNEE, shin);
     difference(p + 3 * BALL, p + 3 * ANKLE, foot);
-    double cosine = dot(thigh, shin) / (length(thigh) * length(shin));
+    double cosine = dot3(thigh, shin) / (norm3(thigh) * norm3(shin));
     cosine = cosine < -1.0 ? -1.0 : cosine > 1.0 ? 1.0 : cosine;
-    const double bend = acos(cosine) * (180.0 / 3.141592653589793);
-    const double across = fabs(dot(shin, foot) / (length(shin) * length(foot)));
-    cross(thigh, shin, a);
-    cross(shin, foot, b);
-    return dot(a, b) > 0 && across < check->foot_across && bend < check->folded ? bend : 0.0;
+    const double bend = acos(cosine) * (180.0 / pi);
+    const double across = fabs(dot3(shin, foot) / (norm3(shin) * norm3(foot)));
+    cross3(thigh, shin, a);
+    cross3(shin, foot, b);
+    return dot3(a, b) > 0 && across < check->foot_across && bend < check->folded ? bend : 0.0;
 }
 
 /* The point's height along up at each frame into h, and how far above its lowest within the
@@ -61,7 +46,7 @@ static int lifts(const double *p, size_t frames, const struct mt_leg_check *chec
 {
     double highest = -INFINITY;
     for (size_t t = 0; t < frames; t++) {
-        h[t] = dot(p + t * 3 * POINTS, check->up);
+        h[t] = dot3(p + t * 3 * POINTS, check->up);
         if (isfinite(h[t]) && h[t] > highest)
             highest = h[t];
     }
@@ -87,32 +72,17 @@ static void across_up(const double *p, size_t t, const double *h, const double *
         out[c] = p[t * 3 * POINTS + c] - h[t] * up[c];
 }
 
-/* The larger of two steps; NaN where either is. */
-static double larger(double after, double before)
-{
-    return after != after || before != before ? after + before : after > before ? after : before;
-}
-
-/* The drift of one foot point over its runs of frames on the floor (see mtcore.h); steps:
-   scratch of frames - 1, each step's length across up times the rate. */
+/* The drift of one foot point over its runs of frames on the floor (see mtcore.h); speed:
+   scratch of frames, its speed across up. */
 static void drift_of(const double *p, size_t frames, const double *h, const double *lift,
-                     const struct mt_leg_check *check, double *steps, double *drift)
+                     const struct mt_leg_check *check, double *speed, double *drift)
 {
     const double meters = check->meters_per_unit;
-    double start[3] = {0, 0, 0}, here[3], next[3], d[3];
-    for (size_t t = 0; t + 1 < frames; t++) {
-        across_up(p, t + 1, h, check->up, next);
-        across_up(p, t, h, check->up, here);
-        difference(next, here, d);
-        steps[t] = length(d) * check->frame_rate;
-    }
+    double start[3] = {0, 0, 0}, here[3], d[3];
+    point_speed(p, frames, 3 * POINTS, check->up, h, check->frame_rate, speed);
     int on = 0;
     for (size_t t = 0; t < frames; t++) {
-        const double speed = frames == 1      ? 0.0
-                             : t == 0          ? steps[0]
-                             : t + 1 == frames ? steps[t - 1]
-                                               : larger(steps[t], steps[t - 1]);
-        if (!(lift[t] * meters < check->floor_height && speed * meters < check->floor_speed)) {
+        if (!(lift[t] * meters < check->floor_height && speed[t] * meters < check->floor_speed)) {
             drift[t] = NAN;
             on = 0;
             continue;
@@ -123,7 +93,7 @@ static void drift_of(const double *p, size_t frames, const double *h, const doub
                 start[c] = here[c];
         on = 1;
         difference(here, start, d);
-        drift[t] = length(d);
+        drift[t] = norm3(d);
     }
 }
 
@@ -151,7 +121,7 @@ int mt_check_legs(const double *points, const double *hips, size_t nlegs, size_t
             back[i * frames + t] = knee_back(hips + (i * frames + t) * 3, p, check);
             double lowest = NAN;
             for (int k = 0; k < (tips[i] ? 3 : 2); k++) {
-                const double above = (dot(p + 3 * order[k], floor_up) - check->level) - rest[3 * i + k];
+                const double above = (dot3(p + 3 * order[k], floor_up) - check->level) - rest[3 * i + k];
                 if (above == above && !(above >= lowest))
                     lowest = above;
             }

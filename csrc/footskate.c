@@ -15,6 +15,7 @@
 #include "clones.h"
 #include "lanes.h"
 #include "mtcore.h"
+#include "speed.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -1397,12 +1398,6 @@ int mt_footskate_write(size_t legs, size_t frames, size_t channels, const double
 
 /* ---------------------------------------------------------------- speeds */
 
-/* the larger, NaN if either is (as numpy.maximum) */
-static double nan_max(double a, double b)
-{
-    return a != a || b != b ? a + b : a > b ? a : b;
-}
-
 /* |a - b| * rate, scaled by half for a central difference */
 static double step_length(const double *a, const double *b, double half, double rate)
 {
@@ -1425,27 +1420,13 @@ int mt_point_speeds(const double *points, size_t tracks, size_t frames, size_t p
             const double *p = points + 3 * (i * frames * per_frame + which[k]);
             double *s = speed + (i * count + k) * frames, *c = central ? central + (i * count + k) * frames : NULL;
             const size_t stride = 3 * per_frame;
-            if (frames == 1) {
-                s[0] = 0.0;
-                if (c)
-                    c[0] = 0.0;
-                continue;
-            }
-            /* the step before frame t, kept from the last frame's step after it */
-            double before = step_length(p + stride, p, 1.0, rate);
-            s[0] = before;
-            for (size_t t = 1; t + 1 < frames; t++) {
-                const double after = step_length(p + (t + 1) * stride, p + t * stride, 1.0, rate);
-                s[t] = nan_max(after, before);
-                before = after;
-            }
-            s[frames - 1] = before;
+            point_speed(p, frames, stride, NULL, NULL, rate, s);
             if (!c)
                 continue;
             c[0] = s[0];
             for (size_t t = 1; t + 1 < frames; t++)
                 c[t] = step_length(p + (t + 1) * stride, p + (t - 1) * stride, 2.0, rate);
-            c[frames - 1] = before;
+            c[frames - 1] = s[frames - 1];
         }
     return MT_OK;
 }

@@ -3,7 +3,9 @@
  * see mtcore.h): the samples of heel, ball and toe tip that stand still, and the plane and rest
  * heights that fit them.
  */
+#include "lanes.h"
 #include "mtcore.h"
+#include "speed.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -12,17 +14,6 @@
 
 enum { BALL = 2, HEEL = 3, TIP = 4, POINTS = 5, CONTACTS = 3 };
 static const int contact[CONTACTS] = {HEEL, BALL, TIP};
-
-static double along(const double *p, const double *v)
-{
-    return p[0] * v[0] + p[1] * v[1] + p[2] * v[2];
-}
-
-static double step(const double *a, const double *b, double rate)
-{
-    const double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
-    return sqrt(x * x + y * y + z * z) * rate;
-}
 
 /* The value at fraction q of the sorted values (n >= 1), linearly between the two around it,
    as numpy's percentile computes it. */
@@ -95,18 +86,10 @@ int mt_resting_points(const double *points, size_t nlegs, size_t frames, const i
             const double *p = points + (i * frames * POINTS + (size_t)contact[k]) * 3;
             unsigned char *rests = resting + i * frames * CONTACTS + (size_t)k;
             size_t count = 0;
+            point_speed(p, frames, POINTS * 3, NULL, NULL, frame_rate, speed);
             for (size_t t = 0; t < frames; t++) {
-                const double *q = p + t * POINTS * 3;
-                height[t] = along(q, up);
-                const double before = t > 0 ? step(q, q - POINTS * 3, frame_rate) : NAN;
-                const double after = t + 1 < frames ? step(q + POINTS * 3, q, frame_rate) : NAN;
-                const double s = frames == 1          ? 0.0
-                                 : t == 0             ? after
-                                 : t + 1 == frames    ? before
-                                 : after != after || before != before ? after + before
-                                 : after > before     ? after
-                                                      : before;
-                speed[t] = s * meters_per_unit;
+                height[t] = dot3(p + t * POINTS * 3, up);
+                speed[t] *= meters_per_unit;
                 rests[t * CONTACTS] = speed[t] < rest_speed;
                 count += rests[t * CONTACTS];
             }
@@ -225,7 +208,7 @@ int mt_fit_floor(const double *points, const unsigned char *resting, size_t nleg
             continue;
         const size_t point = i / (frames * CONTACTS) * CONTACTS + i % CONTACTS;
         const double *p = points + (i / CONTACTS * POINTS + (size_t)contact[i % CONTACTS]) * 3;
-        s[n] = (struct sample){.x = p[horizontal[0]], .y = p[horizontal[1]], .z = along(p, up), .unknown = unknown[point]};
+        s[n] = (struct sample){.x = p[horizontal[0]], .y = p[horizontal[1]], .z = dot3(p, up), .unknown = unknown[point]};
         cx += s[n].x, cy += s[n].y;
         keep[n++] = 1;
     }

@@ -1,7 +1,8 @@
 /*
  * lanes.h - build-internal: small vector and matrix algebra over lanes of
  * frames, shared by the kernels that solve frames side by side
- * (kinematics.c, retarget.c, rotation.c, footskate.c).
+ * (kinematics.c, retarget.c, rotation.c, footskate.c), and its one-lane
+ * forms by those that take a frame at a time (ground.c, check_legs.c).
  *
  * Frames are computed BLOCK at a time, every quantity an array over the
  * block (structure of arrays), so that the inner loops run over frames and
