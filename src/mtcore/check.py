@@ -72,9 +72,7 @@ def channel_events(
     them, changes farther than ``step_limit`` from both changes beside them, and rows that repeat
     the row before in every channel.  The kinds and sizes are those of ``mt_check_channels``
     (csrc/mtcore.h)."""
-    x = np.ascontiguousarray(values, dtype=np.float64)
-    if x.ndim != 2:
-        raise ValueError(f"values must be two-dimensional (rows, channels), got shape {x.shape}")
+    x = _table(values)
     rows, channels = x.shape
     spikes = _limits(spike_limit, channels, "spike_limit")
     steps = _limits(step_limit, channels, "step_limit")
@@ -100,6 +98,14 @@ def channel_events(
     events, sizes = events[: count[0]].astype(np.intp), sizes[: count[0]]
     order = np.lexsort((events[:, 3], events[:, 1], events[:, 0]))
     return ChannelEvents(events[order], sizes[order], roughness, smooth.astype(np.intp))
+
+
+def _table(values: ArrayLike) -> np.ndarray:
+    """The (rows, channels) values as a C-contiguous float64 array."""
+    x = np.ascontiguousarray(values, dtype=np.float64)
+    if x.ndim != 2:
+        raise ValueError(f"values must be two-dimensional (rows, channels), got shape {x.shape}")
+    return x
 
 
 def _limits(limit: ArrayLike, channels: int, name: str) -> np.ndarray:
@@ -131,9 +137,7 @@ def pace(values: ArrayLike, weight: ArrayLike) -> Pace:
     """The :class:`Pace` of the (rows, channels) values' steps, each channel weighted by
     ``weight`` (one per channel, or one for all: 1 / the variance of a step's change less the
     mean of the changes beside it, from noise).  The kernel ``mt_check_pace`` (csrc/mtcore.h)."""
-    x = np.ascontiguousarray(values, dtype=np.float64)
-    if x.ndim != 2:
-        raise ValueError(f"values must be two-dimensional (rows, channels), got shape {x.shape}")
+    x = _table(values)
     rows, channels = x.shape
     w = _limits(weight, channels, "weight")
     if not np.isfinite(w).all():
@@ -173,7 +177,7 @@ class LegCheck:
             raise ValueError(f"up must be a unit vector of 3, got {self.up}")
         if len(slope) != 3 or not abs(sum(a * b for a, b in zip(slope, up))) <= 1e-9:
             raise ValueError(f"slope must be a finite vector of 3 perpendicular to up, got {self.slope}")
-        for name in ("level", "meters_per_unit", "frame_rate", "floor_height", "floor_speed", "foot_across", "folded"):
+        for name in _NUMBERS:
             if not math.isfinite(getattr(self, name)):
                 raise ValueError(f"{name} must be finite, got {getattr(self, name)}")
         if not (self.meters_per_unit > 0 and self.frame_rate > 0):
@@ -183,9 +187,13 @@ class LegCheck:
         settings = ffi.new("struct mt_leg_check *")
         settings.up, settings.slope = up, slope
         settings.window = _checks.integer(self.window, "window", 0)
-        for name in ("level", "meters_per_unit", "frame_rate", "floor_height", "floor_speed", "foot_across", "folded"):
+        for name in _NUMBERS:
             setattr(settings, name, float(getattr(self, name)))
         return settings
+
+
+_NUMBERS = ("level", "meters_per_unit", "frame_rate", "floor_height", "floor_speed", "foot_across", "folded")
+"""The settings of :class:`LegCheck` that are single numbers."""
 
 
 @dataclass(frozen=True)
@@ -225,9 +233,7 @@ def roughness(values: ArrayLike, squares: np.ndarray, counts: np.ndarray) -> Non
     """Add to ``squares`` and ``counts`` (float64 and intp, one per channel) each channel's sum
     of squared residuals from the mean of its two neighbours over the (rows, channels) values'
     inner rows, and how many of those were finite (``mt_check_roughness``, csrc/mtcore.h)."""
-    x = np.ascontiguousarray(values, dtype=np.float64)
-    if x.ndim != 2:
-        raise ValueError(f"values must be two-dimensional (rows, channels), got shape {x.shape}")
+    x = _table(values)
     rows, channels = x.shape
     _checks.output(squares, "squares", (channels,))
     _checks.output(counts, "counts", (channels,), np.uintp)
