@@ -13,6 +13,7 @@ import motiontheater as mt
 from corpus import DATA, real_files
 from motiontheater.databases import pieces, survey
 from motiontheater.databases.check import check_motion
+from motiontheater.databases.findings import Finding
 
 LONG = [
     p
@@ -68,6 +69,32 @@ def _repeated(frames: int) -> bytes:
     first = re.search(rb"(?m)^1\s*$", text).start()
     blocks = re.split(rb"(?m)^\d+\s*\r?\n", text[first:])[1:]
     return text[:first] + b"".join(b"%d\r\n" % (i + 1) + blocks[i % len(blocks)] for i in range(frames))
+
+
+@pytest.mark.parametrize("piece", [7, 64, 500])
+def test_pieces_shorter_than_the_frames_read_around_them_see_every_frame(piece, monkeypatch):
+    """Pieces of fewer frames than the 3 s read on either side (a rate of thousands of Hz has
+    them): each piece is checked with the frames in reach of it, so a finding on every frame
+    (of a joint of its own) comes back once per frame, and each piece sees its margin of frames on either side."""
+    take = mt.read_take(LONG[0]) if LONG else pytest.skip("the real-file corpus (../shared/data/cmu) is absent")
+    take = take.crop(take.first_frame, take.first_frame + 999)
+    margin = round(pieces.MARGIN_SECONDS * take.frame_rate)
+    seen = []
+
+    def every_frame(piece, begins, ends):
+        seen.append((piece.first_frame, piece.last_frame))
+        return [
+            Finding("t", "spike", (f"j{f}",), f, f, "low", 0.0, "", "")
+            for f in range(piece.first_frame, piece.last_frame + 1)
+        ]
+
+    monkeypatch.setattr(pieces, "PIECE_FRAMES", piece)
+    found = pieces.check_frames(take.replace(values=take.values[:0]), [take.values], every_frame)
+    assert [f.first for f in found] == list(range(take.first_frame, take.last_frame + 1))
+    assert len(seen) > 1
+    for (first, last), core in zip(seen, range(take.first_frame, take.last_frame + 1, piece)):
+        assert first == max(core - margin, take.first_frame)
+        assert last == (take.last_frame if (first, last) == seen[-1] else core + piece - 1 + margin)
 
 
 def test_an_amc_read_as_it_is_checked_takes_memory_that_does_not_grow_with_it(tmp_path, monkeypatch):

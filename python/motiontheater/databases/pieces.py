@@ -58,7 +58,7 @@ def check_frames(template: Motion, blocks: Iterable[np.ndarray], check: Check) -
         if last_piece:
             break
         core = end
-        drop = core - margin - start
+        drop = max(core - margin - start, 0)  # pieces shorter than the margin keep every row still in reach
         held, start = held[drop:], start + drop
     return _joined(pieces, template.frame_rate)
 
