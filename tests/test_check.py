@@ -11,9 +11,10 @@ import pytest
 import motiontheater as mt
 from artifacts import KINDS, hits, inject
 from corpus import real_files
+from motiontheater.databases import pieces
 from motiontheater.databases.check import check_motion, recipe
 from motiontheater.databases.check_feet import STRIDE_SPEED_RANGE, STRIDE_SPEED_SHARE
-from motiontheater.databases.check_pace import BLOCK_FRAMES, DROP_EVIDENCE, step_pace
+from motiontheater.databases.check_pace import DROP_EVIDENCE, step_pace
 from motiontheater.databases.findings import KINDS as FINDING_KINDS
 from motiontheater.databases.findings import SEVERITIES
 from motiontheater.feet.footskate import prepare
@@ -165,14 +166,14 @@ def test_frames_taken_out_of_real_takes_are_found_where_the_body_moves(variant, 
 
 def test_frames_missing_from_smooth_motion_are_found_in_a_take_of_any_length(monkeypatch):
     """A smooth synthetic take has no frame missing; with frames taken out, the check tells each
-    cut and no other, also where the take is held a block of frames at a time."""
+    cut and no other, also where the take is checked a piece of frames at a time."""
     take = _smooth_take(120.0)
     assert [f for f in check_motion(take) if f.kind == "dropped"] == []
     rows = [40, 90, 91, 150]  # 91: two frames missing at once
     cut = take.replace(values=np.delete(take.values, rows, axis=0))
     want = [(take.first_frame + 39, 1), (take.first_frame + 88, 2), (take.first_frame + 146, 1)]
-    for block in (BLOCK_FRAMES, 64, 7):
-        monkeypatch.setattr("motiontheater.databases.check_pace.BLOCK_FRAMES", block)
+    for block in (pieces.PIECE_FRAMES, 64, 7):
+        monkeypatch.setattr(pieces, "PIECE_FRAMES", block)
         found = [f for f in check_motion(cut) if f.kind == "dropped"]
         assert [(f.first, round(f.size * take.frame_rate)) for f in found] == want, block
         assert all(f.unit == "s" and f.fix == () and f.severity == "low" for f in found)
@@ -356,19 +357,17 @@ def test_retime_sets_the_rate_and_keeps_every_frame():
         mt.Pipeline.of("retime", rate=0).apply(take)
 
 
-def test_the_elbow_check_holds_a_block_of_frames_at_a_time(monkeypatch):
-    """Blocks of 7 frames (a take of any length is checked a block at a time) find what one
-    block of every frame finds."""
-    from motiontheater.databases import check_arms
-
+def test_the_elbow_check_holds_a_piece_of_frames_at_a_time(monkeypatch):
+    """Pieces of 7 frames (a take of any length is checked a piece at a time) find what one
+    piece of every frame finds."""
     take = _walk()
     values = take.values.copy()
     (column,) = take.columns("rradius", ("rx",))
     values[200:230, column] = -np.sign(np.median(values[:, column])) * 50.0
     bent = take.replace(values=values)
-    whole = check_arms.arm_findings(bent, "walk")
-    monkeypatch.setattr(check_arms, "BLOCK_FRAMES", 7)
-    assert check_arms.arm_findings(bent, "walk") == whole
+    whole = [f for f in check_motion(bent, "walk") if f.kind == "elbow"]
+    monkeypatch.setattr(pieces, "PIECE_FRAMES", 7)
+    assert [f for f in check_motion(bent, "walk") if f.kind == "elbow"] == whole
     assert [(f.joints, f.first, f.last, f.severity) for f in whole] == [(("rradius",), 201, 230, "high")]
 
 

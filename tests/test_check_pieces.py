@@ -74,8 +74,8 @@ def _repeated(frames: int) -> bytes:
 @pytest.mark.parametrize("piece", [7, 64, 500])
 def test_pieces_shorter_than_the_frames_read_around_them_see_every_frame(piece, monkeypatch):
     """Pieces of fewer frames than the 3 s read on either side (a rate of thousands of Hz has
-    them): each piece is checked with the frames in reach of it, so a finding on every frame
-    (of a joint of its own) comes back once per frame, and each piece sees its margin of frames on either side."""
+    them): each piece is checked with the frames in reach of it, so a finding on every frame (of
+    a joint of its own) comes back once per frame, and each piece sees its margin on either side."""
     take = mt.read_take(LONG[0]) if LONG else pytest.skip("the real-file corpus (../shared/data/cmu) is absent")
     take = take.crop(take.first_frame, take.first_frame + 999)
     margin = round(pieces.MARGIN_SECONDS * take.frame_rate)

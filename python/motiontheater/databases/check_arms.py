@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtcore.kinematics import JointTree, Kinematics, world_kinematics
+from mtcore.kinematics import Kinematics, world_kinematics
 
 from ..characters.rigs import recognise, wrist
 from ..feet.contacts import runs
@@ -36,23 +36,17 @@ second moment along it) for the elbow to be a hinge the check can judge."""
 
 def arm_findings(motion: Motion, take: str, kinematics: Kinematics | None = None) -> list[Finding]:
     """The elbows of the take bent backwards past ELBOW_BACK_DEG; ``kinematics``: the take's
-    forward kinematics (positions, world rotations), where the caller has them."""
+    forward kinematics (positions, world rotations), where the caller has them (the check holds a
+    long take's frames a piece at a time: :mod:`.pieces`)."""
     skeleton = motion.skeleton
-    arms, (tree, turning, placing) = skeleton.derived("check arms", lambda: _arms(skeleton))
+    arms, placing = skeleton.derived("check arms", lambda: _arms(skeleton))
     if not len(arms) or motion.frames < 2:
         return []
-    if kinematics is not None:  # the joints' own rows
-        turns = [_turns(kinematics, arms[:, 1], _placing(skeleton, arms))]
-    else:  # a block at a time, of the joints above the wrists only
-        turns = [
-            _turns(world_kinematics(motion.values[rows], tree, workers=1), turning, placing)
-            for rows in _blocks(motion.frames)
-        ]
+    if kinematics is None:
+        kinematics = world_kinematics(motion.values, skeleton.tree, workers=1)
     names = skeleton.point_names
     out = []
-    for i, (_, _, elbow, _) in enumerate(arms):
-        turn = np.concatenate([t[i][0] for t in turns])
-        straight = np.concatenate([t[i][1] for t in turns])
+    for (_, _, elbow, _), (turn, straight) in zip(arms, _turns(kinematics, arms[:, 1], placing)):
         bend = _signed_bends(turn, straight, motion.frame_rate)
         if bend is None:
             continue
@@ -75,11 +69,9 @@ def _placing(skeleton: Skeleton, arms: np.ndarray) -> np.ndarray:
     return placing if skeleton.convention == "bvh" else np.maximum(skeleton.tree.parent[placing], 0)
 
 
-def _arms(skeleton: Skeleton) -> tuple[np.ndarray, tuple[JointTree, np.ndarray, np.ndarray]]:
+def _arms(skeleton: Skeleton) -> tuple[np.ndarray, np.ndarray]:
     """The arms the rig tables find, (arms, 4) joints: shoulder, the upper arm's turning joint,
-    elbow and wrist; and what :func:`_turns` needs of them: the tree of the joints above the
-    wrists (their forward kinematics need no more), and in it, the joint turning each upper arm
-    and the joints placing each shoulder, elbow and wrist."""
+    elbow and wrist; and the joints placing each one's shoulder, elbow and wrist (:func:`_placing`)."""
     parts = recognise(skeleton).parts
     names = list(skeleton.point_names)
     arms = []
@@ -92,25 +84,14 @@ def _arms(skeleton: Skeleton) -> tuple[np.ndarray, tuple[JointTree, np.ndarray, 
                 arms.append((names.index(parts[f"{side}_upper_arm"][0]), names.index(turning), names.index(forearm),
                              names.index(end)))  # fmt: skip
     table = np.array(arms, dtype=np.intp).reshape(-1, 4)
-    placing = _placing(skeleton, table)
-    pruned, where = skeleton.tree.pruned(np.concatenate([table[:, 1], placing.ravel()]))
-    return table, (pruned, where[table[:, 1]], where[placing])
-
-
-BLOCK_FRAMES = 8192
-"""Frames whose joints' world rotations are held at once (18 MB for 31 joints): a take of any
-length is checked in blocks."""
-
-
-def _blocks(frames: int) -> list[slice]:
-    return [slice(a, min(a + BLOCK_FRAMES, frames)) for a in range(0, frames, BLOCK_FRAMES)]
+    return table, _placing(skeleton, table)
 
 
 def _turns(kinematics: Kinematics, turning: np.ndarray, placing: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     """For each arm over the frames of the joints' positions and world rotations: the turn from
     upper arm to forearm (the cross product of the two, in the axes of the joint that turns the
-    upper arm), and their dot product (``turning`` and ``placing`` the joints' rows as
-    :func:`_arms` gives them)."""
+    upper arm), and their dot product (``turning`` each upper arm's turning joint and
+    ``placing`` the joints placing its shoulder, elbow and wrist, as :func:`_arms` gives them)."""
     positions, rotations = kinematics
     out = []
     for upper, (shoulder, elbow, hand) in zip(turning, placing):

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from mtcore import check as kernel
-from mtcore.kinematics import Kinematics
+from mtcore.kinematics import Kinematics, world_kinematics
 
 from ..model.motion import Motion
 from .findings import Finding
@@ -34,8 +34,6 @@ MOST_MISSING = 5
 """The most frames told missing in one step (a longer loss is a cut, not a dropped frame)."""
 NOISE_M = 0.0001
 """The least noise a coordinate is taken to have, metres (a take of few digits, or synthetic)."""
-BLOCK_FRAMES = 8192
-"""Frames whose joints' positions are held at once: a take of any length is checked in blocks."""
 AROUND = ("gap", "repeated")
 """Findings whose frames move unevenly for their own reason: no step within them is told (a
 frame repeated in place of a lost one, then a step of two: the repeat is the finding).  A flip
@@ -89,38 +87,18 @@ def dropped_findings(
 
 def step_pace(motion: Motion, kinematics: Kinematics | None = None) -> kernel.Pace:
     """The :func:`mtcore.check.pace` of the joints' positions (metres), each coordinate weighted
-    by its noise: the frame-to-frame roughness over the take, at least NOISE_M."""
+    by its noise: the frame-to-frame roughness over the take, at least NOISE_M.  ``kinematics``:
+    the take's forward kinematics, where the caller has them (the check holds a long take's
+    frames a piece at a time: :mod:`.pieces`)."""
     rows = motion.frames
     if rows < 4:
         return kernel.Pace(np.zeros(rows), np.zeros(rows), np.zeros(rows))
-    blocks = [(a, min(a + BLOCK_FRAMES, rows)) for a in range(0, rows, BLOCK_FRAMES)]
-    held = None
-    if kinematics is not None:  # every row's, given: one block
-        held, blocks = (kinematics[0] * motion.skeleton.meters_per_unit).reshape(rows, -1), [(0, rows)]
-    elif len(blocks) == 1:
-        held = _positions(motion, 0, rows)
-    squares, counts = (
-        np.zeros(3 * len(motion.skeleton.joint_names)),
-        np.zeros(3 * len(motion.skeleton.joint_names), np.uintp),
-    )
-    for a, b in blocks:  # rows a-1 .. b: the roughness of rows a .. b-1, each row's once (a gap's left out)
-        kernel.roughness(
-            held if held is not None else _positions(motion, max(a - 1, 0), min(b + 1, rows)), squares, counts
-        )
+    if kinematics is None:
+        kinematics = world_kinematics(motion.values, motion.skeleton.tree, workers=1)
+    places = (kinematics[0] * motion.skeleton.meters_per_unit).reshape(rows, -1)
+    squares, counts = np.zeros(places.shape[1]), np.zeros(places.shape[1], np.uintp)
+    kernel.roughness(places, squares, counts)  # a gap's left out
     with np.errstate(invalid="ignore", divide="ignore"):
         noise = np.nan_to_num(squares / counts / 1.5)  # the variance of one coordinate
     # d - m = 1.5 x[t+1] - 1.5 x[t] + 0.5 x[t-1] - 0.5 x[t+2]: five times the variance of one
-    weight = 1.0 / (5.0 * (noise + NOISE_M**2))
-    sums = np.zeros((3, rows))
-    for a, b in blocks:  # rows a-1 .. b+1: the steps a .. b-1 and their neighbours
-        first = max(a - 1, 0)
-        p = held if held is not None else _positions(motion, first, min(b + 2, rows))
-        pace = kernel.pace(p, weight)
-        sums[:, a:b] = np.stack([pace.moved, pace.paced, pace.stepped])[:, a - first : b - first]
-    return kernel.Pace(*sums)
-
-
-def _positions(motion: Motion, first: int, stop: int) -> np.ndarray:
-    """The joints' world positions of rows first..stop-1, metres, (rows, joints x 3)."""
-    part = motion.replace(values=motion.values[first:stop])
-    return part.positions(meters=True).reshape(stop - first, -1)
+    return kernel.pace(places, 1.0 / (5.0 * (noise + NOISE_M**2)))
