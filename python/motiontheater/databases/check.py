@@ -132,9 +132,9 @@ class _Take:
         self._quaternions: dict[str, np.ndarray] = {}
         self._turns: dict[tuple[str, int], np.ndarray] = {}
         self.held: Kinematics | None = None  # the forward kinematics of these frames
-        self.unsettled: dict[
-            int, tuple[Finding, int, int, float, bool]
-        ] = {}  # turning spikes: what they move settles them
+        # the turning spikes that what they move settles (:func:`_settled`), by id: (finding,
+        # first row, last row, degrees, high by their angles)
+        self.unsettled: dict[int, tuple[Finding, int, int, float, bool]] = {}
         self.begins, self.ends = True, True  # whether these frames begin and end the take
 
     def frame(self, row: int) -> int:
@@ -242,7 +242,7 @@ class _Take:
         frame = turns[:, j] @ tree.axis[j]  # the joint's channels' axes in the world
         local = np.einsum("rji,rpj->rpi", frame, offsets)
         actual = self.quaternions(joint, rows)
-        error = quaternions_to_matrices(_conjugate(actual)) @ quaternions_to_matrices(instead)
+        error = np.swapaxes(quaternions_to_matrices(actual), -1, -2) @ quaternions_to_matrices(instead)
         shift = np.einsum("rij,rpj->rpi", error, local) - local
         return np.nan_to_num(np.linalg.norm(shift, axis=-1)).max(axis=1, initial=0.0) * self.meters
 
@@ -259,10 +259,6 @@ class _Take:
     def _places(self, joint: str, rows: np.ndarray) -> np.ndarray:
         """The places (rows, points, 3) in metres of the points the joint's rotation moves."""
         return self._kinematics(rows)[0][:, self._points(joint)] * self.meters
-
-
-def _conjugate(q: np.ndarray) -> np.ndarray:
-    return q * np.array([1.0, -1.0, -1.0, -1.0])
 
 
 _NONE = np.zeros(0, np.intp)
