@@ -168,15 +168,22 @@ def plan(
 ) -> list[CheckJob]:
     """A job per AMC and BVH take under the inputs (files, folders searched recursively, globs);
     ``views``: the folder where each take with medium or high findings gets its viewer page;
-    ``curves``: keep each finding's curve (for an HTML report's plots)."""
+    ``curves``: keep each finding's curve (for an HTML report's plots).  An AMC's skeleton is
+    found here, each folder listed once (a database holds thousands of takes in a few folders)."""
     jobs = []
+    folders: dict[Path, list[Path]] = {}
     for take, relative in find_takes(inputs):
         try:
             size = os.stat(take).st_size
         except OSError:
             size = 0
+        try:
+            companion = skeleton_for(take, asf, folders)
+        except OSError:  # the take's check says what is missing
+            companion = None
         folder = None if views is None else os.fspath(views)
-        jobs.append(CheckJob(os.fspath(take), relative.as_posix(), asf, frame_rate, unit, size, folder, curves, body))
+        skeleton = None if companion is None else os.fspath(companion)
+        jobs.append(CheckJob(os.fspath(take), relative.as_posix(), skeleton, frame_rate, unit, size, folder, curves, body))
     return jobs
 
 
