@@ -1159,6 +1159,17 @@ struct mt_leg_check {
 int mt_check_legs(const double *points, const double *hips, size_t nlegs, size_t frames, const double *rest,
                   const int *tips, const struct mt_leg_check *check, double *drift, double *depth, double *back);
 
+/*
+ * The elbows of a take, frame by frame (check_arms.c).  positions (frames x joints x 3) are every
+ * joint's, world (frames x turned x 9) the world rotations of some joints (row-major).  Arm a's
+ * shoulder, elbow and wrist are where joints place[3a], place[3a + 1] and place[3a + 2] are, and
+ * its upper arm turns with world rotation turning[a] (< turned).  turn (arms x frames x 3)
+ * receives the cross product of upper arm and forearm in the axes of that rotation (W^T (u x f)),
+ * straight (arms x frames) their dot product.  NaN positions give NaN.
+ */
+int mt_check_elbows(const double *positions, size_t frames, size_t joints, const double *world, size_t turned,
+                    const size_t *turning, const size_t *place, size_t arms, double *turn, double *straight);
+
 /* MT_CDEF_END */
 
 #endif /* MTCORE_H */

@@ -28,6 +28,7 @@ __all__ = [
     "LegMeasures",
     "Pace",
     "channel_events",
+    "elbow_turns",
     "leg_measures",
     "pace",
     "roughness",
@@ -227,6 +228,28 @@ def leg_measures(
                                c_array(drift), c_array(depth), c_array(back))  # fmt: skip
     check(status, "mt_check_legs")
     return LegMeasures(drift, depth, back)
+
+
+def elbow_turns(
+    positions: ArrayLike, world: ArrayLike, turning: ArrayLike, placing: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
+    """How each arm's forearm turns from its upper arm, frame by frame (``mt_check_elbows``,
+    csrc/mtcore.h): the cross product of upper arm and forearm in the axes of the upper arm's
+    world rotation (arms, frames, 3), and their dot product (arms, frames).  ``positions``
+    (frames, joints, 3) and ``world`` (frames, turned, 3, 3) of the joints, ``turning`` (arms) the
+    world rotation each upper arm turns with, ``placing`` (arms, 3) the joints where its
+    shoulder, elbow and wrist are."""
+    p = _checks.real(positions, "positions", (None, None, 3))
+    frames, joints = p.shape[:2]
+    w = _checks.real(world, "world", (frames, None, 3, 3))
+    turned = _checks.integers(turning, "turning", (None,), 0, w.shape[1], np.uintp)
+    arms = len(turned)
+    place = _checks.integers(placing, "placing", (arms, 3), 0, joints, np.uintp)
+    turn, straight = np.empty((arms, frames, 3)), np.empty((arms, frames))
+    status = lib.mt_check_elbows(c_array(p), frames, joints, c_array(w), w.shape[1], c_array(turned, "size_t[]"),
+                                 c_array(place, "size_t[]"), arms, c_array(turn), c_array(straight))  # fmt: skip
+    check(status, "mt_check_elbows")
+    return turn, straight
 
 
 def roughness(values: ArrayLike, squares: np.ndarray, counts: np.ndarray) -> None:

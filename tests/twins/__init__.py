@@ -27,7 +27,7 @@ from mtcore import rotations as rot
 from mtcore import search as mt_search
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
-from mtcore.check import channel_events, pace, roughness
+from mtcore.check import channel_events, elbow_turns, pace, roughness
 from mtcore.check import leg_measures as check_legs
 from mtcore.combine import combine_frames
 from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
@@ -990,6 +990,7 @@ TWINS: dict[str, Twin] = {
         check.check_legs_cases,
         close(1e-9),
     ),
+    "mt_check_elbows": Twin(elbow_turns, check.elbow_turns_twin, check.elbow_cases, close(1e-12)),
     "mt_nan_runs": Twin(
         lambda x, *_: mt_signal.nan_runs(x), lambda x, *_: signal_twins.nan_runs_twin(x), nan_run_cases, exact
     ),

@@ -8,6 +8,8 @@ import numpy as np
 
 from mtcore.check import FROZEN, GAP, REPEAT, SPIKE, STEP
 
+from . import rotations
+
 
 def _runs(flags: list[bool]) -> list[tuple[int, int]]:
     """(first, last) of each run of True."""
@@ -225,4 +227,32 @@ def roughness_cases(rng: np.random.Generator) -> list[tuple]:
         if rows > 10:
             x[7, 1], x[20, 2], x[30:33, 4] = math.nan, math.inf, math.nan
         out.append((x, rng.uniform(0, 5, channels), rng.integers(0, 9, channels).astype(np.uintp)))
+    return out
+
+
+def elbow_turns_twin(positions, world, turning, placing):
+    """Each arm's upper arm and forearm at each frame, their cross product turned into the upper
+    arm's axes by numpy, one frame at a time."""
+    p, w = np.asarray(positions, float), np.asarray(world, float)
+    arms, frames = len(turning), len(p)
+    turn, straight = np.zeros((arms, frames, 3)), np.zeros((arms, frames))
+    for a, (upper, (shoulder, elbow, hand)) in enumerate(zip(turning, placing)):
+        for t in range(frames):
+            arm, forearm = p[t, elbow] - p[t, shoulder], p[t, hand] - p[t, elbow]
+            turn[a, t] = w[t, upper].T @ np.cross(arm, forearm)
+            straight[a, t] = arm @ forearm
+    return turn, straight
+
+
+def elbow_cases(rng: np.random.Generator) -> list[tuple]:
+    """No arm to two, 0 to 40 frames, world rotations of every joint or of a few, a NaN place."""
+    out = []
+    for arms, frames, joints, turned in ((0, 5, 3, 2), (1, 0, 4, 4), (1, 1, 3, 1), (2, 7, 6, 3), (2, 40, 9, 9)):
+        positions = rng.normal(size=(frames, joints, 3))
+        if frames > 5:
+            positions[3, 1] = math.nan
+        world = rotations.matrices(rng.uniform(-3, 3, (frames, turned, 3)), "zyx")
+        turning = rng.integers(0, turned, arms)
+        placing = np.array([rng.permutation(joints)[:3] for _ in range(arms)], np.intp).reshape(arms, 3)
+        out.append((positions, world, turning, placing))
     return out

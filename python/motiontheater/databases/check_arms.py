@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mtcore.check import elbow_turns
 from mtcore.kinematics import Kinematics, world_kinematics
 
 from ..characters.rigs import recognise, wrist
@@ -46,7 +47,8 @@ def arm_findings(motion: Motion, take: str, kinematics: Kinematics | None = None
         kinematics = world_kinematics(motion.values, skeleton.tree, workers=1)
     names = skeleton.point_names
     out = []
-    for (_, _, elbow, _), (turn, straight) in zip(arms, _turns(kinematics, arms[:, 1], placing)):
+    turns, straights = elbow_turns(*kinematics, arms[:, 1], placing)
+    for (_, _, elbow, _), turn, straight in zip(arms, turns, straights):
         bend = _signed_bends(turn, straight, motion.frame_rate)
         if bend is None:
             continue
@@ -87,38 +89,17 @@ def _arms(skeleton: Skeleton) -> tuple[np.ndarray, np.ndarray]:
     return table, _placing(skeleton, table)
 
 
-def _turns(kinematics: Kinematics, turning: np.ndarray, placing: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-    """For each arm over the frames of the joints' positions and world rotations: the turn from
-    upper arm to forearm (the cross product of the two, in the axes of the joint that turns the
-    upper arm), and their dot product (``turning`` each upper arm's turning joint and
-    ``placing`` the joints placing its shoulder, elbow and wrist, as :func:`_arms` gives them)."""
-    positions, rotations = kinematics
-    out = []
-    for upper, (shoulder, elbow, hand) in zip(turning, placing):
-        arm = positions[:, elbow] - positions[:, shoulder]
-        forearm = positions[:, hand] - positions[:, elbow]
-        turn = np.einsum("fji,fj->fi", rotations[:, upper], _cross(arm, forearm))
-        out.append((turn, np.sum(arm * forearm, axis=-1)))
-    return out
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross products of rows of 3 (numpy's cross, written out: it moves axes for every call)."""
-    out = np.empty_like(a)
-    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out
+_ONES = np.ones(3)
 
 
 def _signed_bends(turn: np.ndarray, straight: np.ndarray, rate: float) -> np.ndarray | None:
     """The elbow's bend per frame in degrees, forward positive and backwards negative, from its
-    turns and dot products (:func:`_turns`); None where the take does not tell its axis (see the
+    turns and dot products (:func:`mtcore.check.elbow_turns`); None where the take does not tell its axis (see the
     module docstring)."""
-    length = np.linalg.norm(turn, axis=-1)
+    length = np.sqrt(np.square(turn) @ _ONES)  # numpy's norm reduces an axis of 3 slowly
     with np.errstate(invalid="ignore", divide="ignore"):
         bent = np.degrees(np.arctan2(length, straight)) > BENT_DEG
-        if bent.sum() < max(2, BENT_SECONDS * rate):
+        if np.count_nonzero(bent) < max(2, BENT_SECONDS * rate):
             return None
         units = turn[bent] / length[bent, None]
     # the axis the turns share, whichever way each turns (a long backwards bend is among them),

@@ -183,7 +183,9 @@ def plan(
             companion = None
         folder = None if views is None else os.fspath(views)
         skeleton = None if companion is None else os.fspath(companion)
-        jobs.append(CheckJob(os.fspath(take), relative.as_posix(), skeleton, frame_rate, unit, size, folder, curves, body))
+        jobs.append(
+            CheckJob(os.fspath(take), relative.as_posix(), skeleton, frame_rate, unit, size, folder, curves, body)
+        )
     return jobs
 
 
