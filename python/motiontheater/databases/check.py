@@ -212,23 +212,37 @@ class _Take:
                 out[i] = (a, b)
         return out
 
-    def seen_jump(self, joint: str, at: int) -> tuple[float, float, float]:
-        """How far the joint's rotation jumping into row ``at`` (2 <= at <= rows - 2) and staying
-        puts out the points it turns, in metres: the lesser of how much longer their step into
-        the row is than twice their steps before and after it (a snap; an arm flung out fast at 30
-        Hz takes steps as long beside it), and how far they lie from where the rotation going on
-        at its pace would put them; and, of the point that jumps most, its step into the row and
-        the longer of its steps beside.  (0, 0, 0) where it turns no point."""
-        if not len(self._points(joint)):
-            return 0.0, 0.0, 0.0
-        p = self._places(joint, np.arange(at - 2, at + 2))
-        steps = np.nan_to_num(np.linalg.norm(np.diff(p, axis=0), axis=-1))  # into rows at - 1, at, at + 1
-        beside = np.maximum(steps[0], steps[2])
-        worst = int(np.argmax(steps[1] - 2 * beside))
-        jumped = max(float(steps[1, worst] - 2 * beside[worst]), 0.0)
-        q = self.quaternions(joint, np.array([at - 2, at - 1]))
-        moved = float(self._shifts(joint, np.array([at]), slerp(q[0], q[1], np.array([2.0])))[0])
-        return min(jumped, moved), float(steps[1, worst]), float(beside[worst])
+    def seen_jumps(self, jumps: list[tuple[str, int]]) -> list[tuple[float, float, float]]:
+        """For each jump of a joint's rotation into row ``at`` (2 <= at <= rows - 2) that stays:
+        how far it puts out the points the joint turns, in metres: the lesser of how much longer
+        their step into the row is than twice their steps before and after it (a snap; an arm
+        flung out fast at 30 Hz takes steps as long beside it), and how far they lie from where
+        the rotation going on at its pace would put them; and, of the point that jumps most, its
+        step into the row and the longer of its steps beside.  (0, 0, 0) where it turns no
+        point.  Every jump of a joint at once."""
+        out = [(0.0, 0.0, 0.0)] * len(jumps)
+        by_joint: dict[str, list[int]] = {}
+        for i, (joint, _) in enumerate(jumps):
+            by_joint.setdefault(joint, []).append(i)
+        for joint, members in by_joint.items():
+            points = len(self._points(joint))
+            if not points:
+                continue
+            at = np.array([jumps[i][1] for i in members])
+            p = self._places(joint, (at[:, None] + np.arange(-2, 2)).ravel()).reshape(len(at), 4, points, 3)
+            steps = np.nan_to_num(np.linalg.norm(np.diff(p, axis=1), axis=-1))  # into rows at - 1, at, at + 1
+            beside = np.maximum(steps[:, 0], steps[:, 2])
+            worst = np.argmax(steps[:, 1] - 2 * beside, axis=1)
+            step, beside = (
+                np.take_along_axis(steps[:, 1], worst[:, None], 1)[:, 0],
+                np.take_along_axis(beside, worst[:, None], 1)[:, 0],
+            )
+            jumped = np.maximum(step - 2 * beside, 0.0)
+            q = self.quaternions(joint, np.concatenate([at - 2, at - 1]))
+            moved = self._shifts(joint, at, slerp(q[: len(at)], q[len(at) :], np.full(len(at), 2.0)))
+            for i, a, b, c in zip(members, np.minimum(jumped, moved).tolist(), step.tolist(), beside.tolist()):
+                out[i] = (a, b, c)
+        return out
 
     def _shifts(self, joint: str, rows: np.ndarray, instead: np.ndarray) -> np.ndarray:
         """At each of the rows, how far the point the joint turns farthest from where its rotation
@@ -798,20 +812,20 @@ def _excursions(
         windows.append((joint, a, b, math.inf, len(exact)))
         limit = t.physical(t.channels[c], limits[c])
         exact.append(_turning_spike(t, joint, t.channels[c].name, a, b - 1, float(off.max()), limit))
-    for joint, at, jump, c, shown in sorted(jumps):
-        if (joint, at) in paired or not shown:
-            continue
+    stay = [j for j in sorted(jumps) if (j[0], j[1]) not in paired and j[4]]
+    turned = [jump > 30 and joint in t.rotating and 1 < at < t.motion.frames - 1 for joint, at, jump, _, _ in stay]
+    seen_jumps = iter(t.seen_jumps([(j[0], j[1]) for j, turns in zip(stay, turned) if turns]))
+    for (joint, at, jump, c, _), turns in zip(stay, turned):
         if joint in t.rotating:  # a rotation that jumps and stays: the spikes the median finds beside it are its
             windows.append((joint, at, at, jump, len(exact)))
         severity = "high" if jump > 90 else "medium" if jump > 30 else "low"
-        turned = severity != "low" and joint in t.rotating and 1 < at < t.motion.frames - 1
-        seen, step, beside = t.seen_jump(joint, at) if turned else (math.inf, 0.0, 0.0)
+        seen, step, beside = next(seen_jumps) if turns else (math.inf, 0.0, 0.0)
         if seen < UNSEEN_M:  # a twist nothing drawn shows (a skinned mesh would), or fast motion
             severity = "medium" if severity == "high" else "low"
         elif severity == "high" and seen <= SEEN_M:
             severity = "medium"
         moved = f" (what it turns moves {step * 100:.2g} cm into that frame, {beside * 100:.2g} cm beside it)"
-        moved = moved if turned else ""
+        moved = moved if turns else ""
         exact.append(
             Finding(
                 t.name, "jump", (joint,), t.frame(at), t.frame(at), severity, round(jump, 6), "deg",
