@@ -768,8 +768,9 @@ def _rotation_steps(t: _Take, joint: str, rows: range, limit: float) -> list[tup
     a pop (the rotation leaves for one frame and comes back, whatever its Euler angles do on the
     way out and back), found from the jump out or back, or None and the degrees it turns into
     the row more than the mean of its turns into the rows before and after."""
-    turn = t.turns(joint)[rows[0] - 2 : rows[-1] + 1]  # turn[k]: into row rows[0] - 1 + k
-    back = t.turns(joint, 2)[rows[0] - 2 : rows[-1]]  # back[k]: from row rows[0] - 2 + k to two rows on
+    # as Python floats: a step spans a row or a few, where numpy's scalars cost more than the work
+    turn = t.turns(joint)[rows[0] - 2 : rows[-1] + 1].tolist()  # turn[k]: into row rows[0] - 1 + k
+    back = t.turns(joint, 2)[rows[0] - 2 : rows[-1]].tolist()  # back[k]: from row rows[0] - 2 + k to two rows on
     out: list[tuple[int | None, float]] = []
     for i, row in enumerate(rows):
         pop = next(
@@ -781,7 +782,7 @@ def _rotation_steps(t: _Take, joint: str, rows: range, limit: float) -> list[tup
             ),
             None,
         )
-        out.append((pop, 0.0) if pop is not None else (None, float(turn[i + 1] - 0.5 * (turn[i] + turn[i + 2]))))
+        out.append((pop, 0.0) if pop is not None else (None, turn[i + 1] - 0.5 * (turn[i] + turn[i + 2])))
     return out
 
 
@@ -1096,12 +1097,9 @@ def _fastest_step(t: _Take, joint: str, *spans: tuple[int, int]) -> float:
     if joint not in t.rotating:
         return 0.0
     turns = t.turns(joint)  # entry k: from row k to row k + 1
-    steps = [turns[max(a, 0) : min(b, t.motion.frames - 1)] for a, b in spans]
-    steps = [s for s in steps if len(s)]
-    if not steps:
-        return 0.0
-    fastest = np.concatenate(steps)
-    return float(np.nanmax(fastest)) if not np.isnan(fastest).all() else 0.0
+    # a few steps each: Python's floats cost less than numpy's calls
+    steps = [x for a, b in spans for x in turns[max(a, 0) : min(b, t.motion.frames - 1)].tolist() if x == x]
+    return max(steps, default=0.0)
 
 
 def _trimmed(t: _Take, runs: list[Run], limits: list[float]) -> list[tuple[int, int, float | None]]:
