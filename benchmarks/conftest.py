@@ -69,6 +69,11 @@ def _shown(entry) -> str:
     return f"{x:.0f}" if x >= 100 else f"{x:.3g}"
 
 
+def _ratio(x: float) -> str:
+    """A rate against another's: two decimals below 1 (0.56x, not 0.6x, beside a target of 0.8x)."""
+    return f"{x:.2f}x" if x < 1 else f"{x:.1f}x"
+
+
 def _time(seconds: float) -> str:
     return f"{seconds * 1e6:.1f} us" if seconds < 1e-3 else f"{seconds * 1e3:.1f} ms"
 
@@ -90,7 +95,7 @@ def pytest_terminal_summary(terminalreporter):
             continue
         ref = RESULTS.get(CEILING.get(case, ""), {}).get("copy")
         vs_copy = f"{_rate(ours) / _rate(ref):.0%}" if ref else "-"
-        peers = ", ".join(f"{who} {_rate(ours) / _rate(e):.1f}x" for who, e in whos.items() if who != "mtcore")
+        peers = ", ".join(f"{who} {_ratio(_rate(ours) / _rate(e))}" for who, e in whos.items() if who != "mtcore")
         write(
             f"| {case} | {_time(ours[0])} | {_shown(ours)} {ours[2]}/s | {vs_copy} | "
             f"{peers or '-'} | {TARGETS.get(case, '')} |"

@@ -38,6 +38,7 @@ from ..model.motion import Motion
 from ..model.rig import body_joint
 from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 from ..model.units import HUMAN_HEIGHT
+from ..model.vectors import lengths
 from .check_arms import arm_findings
 from .check_feet import leg_findings
 from .check_pace import dropped_findings
@@ -200,7 +201,7 @@ class _Take:
             chosen: list[tuple[str, bool, int, int]] = [(joint, True, int(a), int(b)) for a, b in zip(first, last)]
             rows, starts, inner, share = _blocks(chosen)
             p = self._places(joint, rows)
-            off = np.nan_to_num(np.linalg.norm(p[inner] - 0.5 * (p[inner - 1] + p[inner + 1]), axis=-1)).max(axis=1)
+            off = np.nan_to_num(lengths(p[inner] - 0.5 * (p[inner - 1] + p[inner + 1]))).max(axis=1)
             ends = np.cumsum(np.diff(starts) - 2)  # each run's inner rows end here
             offs = np.maximum.reduceat(off, ends - (last - first + 1)) * np.where(last > first, 2, 1)
             q = self.quaternions(joint, np.concatenate([first - 1, last + 1]))
@@ -230,7 +231,7 @@ class _Take:
                 continue
             at = np.array([jumps[i][1] for i in members])
             p = self._places(joint, (at[:, None] + np.arange(-2, 2)).ravel()).reshape(len(at), 4, points, 3)
-            steps = np.nan_to_num(np.linalg.norm(np.diff(p, axis=1), axis=-1))  # into rows at - 1, at, at + 1
+            steps = np.nan_to_num(lengths(np.diff(p, axis=1)))  # into rows at - 1, at, at + 1
             beside = np.maximum(steps[:, 0], steps[:, 2])
             worst = np.argmax(steps[:, 1] - 2 * beside, axis=1)
             step, beside = (
@@ -258,7 +259,7 @@ class _Take:
         actual = self.quaternions(joint, rows)
         error = np.swapaxes(quaternions_to_matrices(actual), -1, -2) @ quaternions_to_matrices(instead)
         shift = np.einsum("rij,rpj->rpi", error, local) - local
-        return np.nan_to_num(np.linalg.norm(shift, axis=-1)).max(axis=1, initial=0.0) * self.meters
+        return np.nan_to_num(lengths(shift)).max(axis=1, initial=0.0) * self.meters
 
     def _points(self, joint: str) -> np.ndarray:
         skeleton = self.motion.skeleton
@@ -1062,7 +1063,7 @@ def _line_deviations(t: _Take, runs: list[Run], turns: bool) -> np.ndarray:
     before, after = np.repeat(starts[:-1], sizes)[inner], np.repeat(starts[1:] - 1, sizes)[inner]
     line = block[before] + share[:, None] * (block[after] - block[before])
     off = block[inner] - line
-    return _summed(np.abs(off).max(axis=1) if turns else np.linalg.norm(off, axis=1), starts, missing)
+    return _summed(np.abs(off).max(axis=1) if turns else lengths(off), starts, missing)
 
 
 def _unwrapped(block: np.ndarray, period: float) -> np.ndarray:
@@ -1098,7 +1099,7 @@ def _fastest_step(t: _Take, joint: str, *spans: tuple[int, int]) -> float:
         return 0.0
     turns = t.turns(joint)  # entry k: from row k to row k + 1
     # a few steps each: Python's floats cost less than numpy's calls
-    steps = [x for a, b in spans for x in turns[max(a, 0) : min(b, t.motion.frames - 1)].tolist() if x == x]
+    steps = [x for a, b in spans for x in turns[max(a, 0) : min(b, t.motion.frames - 1)].tolist() if not math.isnan(x)]
     return max(steps, default=0.0)
 
 
@@ -1159,7 +1160,7 @@ def _bones(t: _Take) -> list[Finding]:
     for joint, columns in placed:
         if joint in above:
             continue
-        length = np.linalg.norm(t.motion.values[:, columns], axis=1) * t.meters
+        length = lengths(t.motion.values[:, columns]) * t.meters
         if not np.isfinite(length).any():
             continue
         middle = float(np.nanmedian(length))
@@ -1199,7 +1200,7 @@ def _speed(t: _Take) -> list[Finding]:
     if len(columns) != 3:
         return []
     window = max(1, round(0.25 * t.rate))
-    steps = np.linalg.norm(np.diff(t.motion.values[:, columns], axis=0), axis=1) * t.meters * t.rate
+    steps = lengths(np.diff(t.motion.values[:, columns], axis=0)) * t.meters * t.rate
     if not np.nanmax(steps, initial=0.0) > RUN_SPEED:  # no median of them can be: the take is slower
         return []
     # the median over 0.25 s: a teleport of a few frames is not a speed

@@ -21,6 +21,7 @@ from ..characters.rigs import recognise, wrist
 from ..feet.contacts import runs
 from ..model.motion import Motion
 from ..model.skeleton import Skeleton
+from ..model.vectors import lengths
 from .findings import Finding
 
 ELBOW_BACK_DEG = 20.0
@@ -89,14 +90,11 @@ def _arms(skeleton: Skeleton) -> tuple[np.ndarray, np.ndarray]:
     return table, _placing(skeleton, table)
 
 
-_ONES = np.ones(3)
-
-
 def _signed_bends(turn: np.ndarray, straight: np.ndarray, rate: float) -> np.ndarray | None:
     """The elbow's bend per frame in degrees, forward positive and backwards negative, from its
     turns and dot products (:func:`mtcore.check.elbow_turns`); None where the take does not tell its axis (see the
     module docstring)."""
-    length = np.sqrt(np.square(turn) @ _ONES)  # numpy's norm reduces an axis of 3 slowly
+    length = lengths(turn)
     with np.errstate(invalid="ignore", divide="ignore"):
         bent = np.degrees(np.arctan2(length, straight)) > BENT_DEG
         if np.count_nonzero(bent) < max(2, BENT_SECONDS * rate):

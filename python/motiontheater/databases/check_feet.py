@@ -25,6 +25,7 @@ from ..feet.footskate import prepare
 from ..feet.legs import Ground, LegArrays
 from ..model.motion import Motion
 from ..model.rig import body_view
+from ..model.vectors import lengths
 from .findings import Finding
 
 SKATE_M = 0.12
@@ -256,7 +257,7 @@ class _Legs:
             return []
         hips = self.arrays.hips.mean(axis=0)
         ground = hips - (hips @ self.up)[:, None] * self.up
-        stride = float(np.median(np.linalg.norm(ground[frames:] - ground[:-frames], axis=1))) * self.mpu
+        stride = float(np.median(lengths(ground[frames:] - ground[:-frames]))) * self.mpu
         hip = float(np.median(hips @ self.up - heights.min(axis=0))) * self.mpu
         if not (hip > 0 and stride > STRIDE_HIPS * hip):
             return []
