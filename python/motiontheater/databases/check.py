@@ -126,7 +126,7 @@ class _Take:
         # rotations are judged, not their angles (a thumb's rz that crosses 90 deg and comes back
         # 180 deg on is a turn, with no other pair of angles for it)
         self.rotating = skeleton.derived("check rotations", lambda: _rotations(skeleton))
-        self.turning = np.array([c.turns for c in self.channels], dtype=bool)  # the rotation channels
+        self.turning = skeleton.derived("check turning channels", lambda: _turning(self.channels))
         # each channel's joint, and its joint's rotation or position channels, numbered in the
         # order of their names (the order events are joined in)
         self.joints, self.kinds = skeleton.derived("check channel groups", lambda: _groups(self.channels))
@@ -309,6 +309,13 @@ def _channels(skeleton: Skeleton) -> tuple[list[_Channel], dict, dict[tuple[str,
     for c in channels:
         grouped.setdefault((c.joint, c.turns), []).append(c.index)
     return channels, triples, {key: np.array(columns, dtype=np.intp) for key, columns in grouped.items()}
+
+
+def _turning(channels: list[_Channel]) -> np.ndarray:
+    """Which of the channels turn (read-only: every take of the skeleton shares it)."""
+    out = np.array([c.turns for c in channels], dtype=bool)
+    out.flags.writeable = False
+    return out
 
 
 def _rotations(skeleton: Skeleton) -> dict[str, tuple[str, bool, np.ndarray]]:

@@ -318,11 +318,17 @@ def _still_columns(motion: Motion, columns: list[int] | None = None) -> set[int]
     values = motion.values if columns is None else motion.values[:, chosen]
     if not len(values):
         return set(chosen.tolist())
-    rest = motion.skeleton.rest_positions()
+    size = motion.skeleton.derived("figure size", lambda: _figure_size(motion.skeleton))
     with np.errstate(invalid="ignore"):  # a column held at an infinity spans NaN: not told still
-        size = float(np.nanmax(np.ptp(rest, axis=0))) if len(rest) > 1 else 0.0
         spread = np.ptp(values, axis=0)
     return set(chosen[spread <= STILL * max(size, 1.0)].tolist())
+
+
+def _figure_size(skeleton: Skeleton) -> float:
+    """The largest extent of the rest pose along an axis, in file units (0 for one joint)."""
+    rest = skeleton.rest_positions()
+    with np.errstate(invalid="ignore"):
+        return float(np.nanmax(np.ptp(rest, axis=0))) if len(rest) > 1 else 0.0
 
 
 def _chain_above(skeleton: Skeleton, joint: str) -> list[str]:
