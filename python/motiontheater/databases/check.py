@@ -590,10 +590,9 @@ def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
     values = t.motion.values
     suspects: set[str] = set()
     for events, sizes in (steps, spikes):
-        for (c, *_), size in zip(events, sizes):
-            channel = t.channels[int(c)]
-            if channel.turns and abs(t.physical(channel, size)) > FLIP_DEG:
-                suspects.add(channel.joint)
+        columns = events[:, 0]
+        flipped = t.turning[columns] & (np.abs(sizes * t.degrees) > FLIP_DEG)
+        suspects.update(t.channels[c].joint for c in columns[flipped].tolist())
     out = []
     for joint in sorted(suspects):
         if joint in t.triples:

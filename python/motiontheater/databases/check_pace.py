@@ -95,10 +95,11 @@ def step_pace(motion: Motion, kinematics: Kinematics | None = None) -> kernel.Pa
         return kernel.Pace(np.zeros(rows), np.zeros(rows), np.zeros(rows))
     if kinematics is None:
         kinematics = world_kinematics(motion.values, motion.skeleton.tree, workers=1)
-    places = (kinematics[0] * motion.skeleton.meters_per_unit).reshape(rows, -1)
+    places = kinematics[0].reshape(rows, -1)  # in file units: the unit goes into the weights
+    meters = motion.skeleton.meters_per_unit
     squares, counts = np.zeros(places.shape[1]), np.zeros(places.shape[1], np.uintp)
     kernel.roughness(places, squares, counts)  # a gap's left out
     with np.errstate(invalid="ignore", divide="ignore"):
-        noise = np.nan_to_num(squares / counts / 1.5)  # the variance of one coordinate
+        noise = np.nan_to_num(squares / counts / 1.5) * meters**2  # the variance of one coordinate, m^2
     # d - m = 1.5 x[t+1] - 1.5 x[t] + 0.5 x[t-1] - 0.5 x[t+2]: five times the variance of one
-    return kernel.pace(places, 1.0 / (5.0 * (noise + NOISE_M**2)))
+    return kernel.pace(places, meters**2 / (5.0 * (noise + NOISE_M**2)))
