@@ -379,9 +379,12 @@ def check_blocks(template: Motion, blocks: Iterable[np.ndarray], take: str = "")
 def _check_piece(motion: Motion, take: str, begins: bool, ends: bool) -> list[Finding]:
     """The findings of a piece of a take, ``begins`` and ``ends`` saying whether it begins and
     ends the take (a held pose at an end, a rest pose before the capture)."""
-    infinite = np.isinf(motion.values)
-    if infinite.any():  # a number too large to write, read as infinity: a value missing, as NaN is
-        motion = motion.replace(values=np.where(infinite, np.nan, motion.values))
+    # a number too large to write, read as infinity: a value missing, as NaN is (a finite sum
+    # tells there is none at a fraction of the cost of looking at each)
+    with np.errstate(over="ignore", invalid="ignore"):  # huge values may add up to infinity
+        unsure = not np.isfinite(motion.values.sum())
+    if unsure and np.isinf(motion.values).any():
+        motion = motion.replace(values=np.where(np.isinf(motion.values), np.nan, motion.values))
     t = _Take(motion, take)
     t.begins, t.ends = begins, ends
     findings = _unit(t)

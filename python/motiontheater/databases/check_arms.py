@@ -12,6 +12,8 @@ way the arm should have bent is not in the take.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from mtcore.check import elbow_turns
@@ -96,7 +98,7 @@ def _signed_bends(turn: np.ndarray, straight: np.ndarray, rate: float) -> np.nda
     module docstring)."""
     length = lengths(turn)
     with np.errstate(invalid="ignore", divide="ignore"):
-        bent = np.degrees(np.arctan2(length, straight)) > BENT_DEG
+        bent = straight < length / math.tan(math.radians(BENT_DEG))  # bends past BENT_DEG, without an arctan
         if np.count_nonzero(bent) < max(2, BENT_SECONDS * rate):
             return None
         units = turn[bent] / length[bent, None]

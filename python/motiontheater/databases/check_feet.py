@@ -293,14 +293,15 @@ def _stride(alternation: np.ndarray) -> int | None:
     energy = float(x @ x)
     if n < 8 or not energy > 0:
         return None
-    size = 1 << (2 * n - 1).bit_length()  # no wrap-around, and a length pocketfft is fast at
+    half = n // 2  # the lags a take of two strides can show
+    size = 1 << (n + half).bit_length()  # no wrap-around into those lags, a length pocketfft is fast at
     spectrum = np.fft.rfft(x, size)
-    alike = np.fft.irfft(spectrum.real**2 + spectrum.imag**2, size)[:n] / energy
-    alike /= 1 - np.arange(n) / n  # the share of the take each lag compares
-    below = np.flatnonzero(alike[: n // 2] < 0)
+    alike = np.fft.irfft(spectrum.real**2 + spectrum.imag**2, size)[:half] / energy
+    alike /= 1 - np.arange(half) / n  # the share of the take each lag compares
+    below = np.flatnonzero(alike < 0)
     if not len(below):
         return None
-    lag = int(below[0] + np.argmax(alike[below[0] : n // 2]))
+    lag = int(below[0] + np.argmax(alike[below[0] :]))
     return lag if alike[lag] >= STRIDE_ALIKE else None
 
 
