@@ -1044,10 +1044,11 @@ def _summed(off: np.ndarray, starts: np.ndarray, missing: np.ndarray) -> np.ndar
 def _slerp_deviations(t: _Take, runs: list[Run]) -> np.ndarray:
     rows, starts, inner, share = _blocks(runs)
     sizes = np.diff(starts)
-    owners = np.repeat([joint for joint, *_ in runs], sizes)
+    joints = list({joint: None for joint, *_ in runs})
+    owners = np.repeat([joints.index(joint) for joint, *_ in runs], sizes)
     q = np.empty((len(rows), 4))
-    for joint in {joint for joint, *_ in runs}:
-        mine = owners == joint
+    for k, joint in enumerate(joints):
+        mine = owners == k
         q[mine] = t.quaternions(joint, rows[mine])
     # a missing angle makes its quaternion NaN (no quaternion is infinite)
     missing = np.add.reduceat(np.isnan(q[:, 0] + q[:, 1] + q[:, 2] + q[:, 3]), starts[:-1]) > 0
