@@ -132,7 +132,8 @@ class _Take:
         self.joints, self.kinds = skeleton.derived("check channel groups", lambda: _groups(self.channels))
         self._quaternions: dict[str, np.ndarray] = {}
         self._turns: dict[tuple[str, int], np.ndarray] = {}
-        self.held: Kinematics | None = None  # the forward kinematics of these frames
+        # the joints' places and turns, for the spikes, steps, legs and arms alike (a piece's at most)
+        self.held: Kinematics = world_kinematics(motion.values, skeleton.tree, workers=1)
         # the turning spikes that what they move settles (:func:`_settled`), by id: (finding,
         # first row, last row, degrees, high by their angles)
         self.unsettled: dict[int, tuple[Finding, int, int, float, bool]] = {}
@@ -190,10 +191,7 @@ class _Take:
         turned about itself that the knee turns back looks right, and filling the thigh alone
         would put the leg out).  (0, 0) where it turns none.  Every run of a joint at once."""
         out = [(0.0, 0.0)] * len(runs)
-        by_joint: dict[str, list[int]] = {}
-        for i, (joint, _, _) in enumerate(runs):
-            by_joint.setdefault(joint, []).append(i)
-        for joint, members in by_joint.items():
+        for joint, members in _by_joint(joint for joint, _, _ in runs).items():
             if not len(self._points(joint)):
                 continue
             first = np.array([runs[i][1] for i in members])
@@ -222,10 +220,7 @@ class _Take:
         step into the row and the longer of its steps beside.  (0, 0, 0) where it turns no
         point.  Every jump of a joint at once."""
         out = [(0.0, 0.0, 0.0)] * len(jumps)
-        by_joint: dict[str, list[int]] = {}
-        for i, (joint, _) in enumerate(jumps):
-            by_joint.setdefault(joint, []).append(i)
-        for joint, members in by_joint.items():
+        for joint, members in _by_joint(joint for joint, _ in jumps).items():
             points = len(self._points(joint))
             if not points:
                 continue
@@ -266,10 +261,8 @@ class _Take:
         return skeleton.derived(("turned points", joint), lambda: _turned(skeleton, joint))
 
     def _kinematics(self, rows: np.ndarray) -> Kinematics:
-        """Every joint's place and world turn at the rows (of the take held, or worked out)."""
-        if self.held is not None:
-            return self.held[0][rows], self.held[1][rows]
-        return world_kinematics(self.motion.values[rows], self.motion.skeleton.tree, workers=1)
+        """Every joint's place and world turn at the rows."""
+        return self.held[0][rows], self.held[1][rows]
 
     def _places(self, joint: str, rows: np.ndarray) -> np.ndarray:
         """The places (rows, points, 3) in metres of the points the joint's rotation moves."""
@@ -277,6 +270,14 @@ class _Take:
 
 
 _NONE = np.zeros(0, np.intp)
+
+
+def _by_joint(joints: Iterable[str]) -> dict[str, list[int]]:
+    """Where each joint stands in ``joints`` (the runs, jumps or pairs worked out a joint at once)."""
+    out: dict[str, list[int]] = {}
+    for i, joint in enumerate(joints):
+        out.setdefault(joint, []).append(i)
+    return out
 
 
 def _turned(skeleton: Skeleton, joint: str) -> np.ndarray:
@@ -396,8 +397,6 @@ def _check_piece(motion: Motion, take: str, begins: bool, ends: bool) -> list[Fi
         rows = motion.frames
         min_run = max(3, round(FROZEN_SECONDS * t.rate))
         found = kernel.channel_events(motion.values, spikes, steps, min_run)
-        # the joints' places and turns, for the spikes, steps, legs and arms alike (a piece's at most)
-        t.held = world_kinematics(motion.values, motion.skeleton.tree, workers=1)
         ev, sizes = found.events, found.sizes
         by_kind = {kind: (ev[ev[:, 3] == kind], sizes[ev[:, 3] == kind]) for kind in kernel.KINDS}
         repeats = by_kind[kernel.REPEAT][0]
@@ -418,13 +417,12 @@ def _check_piece(motion: Motion, take: str, begins: bool, ends: bool) -> list[Fi
         }
         findings += _spikes(t, by_kind[kernel.SPIKE], by_kind[kernel.STEP], explained, spikes)
         findings += _jitter(t, found.roughness, found.smooth_rows)
-        held = t.held
-        dropped, findings = dropped_findings(motion, take, findings, held)
+        dropped, findings = dropped_findings(motion, take, findings, t.held)
         findings += dropped
         findings += _bones(t)
         findings += _speed(t)
-        findings += leg_findings(motion, take, t.meters, held)
-        findings += arm_findings(motion, take, held)
+        findings += leg_findings(motion, take, t.meters, t.held)
+        findings += arm_findings(motion, take, t.held)
     return findings
 
 
@@ -854,10 +852,7 @@ def _returns(t: _Take, pairs: list[tuple[tuple, tuple]]) -> list[float]:
     over rows a - 2 and a - 1 would have taken it (at 30 Hz a fast forearm turns 60 degrees over
     the three frames of a pop), whichever is nearer; every pair of a joint at once."""
     out = [math.inf] * len(pairs)
-    by_joint: dict[str, list[int]] = {}
-    for i, ((joint, *_), _) in enumerate(pairs):
-        by_joint.setdefault(joint, []).append(i)
-    for joint, members in by_joint.items():
+    for joint, members in _by_joint(joint for (joint, *_), _ in pairs).items():
         a = np.array([pairs[i][0][1] for i in members])
         b = np.array([pairs[i][1][1] for i in members])
         if joint not in t.rotating:
