@@ -94,8 +94,8 @@ def _arms(skeleton: Skeleton) -> tuple[np.ndarray, np.ndarray]:
 
 def _signed_bends(turn: np.ndarray, straight: np.ndarray, rate: float) -> np.ndarray | None:
     """The elbow's bend per frame in degrees, forward positive and backwards negative, from its
-    turns and dot products (:func:`mtcore.check.elbow_turns`); None where the take does not tell its axis (see the
-    module docstring)."""
+    turns and dot products (:func:`mtcore.check.elbow_turns`); None where the take does not tell
+    its axis (see the module docstring)."""
     length = lengths(turn)
     with np.errstate(invalid="ignore", divide="ignore"):
         bent = straight < length / math.tan(math.radians(BENT_DEG))  # bends past BENT_DEG, without an arctan

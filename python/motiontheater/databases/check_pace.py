@@ -86,8 +86,8 @@ def dropped_findings(
 
 
 def step_pace(motion: Motion, kinematics: Kinematics | None = None) -> kernel.Pace:
-    """The :func:`mtcore.check.pace` of the joints' positions (metres), each coordinate weighted
-    by its noise: the frame-to-frame roughness over the take, at least NOISE_M.  ``kinematics``:
+    """The :func:`mtcore.check.pace` of the joints' positions, each coordinate weighted by its
+    noise in metres: the frame-to-frame roughness over the take, at least NOISE_M.  ``kinematics``:
     the take's forward kinematics, where the caller has them (the check holds a long take's
     frames a piece at a time: :mod:`.pieces`)."""
     rows = motion.frames
