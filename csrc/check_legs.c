@@ -39,6 +39,21 @@ static double knee_back(const double *hip, const double *p, const struct mt_leg_
     return dot3(a, b) > 0 && across < check->foot_across && bend < check->folded ? bend : 0.0;
 }
 
+/* Which signed axis the leg stands along at one frame: the axis of the largest coordinate of
+   hip - ankle (the first of equals), 2k for +k and 2k + 1 for -k; -1 where one is not a number. */
+static int standing_axis(const double *hip, const double *ankle)
+{
+    double rise[3];
+    difference(hip, ankle, rise);
+    if (!(isfinite(rise[0]) && isfinite(rise[1]) && isfinite(rise[2])))
+        return -1;
+    int axis = 0;
+    for (int c = 1; c < 3; c++)
+        if (fabs(rise[c]) > fabs(rise[axis]))
+            axis = c;
+    return 2 * axis + (rise[axis] < 0);
+}
+
 /* The point's height along up at each frame into h, and how far above its lowest within the
    window it lies into lift (scratch: 2 x frames); NaN heights are left out of the lowest. */
 static int lifts(const double *p, size_t frames, const struct mt_leg_check *check, double *h, double *lift,
@@ -98,8 +113,13 @@ static void drift_of(const double *p, size_t frames, const double *h, const doub
 }
 
 int mt_check_legs(const double *points, const double *hips, size_t nlegs, size_t frames, const double *rest,
-                  const int *tips, const struct mt_leg_check *check, double *drift, double *depth, double *back)
+                  const int *tips, const struct mt_leg_check *check, double *drift, double *depth, double *back,
+                  size_t *standing)
 {
+    if (!standing)
+        return MT_EINVAL;
+    for (int a = 0; a < 6; a++)
+        standing[a] = 0;
     if (nlegs == 0 || frames == 0)
         return MT_OK;
     if (!points || !hips || !rest || !tips || !check || !drift || !depth || !back ||
@@ -118,7 +138,11 @@ int mt_check_legs(const double *points, const double *hips, size_t nlegs, size_t
         const double *leg = points + i * frames * 3 * POINTS;
         for (size_t t = 0; t < frames; t++) {
             const double *p = leg + t * 3 * POINTS;
-            back[i * frames + t] = knee_back(hips + (i * frames + t) * 3, p, check);
+            const double *hip = hips + (i * frames + t) * 3;
+            back[i * frames + t] = knee_back(hip, p, check);
+            const int axis = standing_axis(hip, p + 3 * ANKLE);
+            if (axis >= 0)
+                standing[axis]++;
             double lowest = NAN;
             for (int k = 0; k < (tips[i] ? 3 : 2); k++) {
                 const double above = (dot3(p + 3 * order[k], floor_up) - check->level) - rest[3 * i + k];

@@ -1145,6 +1145,9 @@ int mt_fit_floor(const double *points, const unsigned char *resting, size_t nleg
  *       (the cosine between them under foot_across: a pointed foot along the shin tells
  *       nothing) and the bend is under `folded` degrees (a knee folded further turns its hinge
  *       with the thigh); 0 elsewhere, and where a point is NaN.
+ *   standing (6): how many of the legs' frames stand along +x, -x, +y, -y, +z and -z: the axis
+ *       of hip minus ankle's largest coordinate (the first of equals) and its sign; frames where
+ *       hip or ankle is not a number are not counted.
  *
  * MT_ENOMEM where scratch of 4 x frames numbers cannot be had.
  */
@@ -1157,7 +1160,8 @@ struct mt_leg_check {
 };
 
 int mt_check_legs(const double *points, const double *hips, size_t nlegs, size_t frames, const double *rest,
-                  const int *tips, const struct mt_leg_check *check, double *drift, double *depth, double *back);
+                  const int *tips, const struct mt_leg_check *check, double *drift, double *depth, double *back,
+                  size_t *standing);
 
 /*
  * The elbows of a take, frame by frame (check_arms.c).  positions (frames x joints x 3) are every

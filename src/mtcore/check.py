@@ -203,11 +203,14 @@ class LegMeasures:
     points' unit and degrees: ``drift`` (legs, 2, frames) of heel and ball, how far the point has
     moved across up since its run of frames on the floor began (NaN off the floor); ``depth``
     (legs, frames), how far the lowest of heel, ball and toe tip lies below where it rests;
-    ``back`` (legs, frames), how far the knee bends backwards (0: it does not, or cannot tell)."""
+    ``back`` (legs, frames), how far the knee bends backwards (0: it does not, or cannot tell);
+    ``standing`` (6,), how many of the legs' frames stand (hip above ankle) along +x, -x, +y, -y,
+    +z and -z."""
 
     drift: np.ndarray
     depth: np.ndarray
     back: np.ndarray
+    standing: np.ndarray
 
 
 def leg_measures(
@@ -224,10 +227,11 @@ def leg_measures(
     t = np.ascontiguousarray(np.broadcast_to(np.asarray(tips, dtype=bool), (legs,)), dtype=np.intc)
     struct = settings.as_struct()
     drift, depth, back = np.empty((legs, 2, frames)), np.empty((legs, frames)), np.empty((legs, frames))
+    standing = np.empty(6, np.uintp)
     status = lib.mt_check_legs(c_array(p), c_array(h), legs, frames, c_array(r), c_array(t, "int[]"), struct,
-                               c_array(drift), c_array(depth), c_array(back))  # fmt: skip
+                               c_array(drift), c_array(depth), c_array(back), c_array(standing, "size_t[]"))  # fmt: skip
     check(status, "mt_check_legs")
-    return LegMeasures(drift, depth, back)
+    return LegMeasures(drift, depth, back, standing)
 
 
 def elbow_turns(

@@ -139,9 +139,14 @@ def check_legs_twin(points, hips, rest, tips, settings):
     mpu, w = settings.meters_per_unit, settings.window
     drift = np.full((legs, 2, frames), math.nan)
     depth, back = np.full((legs, frames), math.nan), np.zeros((legs, frames))
+    standing = np.zeros(6, np.uintp)
     for i in range(legs):
         for t in range(frames):
             knee, ankle, ball, heel, tip = p[i, t]
+            rise = hips[i, t] - ankle
+            if np.isfinite(rise).all():
+                axis = int(np.argmax(np.abs(rise)))
+                standing[2 * axis + int(rise[axis] < 0)] += 1
             thigh, shin, foot = knee - hips[i, t], ankle - knee, ball - ankle
             with np.errstate(all="ignore"):
                 bend = math.degrees(
@@ -172,7 +177,7 @@ def check_legs_twin(points, hips, rest, tips, settings):
                     drift[i, k, t] = np.linalg.norm(flat[t] - flat[start])
                 else:
                     start = None
-    return drift, depth, back
+    return drift, depth, back, standing
 
 
 def check_legs_cases(rng: np.random.Generator) -> list[tuple]:
@@ -199,6 +204,8 @@ def check_legs_cases(rng: np.random.Generator) -> list[tuple]:
         if frames > 10:
             points[0, 4, 3] = math.nan
             points[-1, 7:9] = math.nan
+            hips[0, 2, 1] = math.inf
+            hips[0, 3] = points[0, 3, 1] + (0.5, -0.5, 0.2)  # standing along x and -y alike: x counts
         tips = rng.random(legs) < 0.5
         settings = LegCheck(tuple(up), tuple(slope), float(rng.normal(0, 0.01)), 0.9, 120.0, window, 0.03, 0.6,
                             math.cos(math.radians(45)), 90.0)  # fmt: skip

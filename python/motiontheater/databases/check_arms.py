@@ -20,7 +20,7 @@ from mtcore.check import elbow_turns
 from mtcore.kinematics import Kinematics, world_kinematics
 
 from ..characters.rigs import recognise, wrist
-from ..feet.contacts import runs
+from ..feet.contacts import run_peaks
 from ..model.motion import Motion
 from ..model.skeleton import Skeleton
 from ..model.vectors import lengths
@@ -55,11 +55,11 @@ def arm_findings(motion: Motion, take: str, kinematics: Kinematics | None = None
         bend = _signed_bends(turn, straight, motion.frame_rate)
         if bend is None:
             continue
-        for s, e in zip(*runs(bend < -ELBOW_BACK_DEG)):
-            worst = float(-bend[s:e].min())
+        backwards = -bend[None]
+        for _, s, e, worst in run_peaks(backwards > ELBOW_BACK_DEG, backwards):
             out.append(
                 Finding(
-                    take, "elbow", (names[elbow],), motion.first_frame + int(s), motion.first_frame + int(e) - 1,
+                    take, "elbow", (names[elbow],), motion.first_frame + s, motion.first_frame + e - 1,
                     "high" if worst > 45 else "medium", round(worst, 6), "deg",
                     f"{names[elbow]} bends {worst:.3g} deg backwards, past what an elbow does",
                 )

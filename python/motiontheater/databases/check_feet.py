@@ -20,7 +20,7 @@ import numpy as np
 from mtcore.check import LegCheck, leg_measures
 from mtcore.kinematics import Kinematics
 
-from ..feet.contacts import runs
+from ..feet.contacts import run_peaks
 from ..feet.footskate import prepare
 from ..feet.legs import Ground, LegArrays
 from ..model.motion import Motion
@@ -131,16 +131,14 @@ class _Legs:
         """Runs of frames in which a heel or ball stays on the floor and slower than a step, over
         which it slides farther than SKATE_M: found without the footplants, which a slide splits."""
         shortest = max(2, round(SKATE_SECONDS * self.motion.frame_rate))
+        drift = self.measures.drift.reshape(-1, self.motion.frames)  # each leg's heel, then its ball
+        slides: list[list] = [[] for _ in self.arrays.legs.feet]  # per foot: (first row, last row, metres, point)
+        for row, s, e, peak in run_peaks(~np.isnan(drift), drift):
+            if e - s >= shortest and peak * self.mpu > SKATE_M:
+                slides[row // 2].append((s, e - 1, peak * self.mpu, ("heel", "ball")[row % 2]))
         out = []
-        for i, foot in enumerate(self.arrays.legs.feet):
-            slides = []  # (first row, last row, metres, point)
-            for k, point in enumerate(("heel", "ball")):
-                drift = self.measures.drift[i, k]
-                for s, e in zip(*runs(~np.isnan(drift))):
-                    slide = float(drift[s:e].max()) * self.mpu
-                    if e - s >= shortest and slide > SKATE_M:
-                        slides.append((int(s), int(e) - 1, slide, point))
-            for first, last, slide, point in _merged(slides):
+        for foot, found in zip(self.arrays.legs.feet, slides):
+            for first, last, slide, point in _merged(found):
                 out.append(
                     Finding(
                         self.take, "skate", (foot,), self.frame(first), self.frame(last),
@@ -153,17 +151,16 @@ class _Legs:
 
     def penetrations(self) -> list[Finding]:
         shortest = max(1, round(PENETRATION_SECONDS * self.motion.frame_rate))
+        depth = self.measures.depth * self.mpu
+        feet = self.arrays.legs.feet
         out = []
-        for i, foot in enumerate(self.arrays.legs.feet):
-            depth = self.measures.depth[i] * self.mpu  # NaN where the foot is a gap: it sinks nowhere
-            for s, e in zip(*runs(np.nan_to_num(depth) > PENETRATION_M)):
-                if e - s < shortest:
-                    continue
-                worst = float(depth[s:e].max())
+        # NaN where the foot is a gap: it sinks nowhere
+        for i, s, e, worst in run_peaks(np.nan_to_num(depth) > PENETRATION_M, depth):
+            if e - s >= shortest:
                 out.append(
                     Finding(
-                        self.take, "penetration", (foot,), self.frame(s), self.frame(e - 1), "medium",
-                        round(worst, 6), "m", f"{foot} goes {worst:.3g} m into the floor",
+                        self.take, "penetration", (feet[i],), self.frame(s), self.frame(e - 1), "medium",
+                        round(worst, 6), "m", f"{feet[i]} goes {worst:.3g} m into the floor",
                     )
                 )  # fmt: skip
         return out
@@ -174,15 +171,12 @@ class _Legs:
         (high), along x (medium), along z (medium for ASF/AMC; low for BVH, where z-up exports
         are common and motiontheater reads them standing).  Told where it stands so in
         UPRIGHT_SHARE of its frames (a take that lies down for a while stands otherwise)."""
-        rise = (self.arrays.hips - self.arrays.points[:, :, 1]).reshape(-1, 3)
-        rise = rise[np.isfinite(rise).all(axis=1)]
-        if not len(rise):
+        counts = self.measures.standing  # frames along x, -x, y, -y, z, -z
+        total = int(counts.sum())
+        if not total:
             return []
-        axis = np.argmax(np.abs(rise), axis=1)
-        signed = axis * 2 + (rise[np.arange(len(rise)), axis] < 0)  # 0 x, 1 -x, 2 y, 3 -y, 4 z, 5 -z
-        counts = np.bincount(signed, minlength=6)
         most = int(np.argmax(counts))
-        share = counts[most] / len(rise)
+        share = int(counts[most]) / total
         if most == 2 or share < UPRIGHT_SHARE:
             return []
         name = ("-" if most % 2 else "") + "xyz"[most // 2]
@@ -231,17 +225,15 @@ class _Legs:
         bend and any hip (told only where the foot stands across the shin, and the knee is not
         folded: see :func:`mtcore.check.leg_measures`)."""
         out = []
-        for i, leg in enumerate(self.arrays.legs.legs):
-            backwards = self.measures.back[i]
-            for s, e in zip(*runs(backwards > KNEE_BACK_DEG)):
-                worst = float(backwards[s:e].max())
-                out.append(
-                    Finding(
-                        self.take, "knee", (leg.knee,), self.frame(s), self.frame(e - 1),
-                        "high" if worst > 45 else "medium", round(worst, 6), "deg",
-                        f"{leg.knee} bends {worst:.3g} deg backwards, past what a knee does",
-                    )
-                )  # fmt: skip
+        legs, back = self.arrays.legs.legs, self.measures.back
+        for i, s, e, worst in run_peaks(back > KNEE_BACK_DEG, back):
+            out.append(
+                Finding(
+                    self.take, "knee", (legs[i].knee,), self.frame(s), self.frame(e - 1),
+                    "high" if worst > 45 else "medium", round(worst, 6), "deg",
+                    f"{legs[i].knee} bends {worst:.3g} deg backwards, past what a knee does",
+                )
+            )  # fmt: skip
         return out
 
     def rhythm(self) -> list[Finding]:

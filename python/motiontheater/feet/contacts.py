@@ -240,6 +240,23 @@ def runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return edges[::2], edges[1::2]
 
 
+def run_peaks(mask: np.ndarray, values: np.ndarray) -> list[tuple[int, int, int, float]]:
+    """The runs of True in each row of a 2-d mask, row by row: (row, start, end (exclusive), the
+    largest of ``values`` (the mask's shape) over the run), every row's at once."""
+    rows, frames = mask.shape
+    padded = np.zeros((rows, frames + 1), bool)  # a False between rows parts their runs
+    padded[:, :frames] = mask
+    starts, ends = runs(padded.ravel())
+    if not len(starts):
+        return []
+    row = starts // (frames + 1)
+    first = starts - row  # into values, row by row without the padding
+    bounds = np.stack([first, first + ends - starts], axis=1).ravel()
+    flat = np.ascontiguousarray(values).ravel()
+    peaks = np.maximum.reduceat(flat, bounds[:-1] if bounds[-1] == len(flat) else bounds)[::2]
+    return list(zip(row.tolist(), (starts % (frames + 1)).tolist(), (ends % (frames + 1)).tolist(), peaks.tolist()))
+
+
 @dataclass(frozen=True)
 class Thresholds:
     """Footplant detection thresholds at the reference leg length (see the module docstring)."""
