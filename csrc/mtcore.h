@@ -1164,6 +1164,19 @@ int mt_check_legs(const double *points, const double *hips, size_t nlegs, size_t
                   size_t *standing);
 
 /*
+ * The take check's candidate spikes of one joint's rotation trimmed (check_spikes.c).  q (frames
+ * x 4) the joint's rotation at each frame, unit quaternions; runs i: frames first[i] .. last[i]
+ * (first <= last < frames).  While the run holds more than one frame and its first or last frame
+ * lies within limit[i] degrees of the path between the frames around the run (the SLERP between
+ * them at the frame's place, r - first + 1 of last - first + 2 of the way), that frame is dropped,
+ * the first before the last.  first_out, last_out: the frames left; largest: the most degrees any
+ * of them lies from that path.  A run with no frame before or after it, or with a NaN among its
+ * frames and those around, is left whole and its largest is NaN.
+ */
+int mt_check_trim(const double *q, size_t frames, size_t runs, const size_t *first, const size_t *last,
+                  const double *limit, size_t *first_out, size_t *last_out, double *largest);
+
+/*
  * The elbows of a take, frame by frame (check_arms.c).  positions (frames x joints x 3) are every
  * joint's, world (frames x turned x 9) the world rotations of some joints (row-major).  Arm a's
  * shoulder, elbow and wrist are where joints place[3a], place[3a + 1] and place[3a + 2] are, and

@@ -32,6 +32,7 @@ __all__ = [
     "leg_measures",
     "pace",
     "roughness",
+    "trim_runs",
 ]
 
 GAP, FROZEN, SPIKE, STEP, REPEAT = (
@@ -254,6 +255,29 @@ def elbow_turns(
                                  c_array(place, "size_t[]"), arms, c_array(turn), c_array(straight))  # fmt: skip
     check(status, "mt_check_elbows")
     return turn, straight
+
+
+def trim_runs(
+    quaternions: ArrayLike, first: ArrayLike, last: ArrayLike, limits: ArrayLike
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Candidate spikes of one joint's rotation, ``quaternions`` (frames, 4) unit, over frames
+    first .. last (runs,) each, trimmed of the ends that lie within ``limits`` (runs,) degrees of
+    the path between the frames around them, one frame at a time (``mt_check_trim``,
+    csrc/mtcore.h): the frames left (first, last) and the most degrees any of them lies off that
+    path (NaN for a run at an end of the take or beside a NaN, left whole)."""
+    q = _checks.real(quaternions, "quaternions", (None, 4))
+    frames = len(q)
+    b = _checks.integers(last, "last", (None,), 0, frames, np.uintp)
+    a = _checks.integers(first, "first", (len(b),), 0, frames, np.uintp)
+    if (a > b).any():
+        raise ValueError("each run's first frame must not follow its last")
+    bound = _checks.real(limits, "limits", (len(b),))
+    out = np.empty((2, len(b)), np.uintp), np.empty(len(b))
+    status = lib.mt_check_trim(c_array(q), frames, len(b), c_array(a, "size_t[]"), c_array(b, "size_t[]"),
+                               c_array(bound), c_array(out[0][0], "size_t[]"), c_array(out[0][1], "size_t[]"),
+                               c_array(out[1]))  # fmt: skip
+    check(status, "mt_check_trim")
+    return out[0][0], out[0][1], out[1]
 
 
 def roughness(values: ArrayLike, squares: np.ndarray, counts: np.ndarray) -> None:

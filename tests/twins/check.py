@@ -213,6 +213,52 @@ def check_legs_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
+def trim_twin(q, first, last, limits):
+    """Each run trimmed as the contract says: both ends measured against the SLERP (the twin's)
+    between the frames around what is left, the first dropped before the last, every frame
+    measured once neither is."""
+    q = np.asarray(q, float)
+    frames = len(q)
+
+    def off(a: int, b: int, r: int) -> float:
+        path = rotations.slerp(q[a - 1], q[b + 1], (r - a + 1) / (b - a + 2))
+        return math.degrees(2 * math.acos(min(abs(float(q[r] @ path)), 1.0)))
+
+    out = np.array(first, np.uintp), np.array(last, np.uintp), np.full(len(first), math.nan)
+    for i, (a, b) in enumerate(zip(map(int, first), map(int, last))):
+        if a < 1 or b > frames - 2 or np.isnan(q[a - 1 : b + 2]).any():
+            continue
+        while a < b and (off(a, b, a) <= limits[i] or off(a, b, b) <= limits[i]):
+            if off(a, b, a) <= limits[i]:
+                a += 1
+            else:
+                b -= 1
+        out[0][i], out[1][i], out[2][i] = a, b, max(off(a, b, r) for r in range(a, b + 1))
+    return out
+
+
+def trim_cases(rng: np.random.Generator) -> list[tuple]:
+    """A joint turning smoothly with excursions of one to five frames (some whose ends lie on
+    the path), runs at the take's ends, over stretches of it and of one frame, a NaN frame."""
+    from mtcore.rotations import euler_to_quaternions
+
+    out = []
+    for frames in (0, 1, 2, 3, 9, 60, 200):
+        angles = np.cumsum(rng.normal(0, 2, (frames, 3)), axis=0)
+        first, last = list(rng.integers(0, max(frames, 1), 6 if frames else 0)), []
+        last = [min(a + int(rng.integers(0, 6)), frames - 1) for a in first]
+        for start in range(2, frames - 12, 9):
+            size = int(rng.integers(1, 6))
+            angles[start : start + size] += rng.normal(0, 40, 3)
+            first.append(max(start - int(rng.integers(0, 3)), 0))  # with frames on the path at its ends
+            last.append(min(start + size - 1 + int(rng.integers(0, 3)), frames - 1))
+        q = euler_to_quaternions(angles, "zxy", extrinsic=False, degrees=True)
+        if frames == 60:
+            q[40] = math.nan
+        out.append((q, np.array(first, int), np.array(last, int), rng.uniform(0.5, 20, len(first))))
+    return out
+
+
 def roughness_twin(values, squares, counts):
     """Each inner row's residual from the mean of its neighbours, one at a time; the finite ones summed."""
     x = np.asarray(values, float)

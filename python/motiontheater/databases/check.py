@@ -1111,13 +1111,20 @@ def _fastest_step(t: _Take, joint: str, *spans: tuple[int, int]) -> float:
 def _trimmed(t: _Take, runs: list[Run], limits: list[float]) -> list[tuple[int, int, float | None]]:
     """Each run without the rows at its ends that lie on the path between the rows around them
     (the median of five beside a large spike can leave a fast-moving neighbour), and its largest
-    deviation (None where :func:`_deviations` has none): (first, last, deviation), every run
-    trimmed at once, a row at a time, while any still loses one."""
+    deviation (None where :func:`_deviations` has none): (first, last, deviation).  A joint's
+    rotation is trimmed in C (:func:`mtcore.check.trim_runs`, whose twin is this loop's
+    SLERP); the others at once, a row at a time, while any still loses one."""
     first = np.array([first for _, _, first, _ in runs], dtype=np.intp)
     last = np.array([last for _, _, _, last in runs], dtype=np.intp)
     limit = np.asarray(limits, dtype=float)
     largest = np.full(len(runs), np.nan)
-    pending = np.arange(len(runs))
+    turning = np.array([turns and joint in t.rotating for joint, turns, _, _ in runs], dtype=bool)
+    rotations = np.flatnonzero(turning)
+    for joint, members in _by_joint(runs[i][0] for i in rotations.tolist()).items():
+        mine = rotations[members]
+        trimmed = kernel.trim_runs(t.quaternions(joint, slice(None)), first[mine], last[mine], limit[mine])
+        first[mine], last[mine], largest[mine] = trimmed
+    pending = np.flatnonzero(~turning)  # the others' positions or angles, a row at a time here
     while len(pending):
         off = _deviations(t, [(*runs[i][:2], a, b) for i, a, b in zip(pending, first[pending], last[pending])])
         head = off[:, 0] <= limit[pending]  # NaN: no deviations, nothing trimmed
