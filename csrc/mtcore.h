@@ -355,6 +355,11 @@ int mt_local_quaternions(const double *values, size_t frames, size_t channels, s
 int mt_euler_to_matrices(const double *angles, size_t n, const int *axes, size_t count, int intrinsic,
                          double scale, double *out);
 
+/* Unit quaternions (n x 4: w, x, y, z; w >= 0) of n Euler triples (angles n x 3) about
+   Tait-Bryan or proper Euler axes (as mt_matrices_to_euler's), without the matrices. */
+int mt_euler_to_quaternions(const double *angles, size_t n, const int *axes, int intrinsic, double scale,
+                            double *out);
+
 /*
  * Euler angles (n x 3, in units of 1/scale radians) of n matrices, for
  * Tait-Bryan axes (three distinct) or proper Euler axes (the first and last

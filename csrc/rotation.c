@@ -182,6 +182,32 @@ static MT_INLINE void euler_quaternion_block(double angles[3][LANES], const stru
     }
 }
 
+static MT_CLONES void euler_quaternions(const double *angles, size_t n, const struct convention *cv, double *out)
+{
+    for (size_t f0 = 0; f0 < n; f0 += LANES) {
+        const size_t lanes = n - f0 < LANES ? n - f0 : LANES;
+        double a[3][LANES], q[4][LANES];
+        load_block(angles + 3 * f0, 3, lanes, a);
+        euler_quaternion_block(a, cv, q);
+        for (int l = 0; l < LANES; l++) {
+            const double sign = q[0][l] < 0 ? -1.0 : 1.0;
+            for (int e = 0; e < 4; e++)
+                q[e][l] *= sign;
+        }
+        store_block(q, 4, lanes, out + 4 * f0);
+    }
+}
+
+int mt_euler_to_quaternions(const double *angles, size_t n, const int *axes, int intrinsic, double scale,
+                            double *out)
+{
+    struct convention cv;
+    if (convention(axes, intrinsic, scale, &cv) != MT_OK || (n > 0 && (!angles || !out)))
+        return MT_EINVAL;
+    euler_quaternions(angles, n, &cv, out);
+    return MT_OK;
+}
+
 /* The matrices of quaternions, normalised. */
 static MT_INLINE void quaternion_matrix_block(double q[4][LANES], double m[9][LANES])
 {

@@ -162,7 +162,14 @@ def rotvecs_to_quaternions(rotvecs) -> np.ndarray:
 
 def euler_to_quaternions(angles, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:
     """Unit quaternions (..., 4), w >= 0, of Euler angles (..., 3)."""
-    return _quaternions(euler_to_matrices(angles, order, extrinsic=extrinsic, degrees=degrees))
+    codes, intrinsic, scale = _order(order), not _checks.flag(extrinsic, "extrinsic"), _scale(degrees)
+    a = _checks.real(angles, "angles", (..., 3))
+    out = np.empty(a.shape[:-1] + (4,))
+    check(
+        lib.mt_euler_to_quaternions(c_array(a), out.size // 4, ffi.new("int[]", codes), intrinsic, scale, c_array(out)),
+        "mt_euler_to_quaternions",
+    )
+    return out
 
 
 def quaternions_to_euler(quaternions, order: str, *, extrinsic: bool, degrees: bool = False) -> np.ndarray:

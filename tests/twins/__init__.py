@@ -919,6 +919,15 @@ TWINS: dict[str, Twin] = {
     ),
     "mt_local_quaternions": Twin(local_quaternions, kinematics.local_quaternions, local_quaternion_cases, close(1e-6)),
     "mt_euler_to_matrices": Twin(fast_euler, rotations.euler_to_matrices, euler_cases, close(1e-14)),
+    # the twin's quaternions are its matrices' eigenvectors (w >= 0 picks the sign)
+    "mt_euler_to_quaternions": Twin(
+        lambda angles, order, extrinsic: rot.euler_to_quaternions(angles, order, extrinsic=extrinsic),
+        lambda angles, order, extrinsic: rotations.matrices_to_quaternions(
+            rotations.euler_to_matrices(angles, order, extrinsic)
+        ),
+        lambda rng: [case for case in euler_cases(rng) if case[1] in rot.ORDERS],
+        close(1e-12),
+    ),
     "mt_matrices_to_euler": Twin(
         lambda m, order, extrinsic: rot.matrices_to_euler(m, order, extrinsic=extrinsic),
         rotations.matrices_to_euler,
