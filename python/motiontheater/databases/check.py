@@ -466,9 +466,9 @@ def _joint_runs(
     channel, its size)."""
     out: list[list] = []
     order = np.lexsort((events[:, 1], (t.kinds if apart else t.joints)[events[:, 0]]))
-    for i in order:
-        c, first, last = int(events[i, 0]), int(events[i, 1]), int(events[i, 2])
-        joint, size = t.channels[c].joint, float(sizes[i])
+    # as Python numbers: numpy's scalars cost more than the work
+    for (c, first, last, *_), size in zip(events[order].tolist(), sizes[order].tolist()):
+        joint = t.channels[c].joint
         kin = not apart or (bool(out) and t.channels[out[-1][3]].turns == t.channels[c].turns)
         if out and out[-1][0] == joint and kin and first <= out[-1][2] + pad:
             run = out[-1]
@@ -648,11 +648,12 @@ def _pops(t: _Take, steps: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     stay.  Not of a joint's rotation channels: its rotation pairs its jumps (:func:`_excursions`)."""
     events, sizes = steps
     window = max(STEP_PAIR_SECONDS * t.rate, POP_FRAMES)
-    pops, popsizes, kept = [], [], np.ones(len(events), bool)
+    pops, popsizes, kept = [], [], [True] * len(events)
+    rows, values = events.tolist(), sizes.tolist()  # Python numbers: numpy's scalars cost more than the work
     for i in range(len(events) - 1):
-        (c0, f0, *_), (c1, f1, *_) = events[i], events[i + 1]
-        s0, s1 = sizes[i], sizes[i + 1]
-        channel = t.channels[int(c0)]
+        (c0, f0, *_), (c1, f1, *_) = rows[i], rows[i + 1]
+        s0, s1 = values[i], values[i + 1]
+        channel = t.channels[c0]
         if (
             not (channel.turns and channel.joint in t.rotating)
             and kept[i]
@@ -665,11 +666,12 @@ def _pops(t: _Take, steps: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             popsizes.append(s0)
             kept[i] = kept[i + 1] = False
     table = np.array(pops, dtype=np.intp).reshape(-1, 5)
-    return table, np.array(popsizes, dtype=float), kept
+    return table, np.array(popsizes, dtype=float), np.array(kept, dtype=bool)
 
 
-def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.ndarray) -> list[Finding]:
+def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, per_channel: np.ndarray) -> list[Finding]:
     events, sizes = spikes
+    limits: list[float] = per_channel.tolist()  # Python floats: each candidate compares a few
     pops, popsizes, stay = _pops(t, steps)
     events, sizes = np.concatenate([events, pops]), np.concatenate([sizes, popsizes])
     values = t.motion.values
@@ -718,7 +720,7 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
         )  # fmt: skip
     # jumps that stay: of the root's position a teleport, of a rotation a jump (flips are found above)
     near_spike = np.zeros((len(t.channels), rows), bool)
-    for c, first, last, *_ in events:
+    for c, first, last, *_ in events.tolist():
         near_spike[c, first : last + 1] = True
     events, sizes = steps
     seen, popped = set(), set()  # (joint, row): a joint's jump or pop shows in several of its channels
@@ -726,12 +728,12 @@ def _spikes(t: _Take, spikes: tuple, steps: tuple, explained: set, limits: np.nd
     exact: list[Finding] = []  # the spikes the rotation's own jumps bound, in place of the candidates beside
     windows: list[Window] = []
     pops_seen: list[tuple[str, str, int, float]] = []  # (joint, channel, row, limit) of each pop
-    for (c, first, last, _, at), size in zip(events[stay], sizes[stay]):
-        channel = t.channels[int(c)]
+    for (c, first, last, _, at), size in zip(events[stay].tolist(), sizes[stay].tolist()):
+        channel = t.channels[c]
         if channel.turns and channel.joint in t.rotating:
             # every row of a step: a turn-over's jumps out and back, a frame or two apart, make one
             # step of the angles with its peak at one of them
-            limit = max(JUMP_DEG, limits[int(c)] * t.degrees)
+            limit = max(JUMP_DEG, limits[c] * t.degrees)
             span = range(max(first, 2), min(last, rows - 2) + 1)
             for row, (pop, jump) in zip(span, _rotation_steps(t, channel.joint, span, limit) if span else ()):
                 if (channel.joint, row) in seen or (channel.joint, True, t.frame(row)) in explained:
@@ -798,7 +800,7 @@ def _excursions(
     t: _Take,
     out: list[Finding],
     jumps: list[tuple[str, int, float, int, bool]],
-    limits: np.ndarray,
+    limits: list[float],
     exact: list[Finding],
     windows: list[Window],
 ) -> list[Finding]:
@@ -935,11 +937,10 @@ def _turning_spike(
     # at 120 Hz; 67 deg at 30 Hz, where a fast wrist leaves its neighbours by 30), farther than the
     # joint turns per frame just before and after (a joint that turns as fast around it shakes:
     # a waving hand at 30 Hz), and in a turn no joint makes
-    high = (
-        deviation > max(30, 6 * limit)
-        and deviation > 2 * _pace(t, joint, first, last)
-        and _fastest(t, joint, first, last) > SPIKE_TURN_DEG_S
-    )
+    high = deviation > max(30, 6 * limit)
+    if high:
+        pace, fastest = _paces(t, joint, first, last)
+        high = deviation > 2 * pace and fastest > SPIKE_TURN_DEG_S
     # medium: farther out than smooth motion at twice the peak acceleration (10 deg at 45 Hz and
     # above; 22 at 30 Hz, where a swinging forearm bends off the path between its neighbours by
     # 15), or farther out than the rows around it lie apart: a turn out and back
@@ -1083,29 +1084,26 @@ def _unwrapped(block: np.ndarray, period: float) -> np.ndarray:
 PACE_FRAMES = 3
 
 
-def _pace(t: _Take, joint: str, first: int, last: int) -> float:
-    """The most the joint turns from one frame to the next over the PACE_FRAMES frames before
-    rows first..last and after them, in degrees (0 where its channels make no rotation)."""
-    return _fastest_step(t, joint, (first - PACE_FRAMES, first - 1), (last + 1, last + PACE_FRAMES))
-
-
-def _fastest(t: _Take, joint: str, first: int, last: int) -> float:
-    """The fastest the joint turns from one frame to the next from the row before rows
-    first..last to the row after them, in degrees per second (inf where its channels make no
-    rotation, where the check has no other measure than the channel's own)."""
-    return _fastest_step(t, joint, (first - 1, last + 1)) * t.rate if joint in t.rotating else math.inf
-
-
-def _fastest_step(t: _Take, joint: str, *spans: tuple[int, int]) -> float:
-    """The most the joint turns from one frame to the next within the spans of rows (first,
-    last) of the take, in degrees (0 where its channels make no rotation or no span holds two of
-    those rows).  NaN steps (a gap) are left out."""
+def _paces(t: _Take, joint: str, first: int, last: int) -> tuple[float, float]:
+    """How fast the joint turns around rows first..last (first >= 1) and through them: the most
+    it turns from one frame to the next over the PACE_FRAMES frames before them and after them,
+    in degrees (0 where its channels make no rotation), and the fastest it turns from one frame
+    to the next from the row before them to the row after, in degrees per second (inf where its
+    channels make no rotation, where the check has no other measure than the channel's own).
+    NaN steps (a gap) are left out."""
     if joint not in t.rotating:
-        return 0.0
-    turns = t.turns(joint)  # entry k: from row k to row k + 1
-    # a few steps each: Python's floats cost less than numpy's calls
-    steps = [x for a, b in spans for x in turns[max(a, 0) : min(b, t.motion.frames - 1)].tolist() if not math.isnan(x)]
-    return max(steps, default=0.0)
+        return 0.0, math.inf
+    low, steps_end = max(first - PACE_FRAMES, 0), t.motion.frames - 1
+    # entry k: from row low + k to the next; a few steps, where Python's floats cost less than numpy's calls
+    steps = t.turns(joint)[low : min(last + PACE_FRAMES, steps_end)].tolist()
+
+    def most(a: int, b: int) -> float:  # of the steps from rows a .. b - 1
+        return max(
+            (x for x in steps[max(a, 0) - low : max(min(b, steps_end) - low, 0)] if not math.isnan(x)), default=0.0
+        )
+
+    pace = max(most(first - PACE_FRAMES, first - 1), most(last + 1, last + PACE_FRAMES))
+    return pace, most(first - 1, last + 1) * t.rate
 
 
 def _trimmed(t: _Take, runs: list[Run], limits: list[float]) -> list[tuple[int, int, float | None]]:
