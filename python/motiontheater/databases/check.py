@@ -199,7 +199,8 @@ class _Take:
             chosen: list[tuple[str, bool, int, int]] = [(joint, True, int(a), int(b)) for a, b in zip(first, last)]
             rows, starts, inner, share = _blocks(chosen)
             p = self._places(joint, rows)
-            off = np.nan_to_num(lengths(p[inner] - 0.5 * (p[inner - 1] + p[inner + 1]))).max(axis=1)
+            # the largest, a missing place (NaN) left out: fmax, not nan_to_num's copies, on these small blocks
+            off = np.fmax.reduce(lengths(p[inner] - 0.5 * (p[inner - 1] + p[inner + 1])), axis=1, initial=0.0)
             ends = np.cumsum(np.diff(starts) - 2)  # each run's inner rows end here
             offs = np.maximum.reduceat(off, ends - (last - first + 1)) * np.where(last > first, 2, 1)
             q = self.quaternions(joint, np.concatenate([first - 1, last + 1]))
@@ -226,7 +227,8 @@ class _Take:
                 continue
             at = np.array([jumps[i][1] for i in members])
             p = self._places(joint, (at[:, None] + np.arange(-2, 2)).ravel()).reshape(len(at), 4, points, 3)
-            steps = np.nan_to_num(lengths(np.diff(p, axis=1)))  # into rows at - 1, at, at + 1
+            steps = lengths(np.diff(p, axis=1))  # into rows at - 1, at, at + 1
+            steps[np.isnan(steps)] = 0.0
             beside = np.maximum(steps[:, 0], steps[:, 2])
             worst = np.argmax(steps[:, 1] - 2 * beside, axis=1)
             step, beside = (
@@ -246,27 +248,24 @@ class _Take:
         joint, in its channels' axes, turned by the difference of the two rotations."""
         skeleton = self.motion.skeleton
         tree, j = skeleton.tree, skeleton.joint_names.index(joint)
-        places, turns = self._kinematics(rows)
+        places, turns = self.held
         origin = j if skeleton.convention == "bvh" or tree.parent[j] < 0 else int(tree.parent[j])
-        offsets = places[:, self._points(joint)] - places[:, origin][:, None]  # (rows, points, 3), world axes
-        frame = turns[:, j] @ tree.axis[j]  # the joint's channels' axes in the world
+        # (rows, points, 3), world axes: of the rows' points alone, not every joint's
+        offsets = places[rows[:, None], self._points(joint)] - places[rows, origin][:, None]
+        frame = turns[rows, j] @ tree.axis[j]  # the joint's channels' axes in the world
         local = np.einsum("rji,rpj->rpi", frame, offsets)
         actual = self.quaternions(joint, rows)
         error = np.swapaxes(quaternions_to_matrices(actual), -1, -2) @ quaternions_to_matrices(instead)
         shift = np.einsum("rij,rpj->rpi", error, local) - local
-        return np.nan_to_num(lengths(shift)).max(axis=1, initial=0.0) * self.meters
+        return np.fmax.reduce(lengths(shift), axis=1, initial=0.0) * self.meters
 
     def _points(self, joint: str) -> np.ndarray:
         skeleton = self.motion.skeleton
         return skeleton.derived(("turned points", joint), lambda: _turned(skeleton, joint))
 
-    def _kinematics(self, rows: np.ndarray) -> Kinematics:
-        """Every joint's place and world turn at the rows."""
-        return self.held[0][rows], self.held[1][rows]
-
     def _places(self, joint: str, rows: np.ndarray) -> np.ndarray:
         """The places (rows, points, 3) in metres of the points the joint's rotation moves."""
-        return self._kinematics(rows)[0][:, self._points(joint)] * self.meters
+        return self.held[0][rows[:, None], self._points(joint)] * self.meters
 
 
 _NONE = np.zeros(0, np.intp)
@@ -605,7 +604,7 @@ def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
             angles = values[:, columns]
             rolled = np.unwrap(angles, axis=0, period=360.0 / t.degrees)
         delta = (rolled - angles) * t.degrees
-        off = np.nan_to_num(np.abs(delta).max(axis=1)) > FLIP_DEG
+        off = np.abs(delta).max(axis=1) > FLIP_DEG  # NaN compares false
         finite = np.isfinite(angles).all(axis=1)
         runs = _runs(off)
         # every frame but the first few off their triple: the first frames (a rest pose) are the flipped ones
@@ -1175,7 +1174,7 @@ def _bones(t: _Take) -> list[Finding]:
             continue
         middle = float(np.nanmedian(length))
         off = np.abs(length - middle)
-        bad = np.nan_to_num(off) > max(BONE_DRIFT_M, BONE_DRIFT_SHARE * middle)
+        bad = off > max(BONE_DRIFT_M, BONE_DRIFT_SHARE * middle)  # NaN compares false
         for first, last in _runs(bad):
             size = float(np.nanmax(off[first : last + 1]))
             out.append(
@@ -1211,10 +1210,10 @@ def _speed(t: _Take) -> list[Finding]:
         return []
     window = max(1, round(0.25 * t.rate))
     steps = lengths(np.diff(t.motion.values[:, columns], axis=0)) * t.meters * t.rate
-    if not np.nanmax(steps, initial=0.0) > RUN_SPEED:  # no median of them can be: the take is slower
+    if not np.fmax.reduce(steps, initial=0.0) > RUN_SPEED:  # no median of them can be: the take is slower
         return []
     # the median over 0.25 s: a teleport of a few frames is not a speed
-    typical = median_filter1d(np.nan_to_num(steps), window | 1, mode="nearest")
+    typical = median_filter1d(np.where(np.isnan(steps), 0.0, steps), window | 1, mode="nearest")
     out = []
     for first, last in _runs(typical > RUN_SPEED):
         speed = float(typical[first : last + 1].max())

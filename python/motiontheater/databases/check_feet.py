@@ -154,8 +154,8 @@ class _Legs:
         depth = self.measures.depth * self.mpu
         feet = self.arrays.legs.feet
         out = []
-        # NaN where the foot is a gap: it sinks nowhere
-        for i, s, e, worst in run_peaks(np.nan_to_num(depth) > PENETRATION_M, depth):
+        # NaN where the foot is a gap: it sinks nowhere (NaN compares false)
+        for i, s, e, worst in run_peaks(depth > PENETRATION_M, depth):
             if e - s >= shortest:
                 out.append(
                     Finding(

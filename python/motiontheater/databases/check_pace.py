@@ -53,7 +53,7 @@ def dropped_findings(
     pace = step_pace(motion, kinematics)
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = pace.paced / pace.moved
-    steps = np.clip(np.round(np.nan_to_num(ratio)), 2.0, MOST_MISSING + 1.0)
+    steps = np.clip(np.round(np.where(np.isnan(ratio), 0.0, ratio)), 2.0, MOST_MISSING + 1.0)
 
     def misfit(s: np.ndarray | float) -> np.ndarray:
         return pace.stepped - 2 * s * pace.paced + s * s * pace.moved
@@ -100,6 +100,7 @@ def step_pace(motion: Motion, kinematics: Kinematics | None = None) -> kernel.Pa
     squares, counts = np.zeros(places.shape[1]), np.zeros(places.shape[1], np.uintp)
     kernel.roughness(places, squares, counts)  # a gap's left out
     with np.errstate(invalid="ignore", divide="ignore"):
-        noise = np.nan_to_num(squares / counts / 1.5) * meters**2  # the variance of one coordinate, m^2
+        noise = squares / counts / 1.5 * meters**2  # the variance of one coordinate, m^2
+    noise[np.isnan(noise)] = 0.0  # a coordinate never finite beside its neighbours
     # d - m = 1.5 x[t+1] - 1.5 x[t] + 0.5 x[t-1] - 0.5 x[t+2]: five times the variance of one
     return kernel.pace(places, meters**2 / (5.0 * (noise + NOISE_M**2)))
