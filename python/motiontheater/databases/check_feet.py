@@ -132,6 +132,8 @@ class _Legs:
         which it slides farther than SKATE_M: found without the footplants, which a slide splits."""
         shortest = max(2, round(SKATE_SECONDS * self.motion.frame_rate))
         drift = self.measures.drift.reshape(-1, self.motion.frames)  # each leg's heel, then its ball
+        if not np.fmax.reduce(drift, axis=None, initial=0.0) * self.mpu > SKATE_M:
+            return []  # no point slides so far (NaN off the floor left out)
         slides: list[list] = [[] for _ in self.arrays.legs.feet]  # per foot: (first row, last row, metres, point)
         for row, s, e, peak in run_peaks(~np.isnan(drift), drift):
             if e - s >= shortest and peak * self.mpu > SKATE_M:

@@ -243,6 +243,8 @@ def runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def run_peaks(mask: np.ndarray, values: np.ndarray) -> list[tuple[int, int, int, float]]:
     """The runs of True in each row of a 2-d mask, row by row: (row, start, end (exclusive), the
     largest of ``values`` (the mask's shape) over the run), every row's at once."""
+    if not mask.any():  # as nearly every take's knees and elbows
+        return []
     rows, frames = mask.shape
     padded = np.zeros((rows, frames + 1), bool)  # a False between rows parts their runs
     padded[:, :frames] = mask
