@@ -101,7 +101,7 @@ def _signed_bends(turn: np.ndarray, straight: np.ndarray, rate: float) -> np.nda
         bent = straight < length / math.tan(math.radians(BENT_DEG))  # bends past BENT_DEG, without an arctan
         if np.count_nonzero(bent) < max(2, BENT_SECONDS * rate):
             return None
-        units = turn[bent] / length[bent, None]
+        units = np.compress(bent, turn, axis=0) / np.compress(bent, length)[:, None]  # compress: half a mask's time
     # the axis the turns share, whichever way each turns (a long backwards bend is among them),
     # forward the way most of them turn
     shares, axes = np.linalg.eigh(units.T @ units / len(units))
