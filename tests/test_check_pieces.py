@@ -3,6 +3,7 @@ is read: what is found is what checking it whole finds, and the memory it takes 
 with the take."""
 
 import collections
+import dataclasses
 import re
 import tracemalloc
 
@@ -121,3 +122,22 @@ def test_an_amc_read_as_it_is_checked_takes_memory_that_does_not_grow_with_it(tm
         found[frames] = collections.Counter(f.kind for f in streamed.findings)
     assert peaks[24000] < 1.25 * peaks[6000], peaks
     assert found[24000]["teleport"] > found[6000]["teleport"] > 0  # the seams of the repeats, found all along
+
+
+def test_takes_are_read_a_few_at_a_time_and_found_as_one_by_one(tmp_path):
+    """A worker reads a few takes before it checks them: the groups keep the jobs' order, hold
+    at most READ_TOGETHER takes and STREAM_ABOVE bytes in all (a larger take alone), and the
+    survey finds in each take what checking it alone finds, an unreadable one among them."""
+    if not real_files("hdm05/*.amc"):
+        pytest.skip("the real-file corpus (../shared/data/hdm05) is absent")
+    (tmp_path / "broken.amc").write_text(":DEGREES\n1\nroot 0 0\n")
+    jobs = survey.plan([str(DATA / "hdm05"), str(tmp_path / "broken.amc")], asf=None)
+    jobs += [dataclasses.replace(jobs[0], bytes=survey.STREAM_ABOVE - 1)] * 2  # too large to share a group
+    groups = survey.reading_groups(jobs)
+    assert [job for group in groups for job in group] == jobs
+    assert max(map(len, groups)) == survey.READ_TOGETHER
+    assert all(len(g) == 1 or sum(j.bytes for j in g) <= survey.STREAM_ABOVE for g in groups)
+    assert [len(g) for g in groups[-2:]] == [1, 1]
+    checks = survey.survey(jobs, workers=1)
+    assert [c.findings for c in checks] == [survey.check_job(job).findings for job in jobs]
+    assert checks[len(jobs) - 3].findings[0].kind == "unreadable"
