@@ -1,11 +1,14 @@
 /*
  * check_spikes.c - the take check's spikes of a joint's rotation trimmed to the frames that
- * leave their path (mt_check_trim; see mtcore.h).
+ * leave their path (mt_check_trim), and what they move (mt_check_seen; see mtcore.h).
  *
  * A candidate's ends are trimmed one frame at a time, each time against the path between the
  * frames around what is left: only its two ends are measured until it keeps them both, and
  * only then every frame of it.  The runs still trimming are measured together, a round of
  * SLERPs at a time, so that mt_slerp fills its lanes.
+ *
+ * What a spike of a joint's rotation moves (mt_check_seen) is measured on the points the joint
+ * turns, at the run's frames, from the take's forward kinematics.
  */
 #include "lanes.h"
 #include "mtcore.h"
@@ -112,5 +115,110 @@ int mt_check_trim(const double *q, size_t frames, size_t runs, const size_t *fir
         largest[i] = worst;
     }
     free(scratch), free(trimming);
+    return MT_OK;
+}
+
+/* The larger of a and b where b is a number (fmax leaves NaN out as numpy's fmax does). */
+static double larger(double a, double b)
+{
+    return b > a ? b : a;
+}
+
+/* At row r, how far the points lie from where the joint's rotation `instead` (a matrix) would
+   put them, in the points' unit: their offsets from the origin, in the joint's channels' axes
+   (its world rotation times axis), turned by actual^T instead less themselves; the farthest,
+   NaN left out, 0 for none. */
+static double shift_at(const struct mt_turned *k, size_t r, const double *actual, const double *instead)
+{
+    const double *w = k->world + 9 * (k->joints * r + k->joint), *c = k->axis;
+    double frame[9], error[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            frame[3 * i + j] = w[3 * i] * c[j] + w[3 * i + 1] * c[3 + j] + w[3 * i + 2] * c[6 + j];
+            error[3 * i + j] = actual[i] * instead[j] + actual[3 + i] * instead[3 + j] + actual[6 + i] * instead[6 + j];
+        }
+    const double *at = k->places + 3 * k->joints * r, *origin = at + 3 * k->origin;
+    double farthest = 0.0;
+    for (size_t p = 0; p < k->count; p++) {
+        double offset[3], local[3], shift[3];
+        for (int e = 0; e < 3; e++)
+            offset[e] = at[3 * k->points[p] + e] - origin[e];
+        for (int i = 0; i < 3; i++)
+            local[i] = frame[i] * offset[0] + frame[3 + i] * offset[1] + frame[6 + i] * offset[2];
+        for (int i = 0; i < 3; i++)
+            shift[i] = error[3 * i] * local[0] + error[3 * i + 1] * local[1] + error[3 * i + 2] * local[2] - local[i];
+        farthest = larger(farthest, sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]));
+    }
+    return farthest;
+}
+
+/* How far the points lie at row r from midway between where they are at rows r - 1 and r + 1,
+   in metres: the farthest, NaN left out, 0 for none. */
+static double off_midway(const struct mt_turned *k, size_t r, double meters)
+{
+    const double *before = k->places + 3 * k->joints * (r - 1), *at = before + 3 * k->joints,
+                 *after = at + 3 * k->joints;
+    double farthest = 0.0;
+    for (size_t p = 0; p < k->count; p++) {
+        double d[3];
+        for (int e = 0; e < 3; e++) {
+            const size_t i = 3 * k->points[p] + e;
+            d[e] = at[i] * meters - 0.5 * (before[i] * meters + after[i] * meters);
+        }
+        farthest = larger(farthest, sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+    }
+    return farthest;
+}
+
+int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const size_t *first, const size_t *last,
+                  double meters, double *off, double *filled)
+{
+    if (runs == 0)
+        return MT_OK;
+    if (!k || !q || !first || !last || !off || !filled || !k->places || !k->world || !k->axis ||
+        (k->count > 0 && !k->points) || k->joint >= k->joints || k->origin >= k->joints)
+        return MT_EINVAL;
+    for (size_t p = 0; p < k->count; p++)
+        if (k->points[p] >= k->joints)
+            return MT_EINVAL;
+    size_t rows = 0;
+    for (size_t i = 0; i < runs; i++) {
+        if (first[i] < 1 || first[i] > last[i] || last[i] + 2 > k->frames)
+            return MT_EINVAL;
+        rows += last[i] - first[i] + 1;
+    }
+    if (rows > SIZE_MAX / (26 * sizeof(double)))
+        return MT_ENOMEM;
+    /* per row: the keys and share of its path (9), the path and the actual rotation (4 each),
+       the path's matrix (9); the actual rotation's matrix takes the keys' place once done with */
+    double *scratch = malloc(rows * 26 * sizeof *scratch);
+    if (!scratch)
+        return MT_ENOMEM;
+    double *q0 = scratch, *q1 = q0 + 4 * rows, *share = q1 + 4 * rows, *path = share + rows, *actual = path + 4 * rows,
+           *turned = actual + 4 * rows, *m_actual = scratch;
+    size_t n = 0;
+    for (size_t i = 0; i < runs; i++)
+        for (size_t r = first[i]; r <= last[i]; r++, n++) {
+            for (int c = 0; c < 4; c++) {
+                q0[4 * n + c] = q[4 * (first[i] - 1) + c], q1[4 * n + c] = q[4 * (last[i] + 1) + c];
+                actual[4 * n + c] = q[4 * r + c];
+            }
+            share[n] = (double)(r - first[i] + 1) / (double)(last[i] - first[i] + 2);
+        }
+    mt_slerp(q0, q1, share, rows, path);
+    mt_quaternions_to_matrices(path, rows, turned);
+    mt_quaternions_to_matrices(actual, rows, m_actual);
+    n = 0;
+    for (size_t i = 0; i < runs; i++) {
+        double where = 0.0, instead = 0.0;
+        for (size_t r = first[i]; r <= last[i]; r++, n++) {
+            const double midway = off_midway(k, r, meters);
+            where = midway > where ? midway : where;
+            instead = larger(instead, shift_at(k, r, m_actual + 9 * n, turned + 9 * n));
+        }
+        off[i] = where * (last[i] > first[i] ? 2.0 : 1.0);
+        filled[i] = instead * meters;
+    }
+    free(scratch);
     return MT_OK;
 }

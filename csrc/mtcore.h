@@ -1182,6 +1182,36 @@ int mt_check_trim(const double *q, size_t frames, size_t runs, const size_t *fir
                   const double *limit, size_t *first_out, size_t *last_out, double *largest);
 
 /*
+ * What spikes of one joint's rotation move (check_spikes.c): the points the joint turns, from a
+ * take's forward kinematics.  places (frames x joints x 3) and world (frames x joints x 9,
+ * row-major) are every joint's end and world rotation; the joint's channels turn about its
+ * world rotation times axis (9); the points (count of them, indices of joints) are what it
+ * turns, their offsets taken from joint `origin`'s place.
+ */
+struct mt_turned {
+    const double *places, *world;
+    size_t frames, joints, joint, origin;
+    const double *axis;
+    const size_t *points;
+    size_t count;
+};
+
+/*
+ * For runs i of rows first[i] .. last[i] (1 <= first <= last <= frames - 2) of the joint, whose
+ * rotation at each frame is q (frames x 4, unit quaternions): off[i], the farthest any point
+ * lies, at a row of the run, from midway between where it is at the rows before and after, in
+ * metres (places times meters), twice that for a run of several rows; filled[i], the farthest
+ * any point lies, at a row of the run, from where the joint's rotation on the SLERP between rows
+ * first - 1 and last + 1 (at the row's place, r - first + 1 of last - first + 2 of the way)
+ * would put it, the joints below as they are, in metres: its offset from the origin, in the
+ * joint's channels' axes, turned by A^T B less itself (A, B the matrices of the actual and the
+ * SLERP's rotation).  NaN distances are left out, and a run where none is a number gets 0.
+ * MT_ENOMEM where scratch of 26 numbers a row cannot be had.
+ */
+int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const size_t *first, const size_t *last,
+                  double meters, double *off, double *filled);
+
+/*
  * The elbows of a take, frame by frame (check_arms.c).  positions (frames x joints x 3) are every
  * joint's, world (frames x turned x 9) the world rotations of some joints (row-major).  Arm a's
  * shoulder, elbow and wrist are where joints place[3a], place[3a + 1] and place[3a + 2] are, and

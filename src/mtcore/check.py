@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -32,6 +33,7 @@ __all__ = [
     "leg_measures",
     "pace",
     "roughness",
+    "seen_runs",
     "trim_runs",
 ]
 
@@ -278,6 +280,48 @@ def trim_runs(
                                c_array(out[1]))  # fmt: skip
     check(status, "mt_check_trim")
     return out[0][0], out[0][1], out[1]
+
+
+def seen_runs(
+    places: ArrayLike,
+    world: ArrayLike,
+    joint: int,
+    origin: int,
+    axis: ArrayLike,
+    points: ArrayLike,
+    quaternions: ArrayLike,
+    first: ArrayLike,
+    last: ArrayLike,
+    meters: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """What runs of rows first .. last (1 <= first <= last <= frames - 2) of a joint's rotation
+    move (``mt_check_seen``, csrc/mtcore.h), from the take's ``places`` (frames, joints, 3) and
+    ``world`` rotations (frames, joints, 3, 3): the ``points`` it turns (joint indices, offsets
+    from joint ``origin``'s place) about its world rotation times ``axis`` (3, 3), its rotation
+    at each frame ``quaternions`` (frames, 4): how far they lie off midway between the rows
+    around, and how far from where the SLERP between the rows around the run would put them, in
+    metres (``meters`` a unit), per run."""
+    p = _checks.real(places, "places", (None, None, 3))
+    frames, joints = p.shape[:2]
+    w = _checks.real(world, "world", (frames, joints, 3, 3))
+    q = _checks.real(quaternions, "quaternions", (frames, 4))
+    c = _checks.real(axis, "axis", (3, 3))
+    chosen = _checks.integers(points, "points", (None,), 0, joints, np.uintp)
+    b = _checks.integers(last, "last", (None,), 1, max(frames - 1, 1), np.uintp)
+    a = _checks.integers(first, "first", (len(b),), 1, max(frames - 1, 1), np.uintp)
+    if (a > b).any():
+        raise ValueError("each run's first row must not follow its last")
+    turned: Any = ffi.new("struct mt_turned *")  # structs: fields by name
+    held = c_array(p), c_array(w), c_array(c), c_array(chosen, "size_t[]")  # alive through the call
+    turned.places, turned.world, turned.axis, turned.points = held
+    turned.frames, turned.joints, turned.count = frames, joints, len(chosen)
+    turned.joint = _checks.integer(joint, "joint", 0, joints - 1)
+    turned.origin = _checks.integer(origin, "origin", 0, joints - 1)
+    off, filled = np.empty(len(b)), np.empty(len(b))
+    status = lib.mt_check_seen(turned, c_array(q), len(b), c_array(a, "size_t[]"), c_array(b, "size_t[]"),
+                               float(meters), c_array(off), c_array(filled))  # fmt: skip
+    check(status, "mt_check_seen")
+    return off, filled
 
 
 def roughness(values: ArrayLike, squares: np.ndarray, counts: np.ndarray) -> None:

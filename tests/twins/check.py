@@ -259,6 +259,51 @@ def trim_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
+def seen_twin(places, world, joint, origin, axis, points, quaternions, first, last, meters):
+    """Each run's rows one at a time: the points' distance from midway between the rows around,
+    and from where the SLERP (the twin's) between the rows around the run would put them."""
+    places, world, q = np.asarray(places, float), np.asarray(world, float), np.asarray(quaternions, float)
+    points = np.asarray(points, int)
+    off, filled = np.zeros(len(first)), np.zeros(len(first))
+
+    def farthest(vectors) -> float:
+        found = [float(np.linalg.norm(v)) for v in vectors]
+        return max([x for x in found if not math.isnan(x)], default=0.0)
+
+    for i, (a, b) in enumerate(zip(map(int, first), map(int, last))):
+        for r in range(a, b + 1):
+            p = places * meters
+            off[i] = max(off[i], farthest(p[r, points] - 0.5 * (p[r - 1, points] + p[r + 1, points])))
+            path = rotations.slerp(q[a - 1], q[b + 1], (r - a + 1) / (b - a + 2))
+            frame = world[r, joint] @ np.asarray(axis, float)
+            error = rotations.quaternions_to_matrices(q[r]).T @ rotations.quaternions_to_matrices(path)
+            local = [frame.T @ (places[r, k] - places[r, origin]) for k in points]
+            filled[i] = max(filled[i], farthest([error @ x - x for x in local]) * meters)
+        off[i] *= 2 if b > a else 1
+    return off, filled
+
+
+def seen_cases(rng: np.random.Generator) -> list[tuple]:
+    """A chain of joints turning at random, runs of one to four rows over it, points below the
+    joint and none, a NaN place and a NaN rotation."""
+    from mtcore.rotations import euler_to_matrices, euler_to_quaternions
+
+    out = []
+    for frames, joints, count in ((3, 3, 1), (12, 6, 3), (40, 8, 0), (40, 8, 5)):
+        places = rng.normal(0, 10, (frames, joints, 3))
+        world = euler_to_matrices(rng.uniform(-180, 180, (frames, joints, 3)), "zyx", extrinsic=True, degrees=True)
+        axis = euler_to_matrices(rng.uniform(-90, 90, 3), "xyz", extrinsic=True, degrees=True)
+        q = euler_to_quaternions(np.cumsum(rng.normal(0, 5, (frames, 3)), axis=0), "zxy", extrinsic=False, degrees=True)
+        first = rng.integers(1, frames - 1, 6)
+        last = np.minimum(first + rng.integers(0, 4, 6), frames - 2)
+        if frames == 40 and count:
+            places[20, 2] = math.nan
+            q[30] = math.nan
+        points = rng.choice(np.arange(1, joints), count, replace=False)
+        out.append((places, world, 1, 0, axis, points, q, first, last, 0.05))
+    return out
+
+
 def roughness_twin(values, squares, counts):
     """Each inner row's residual from the mean of its neighbours, one at a time; the finite ones summed."""
     x = np.asarray(values, float)

@@ -189,26 +189,20 @@ class _Take:
         lie from where the joint's rotation on the path between the rows around would put them,
         the joints below as they are (a hand whose end has no length turns nothing; a thigh
         turned about itself that the knee turns back looks right, and filling the thigh alone
-        would put the leg out).  (0, 0) where it turns none.  Every run of a joint at once."""
+        would put the leg out).  (0, 0) where it turns none.  Every run of a joint in one call
+        of :func:`mtcore.check.seen_runs`."""
         out = [(0.0, 0.0)] * len(runs)
+        skeleton = self.motion.skeleton
         for joint, members in _by_joint(joint for joint, _, _ in runs).items():
-            if not len(self._points(joint)):
+            points = self._points(joint)
+            if not len(points):
                 continue
-            first = np.array([runs[i][1] for i in members])
-            last = np.array([runs[i][2] for i in members])
-            chosen: list[tuple[str, bool, int, int]] = [(joint, True, int(a), int(b)) for a, b in zip(first, last)]
-            rows, starts, inner, share = _blocks(chosen)
-            p = self._places(joint, rows)
-            # the largest, a missing place (NaN) left out: fmax, not nan_to_num's copies, on these small blocks
-            off = np.fmax.reduce(lengths(p[inner] - 0.5 * (p[inner - 1] + p[inner + 1])), axis=1, initial=0.0)
-            ends = np.cumsum(np.diff(starts) - 2)  # each run's inner rows end here
-            offs = np.maximum.reduceat(off, ends - (last - first + 1)) * np.where(last > first, 2, 1)
-            q = self.quaternions(joint, np.concatenate([first - 1, last + 1]))
-            sizes = last - first + 1
-            path = slerp(np.repeat(q[: len(first)], sizes, axis=0), np.repeat(q[len(first) :], sizes, axis=0), share)
-            moved = self._shifts(joint, rows[inner], path)
-            filled = np.maximum.reduceat(moved, ends - sizes)
-            for i, a, b in zip(members, offs.tolist(), filled.tolist()):
+            j = skeleton.joint_names.index(joint)
+            off, filled = kernel.seen_runs(
+                *self.held, j, self._origin(j), skeleton.tree.axis[j], points, self.quaternions(joint, slice(None)),
+                [runs[i][1] for i in members], [runs[i][2] for i in members], self.meters,
+            )  # fmt: skip
+            for i, a, b in zip(members, off.tolist(), filled.tolist()):
                 out[i] = (a, b)
         return out
 
@@ -249,15 +243,20 @@ class _Take:
         skeleton = self.motion.skeleton
         tree, j = skeleton.tree, skeleton.joint_names.index(joint)
         places, turns = self.held
-        origin = j if skeleton.convention == "bvh" or tree.parent[j] < 0 else int(tree.parent[j])
         # (rows, points, 3), world axes: of the rows' points alone, not every joint's
-        offsets = places[rows[:, None], self._points(joint)] - places[rows, origin][:, None]
+        offsets = places[rows[:, None], self._points(joint)] - places[rows, self._origin(j)][:, None]
         frame = turns[rows, j] @ tree.axis[j]  # the joint's channels' axes in the world
         local = np.einsum("rji,rpj->rpi", frame, offsets)
         actual = self.quaternions(joint, rows)
         error = np.swapaxes(quaternions_to_matrices(actual), -1, -2) @ quaternions_to_matrices(instead)
         shift = np.einsum("rij,rpj->rpi", error, local) - local
         return np.fmax.reduce(lengths(shift), axis=1, initial=0.0) * self.meters
+
+    def _origin(self, j: int) -> int:
+        """The joint whose place the offsets of the points joint j turns are taken from: its own
+        in BVH (a joint's place is its parent's doing), its parent's end in ASF."""
+        parent = int(self.motion.skeleton.tree.parent[j])
+        return j if self.motion.skeleton.convention == "bvh" or parent < 0 else parent
 
     def _points(self, joint: str) -> np.ndarray:
         skeleton = self.motion.skeleton
