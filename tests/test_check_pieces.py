@@ -138,6 +138,7 @@ def test_takes_are_read_a_few_at_a_time_and_found_as_one_by_one(tmp_path):
     assert max(map(len, groups)) == survey.READ_TOGETHER
     assert all(len(g) == 1 or sum(j.bytes for j in g) <= survey.STREAM_ABOVE for g in groups)
     assert [len(g) for g in groups[-2:]] == [1, 1]
+    assert max(map(len, survey.reading_groups(jobs, workers=4))) == len(jobs) // 16  # four groups or more a worker
     checks = survey.survey(jobs, workers=1)
     assert [c.findings for c in checks] == [survey.check_job(job).findings for job in jobs]
     assert checks[len(jobs) - 3].findings[0].kind == "unreadable"

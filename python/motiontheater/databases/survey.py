@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from mtcore import cpu_count
+
 from .._io import output
 from ..formats.amc import open_amc
 from ..formats.cut import Cut
@@ -96,13 +98,16 @@ def check_group(jobs: list[CheckJob]) -> list[TakeCheck]:
     return [found if isinstance(found, TakeCheck) else _checked(job, *found) for job, found in zip(jobs, read)]
 
 
-def reading_groups(jobs: list[CheckJob]) -> list[list[CheckJob]]:
+def reading_groups(jobs: list[CheckJob], workers: int = 1) -> list[list[CheckJob]]:
     """The jobs in order, in groups read together: up to READ_TOGETHER takes of at most
-    STREAM_ABOVE bytes in all (a larger take alone), so that a group's frames stay few."""
+    STREAM_ABOVE bytes in all (a larger take alone), so that a group's frames stay few; and so
+    many groups that each of ``workers`` processes gets four or more (a few takes on many
+    cores are not left to one)."""
+    most = max(1, min(READ_TOGETHER, len(jobs) // (4 * max(workers, 1))))
     groups: list[list[CheckJob]] = []
     size = 0
     for job in jobs:
-        if groups and len(groups[-1]) < READ_TOGETHER and size + job.bytes <= STREAM_ABOVE:
+        if groups and len(groups[-1]) < most and size + job.bytes <= STREAM_ABOVE:
             groups[-1].append(job)
             size += job.bytes
         else:
@@ -238,7 +243,9 @@ def survey(
     the Dask cluster at ``scheduler`` or a local one, with ``progress`` advanced take by take."""
     progress = progress or Progress(len(jobs), sum(j.bytes for j in jobs), enabled=False)
     done: dict[str, TakeCheck] = {}
-    results = run_each(reading_groups(jobs), check_group, workers, scheduler=scheduler, dask_local=dask_local)
+    processes = 1 if scheduler or dask_local else workers or cpu_count()  # a cluster's size is its own
+    groups = reading_groups(jobs, processes)
+    results = run_each(groups, check_group, workers, scheduler=scheduler, dask_local=dask_local)
     try:
         for group, checks in results:
             for job, result in zip(group, checks):
