@@ -171,11 +171,11 @@ static double off_midway(const struct mt_turned *k, size_t r, double meters)
 }
 
 int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const size_t *first, const size_t *last,
-                  double meters, double *off, double *filled)
+                  const size_t *before, const size_t *after, double meters, double *off, double *filled)
 {
     if (runs == 0)
         return MT_OK;
-    if (!k || !q || !first || !last || !off || !filled || !k->places || !k->world || !k->axis ||
+    if (!k || !q || !first || !last || !before || !after || !off || !filled || !k->places || !k->world || !k->axis ||
         (k->count > 0 && !k->points) || k->joint >= k->joints || k->origin >= k->joints)
         return MT_EINVAL;
     for (size_t p = 0; p < k->count; p++)
@@ -183,7 +183,8 @@ int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const
             return MT_EINVAL;
     size_t rows = 0;
     for (size_t i = 0; i < runs; i++) {
-        if (first[i] < 1 || first[i] > last[i] || last[i] + 2 > k->frames)
+        if (first[i] < 1 || first[i] > last[i] || last[i] + 2 > k->frames || before[i] >= after[i] ||
+            after[i] >= k->frames)
             return MT_EINVAL;
         rows += last[i] - first[i] + 1;
     }
@@ -200,10 +201,10 @@ int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const
     for (size_t i = 0; i < runs; i++)
         for (size_t r = first[i]; r <= last[i]; r++, n++) {
             for (int c = 0; c < 4; c++) {
-                q0[4 * n + c] = q[4 * (first[i] - 1) + c], q1[4 * n + c] = q[4 * (last[i] + 1) + c];
+                q0[4 * n + c] = q[4 * before[i] + c], q1[4 * n + c] = q[4 * after[i] + c];
                 actual[4 * n + c] = q[4 * r + c];
             }
-            share[n] = (double)(r - first[i] + 1) / (double)(last[i] - first[i] + 2);
+            share[n] = ((double)r - (double)before[i]) / (double)(after[i] - before[i]);
         }
     mt_slerp(q0, q1, share, rows, path);
     mt_quaternions_to_matrices(path, rows, turned);

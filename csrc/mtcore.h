@@ -1201,15 +1201,17 @@ struct mt_turned {
  * rotation at each frame is q (frames x 4, unit quaternions): off[i], the farthest any point
  * lies, at a row of the run, from midway between where it is at the rows before and after, in
  * metres (places times meters), twice that for a run of several rows; filled[i], the farthest
- * any point lies, at a row of the run, from where the joint's rotation on the SLERP between rows
- * first - 1 and last + 1 (at the row's place, r - first + 1 of last - first + 2 of the way)
- * would put it, the joints below as they are, in metres: its offset from the origin, in the
+ * any point lies, at a row r of the run, from where the joint's rotation on the SLERP from row
+ * before[i] to row after[i] (before < after < frames; at (r - before) / (after - before) of the
+ * way: the path between the rows around the run for before = first - 1 and after = last + 1,
+ * the pace going on for a row r = after + 1) would put it, the joints below as they are, in
+ * metres: its offset from the origin, in the
  * joint's channels' axes, turned by A^T B less itself (A, B the matrices of the actual and the
  * SLERP's rotation).  NaN distances are left out, and a run where none is a number gets 0.
  * MT_ENOMEM where scratch of 26 numbers a row cannot be had.
  */
 int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const size_t *first, const size_t *last,
-                  double meters, double *off, double *filled);
+                  const size_t *before, const size_t *after, double meters, double *off, double *filled);
 
 /*
  * The elbows of a take, frame by frame (check_arms.c).  positions (frames x joints x 3) are every

@@ -293,14 +293,15 @@ def seen_runs(
     first: ArrayLike,
     last: ArrayLike,
     meters: float,
+    keys: tuple[ArrayLike, ArrayLike] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """What runs of rows first .. last (1 <= first <= last <= frames - 2) of a joint's rotation
     move (``mt_check_seen``, csrc/mtcore.h), from the take's ``places`` (frames, joints, 3) and
     ``world`` rotations (frames, joints, 3, 3): the ``points`` it turns (joint indices, offsets
     from joint ``origin``'s place) about its world rotation times ``axis`` (3, 3), its rotation
     at each frame ``quaternions`` (frames, 4): how far they lie off midway between the rows
-    around, and how far from where the SLERP between the rows around the run would put them, in
-    metres (``meters`` a unit), per run."""
+    around, and how far from where the SLERP between the rows ``keys`` (before, after; by
+    default those around the run) would put them, in metres (``meters`` a unit), per run."""
     p = _checks.real(places, "places", (None, None, 3))
     frames, joints = p.shape[:2]
     w = _checks.real(world, "world", (frames, joints, 3, 3))
@@ -311,6 +312,11 @@ def seen_runs(
     a = _checks.integers(first, "first", (len(b),), 1, max(frames - 1, 1), np.uintp)
     if (a > b).any():
         raise ValueError("each run's first row must not follow its last")
+    before, after = (a - 1, b + 1) if keys is None else keys
+    k0 = _checks.integers(before, "keys[0]", (len(b),), 0, frames, np.uintp)
+    k1 = _checks.integers(after, "keys[1]", (len(b),), 0, frames, np.uintp)
+    if (k0 >= k1).any():
+        raise ValueError("each run's first key row must come before its second")
     turned: Any = ffi.new("struct mt_turned *")  # structs: fields by name
     held = c_array(p), c_array(w), c_array(c), c_array(chosen, "size_t[]")  # alive through the call
     turned.places, turned.world, turned.axis, turned.points = held
@@ -319,7 +325,8 @@ def seen_runs(
     turned.origin = _checks.integer(origin, "origin", 0, joints - 1)
     off, filled = np.empty(len(b)), np.empty(len(b))
     status = lib.mt_check_seen(turned, c_array(q), len(b), c_array(a, "size_t[]"), c_array(b, "size_t[]"),
-                               float(meters), c_array(off), c_array(filled))  # fmt: skip
+                               c_array(k0, "size_t[]"), c_array(k1, "size_t[]"), float(meters), c_array(off),
+                               c_array(filled))  # fmt: skip
     check(status, "mt_check_seen")
     return off, filled
 

@@ -259,9 +259,10 @@ def trim_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
-def seen_twin(places, world, joint, origin, axis, points, quaternions, first, last, meters):
+def seen_twin(places, world, joint, origin, axis, points, quaternions, first, last, meters, keys=None):
     """Each run's rows one at a time: the points' distance from midway between the rows around,
-    and from where the SLERP (the twin's) between the rows around the run would put them."""
+    and from where the SLERP (the twin's) between the rows ``keys`` (those around the run)
+    would put them."""
     places, world, q = np.asarray(places, float), np.asarray(world, float), np.asarray(quaternions, float)
     points = np.asarray(points, int)
     off, filled = np.zeros(len(first)), np.zeros(len(first))
@@ -270,11 +271,13 @@ def seen_twin(places, world, joint, origin, axis, points, quaternions, first, la
         found = [float(np.linalg.norm(v)) for v in vectors]
         return max([x for x in found if not math.isnan(x)], default=0.0)
 
+    before, after = (np.asarray(first) - 1, np.asarray(last) + 1) if keys is None else keys
     for i, (a, b) in enumerate(zip(map(int, first), map(int, last))):
+        k0, k1 = int(before[i]), int(after[i])
         for r in range(a, b + 1):
             p = places * meters
             off[i] = max(off[i], farthest(p[r, points] - 0.5 * (p[r - 1, points] + p[r + 1, points])))
-            path = rotations.slerp(q[a - 1], q[b + 1], (r - a + 1) / (b - a + 2))
+            path = rotations.slerp(q[k0], q[k1], (r - k0) / (k1 - k0))
             frame = world[r, joint] @ np.asarray(axis, float)
             error = rotations.quaternions_to_matrices(q[r]).T @ rotations.quaternions_to_matrices(path)
             local = [frame.T @ (places[r, k] - places[r, origin]) for k in points]
@@ -301,6 +304,8 @@ def seen_cases(rng: np.random.Generator) -> list[tuple]:
             q[30] = math.nan
         points = rng.choice(np.arange(1, joints), count, replace=False)
         out.append((places, world, 1, 0, axis, points, q, first, last, 0.05))
+        at = np.arange(2, frames - 1)  # jumps: the rotation going on from the two rows before
+        out.append((places, world, 1, 0, axis, points, q, at, at, 0.05, (at - 2, at - 1)))
     return out
 
 

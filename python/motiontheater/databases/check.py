@@ -30,7 +30,7 @@ import numpy as np
 from mtcore import check as kernel
 from mtcore import median_filter1d
 from mtcore.kinematics import Kinematics, world_kinematics
-from mtcore.rotations import euler_to_quaternions, quaternions_to_matrices, slerp, unroll_euler
+from mtcore.rotations import euler_to_quaternions, slerp, unroll_euler
 
 from ..editing.pipeline import Pipeline
 from ..formats.cut import Cut
@@ -192,16 +192,10 @@ class _Take:
         would put the leg out).  (0, 0) where it turns none.  Every run of a joint in one call
         of :func:`mtcore.check.seen_runs`."""
         out = [(0.0, 0.0)] * len(runs)
-        skeleton = self.motion.skeleton
         for joint, members in _by_joint(joint for joint, _, _ in runs).items():
-            points = self._points(joint)
-            if not len(points):
+            if not len(self._points(joint)):
                 continue
-            j = skeleton.joint_names.index(joint)
-            off, filled = kernel.seen_runs(
-                *self.held, j, self._origin(j), skeleton.tree.axis[j], points, self.quaternions(joint, slice(None)),
-                [runs[i][1] for i in members], [runs[i][2] for i in members], self.meters,
-            )  # fmt: skip
+            off, filled = self._seen(joint, [runs[i][1] for i in members], [runs[i][2] for i in members])
             for i, a, b in zip(members, off.tolist(), filled.tolist()):
                 out[i] = (a, b)
         return out
@@ -230,27 +224,20 @@ class _Take:
                 np.take_along_axis(beside, worst[:, None], 1)[:, 0],
             )
             jumped = np.maximum(step - 2 * beside, 0.0)
-            q = self.quaternions(joint, np.concatenate([at - 2, at - 1]))
-            moved = self._shifts(joint, at, slerp(q[: len(at)], q[len(at) :], np.full(len(at), 2.0)))
+            _, moved = self._seen(joint, at, at, (at - 2, at - 1))  # the rotation going on from the two rows before
             for i, a, b, c in zip(members, np.minimum(jumped, moved).tolist(), step.tolist(), beside.tolist()):
                 out[i] = (a, b, c)
         return out
 
-    def _shifts(self, joint: str, rows: np.ndarray, instead: np.ndarray) -> np.ndarray:
-        """At each of the rows, how far the point the joint turns farthest from where its rotation
-        ``instead`` (a quaternion per row) would put it lies, in metres: their offsets from the
-        joint, in its channels' axes, turned by the difference of the two rotations."""
+    def _seen(self, joint: str, first, last, keys: tuple | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`mtcore.check.seen_runs` of the joint's runs (rows first..last), its rotation's
+        SLERP between the rows ``keys`` (default those around each run)."""
         skeleton = self.motion.skeleton
-        tree, j = skeleton.tree, skeleton.joint_names.index(joint)
-        places, turns = self.held
-        # (rows, points, 3), world axes: of the rows' points alone, not every joint's
-        offsets = places[rows[:, None], self._points(joint)] - places[rows, self._origin(j)][:, None]
-        frame = turns[rows, j] @ tree.axis[j]  # the joint's channels' axes in the world
-        local = np.einsum("rji,rpj->rpi", frame, offsets)
-        actual = self.quaternions(joint, rows)
-        error = np.swapaxes(quaternions_to_matrices(actual), -1, -2) @ quaternions_to_matrices(instead)
-        shift = np.einsum("rij,rpj->rpi", error, local) - local
-        return np.fmax.reduce(lengths(shift), axis=1, initial=0.0) * self.meters
+        j = skeleton.joint_names.index(joint)
+        return kernel.seen_runs(
+            *self.held, j, self._origin(j), skeleton.tree.axis[j], self._points(joint),
+            self.quaternions(joint, slice(None)), first, last, self.meters, keys,
+        )  # fmt: skip
 
     def _origin(self, j: int) -> int:
         """The joint whose place the offsets of the points joint j turns are taken from: its own
