@@ -88,8 +88,8 @@ def channel_events(
     count = ffi.new("size_t *")
     capacity = 64 + rows  # seldom outgrown: a second pass over the values costs as much as the first
     while True:
-        events = np.zeros((capacity, 5), dtype=np.uintp)
-        sizes = np.zeros(capacity)
+        events = np.empty((capacity, 5), dtype=np.uintp)  # the kernel writes the first count rows
+        sizes = np.empty(capacity)
         status = lib.mt_check_channels(
             c_array(x), rows, channels, channels, begin, end, c_array(spikes), c_array(steps), min_run,
             c_array(events, "size_t[]"), c_array(sizes), capacity, count, c_array(roughness),
