@@ -6,6 +6,7 @@ against a snapshot taken before it (run from the checkout, the corpus as the tes
     python tests/findings_snapshot.py compare BEFORE.json  # after it: the cases that differ
 """
 
+import collections
 import json
 import sys
 import tempfile
@@ -50,13 +51,26 @@ def main(command: str, snapshot: str) -> int:
         return 0
     before = json.loads(Path(snapshot).read_text())
     differ = [case for case in before if before[case] != now.get(case)]
-    for case in differ[:15]:
+    changed: collections.Counter = collections.Counter()  # every case's, in short: how many cases each
+    for i, case in enumerate(differ):
         was, got = set(before[case]), set(now.get(case, []))
-        print(case)
-        print(
-            "".join(f"  - {line}\n" for line in sorted(was - got))
-            + "".join(f"  + {line}\n" for line in sorted(got - was))
-        )
+        if i < 15:
+            print(case)
+            print(
+                "".join(f"  - {line}\n" for line in sorted(was - got))
+                + "".join(f"  + {line}\n" for line in sorted(got - was))
+            )
+        for sign, lines in (("-", was - got), ("+", got - was)):
+            for line in lines:
+                f = json.loads(line)
+                take = case.split(" | ")[1]
+                changed[sign, take, f["kind"], ", ".join(f["joints"]), f["first"], f["last"], f["severity"]] += 1
+    if len(differ) > 15:
+        print("every change, in short (cases: -/+ take kind joints frames severity):")
+        for (sign, take, kind, joints, first, last, severity), cases in sorted(
+            changed.items(), key=lambda x: x[0][1:] + x[0][:1]
+        ):
+            print(f"  {cases:4d}: {sign} {take} {kind} {joints} {first}-{last} {severity}")
     print(f"{len(differ)} of {len(before)} cases differ")
     return 1 if differ else 0
 
