@@ -25,17 +25,26 @@ static double angle_deg(const double *a, const double *b)
     return 2 * acos(dot > 1.0 ? 1.0 : dot) * (180.0 / pi);
 }
 
-/* Points on the paths, one a row: row[k] of the run first[k] .. last[k], between the rows around it. */
+/* The larger of a and b where b is a number (fmax leaves NaN out as numpy's fmax does). */
+static double larger(double a, double b)
+{
+    return b > a ? b : a;
+}
+
+/* Points on paths, one a row: row[k]'s place on the SLERP from its key rows' rotations (q0, q1)
+   at `share` of the way, into out. */
 struct paths {
     double *q0, *q1, *share, *out;
     size_t *row;
 };
 
-static void add_row(const double *q, struct paths *p, size_t k, size_t a, size_t b, size_t r)
+/* Row r's point on the SLERP from row `before` to row `after` (the rows around a run r is in:
+   r - first + 1 of last - first + 2 of the way; or two rows before r, extrapolated). */
+static void add_row(const double *q, struct paths *p, size_t k, size_t before, size_t after, size_t r)
 {
     for (int c = 0; c < 4; c++)
-        p->q0[4 * k + c] = q[4 * (a - 1) + c], p->q1[4 * k + c] = q[4 * (b + 1) + c];
-    p->share[k] = (double)(r - a + 1) / (double)(b - a + 2);
+        p->q0[4 * k + c] = q[4 * before + c], p->q1[4 * k + c] = q[4 * after + c];
+    p->share[k] = ((double)r - (double)before) / (double)(after - before);
     p->row[k] = r;
 }
 
@@ -83,8 +92,8 @@ int mt_check_trim(const double *q, size_t frames, size_t runs, const size_t *fir
     while (n > 0) {
         for (size_t k = 0; k < n; k++) {
             const size_t i = trimming[k];
-            add_row(q, &p, 2 * k, first_out[i], last_out[i], first_out[i]);
-            add_row(q, &p, 2 * k + 1, first_out[i], last_out[i], last_out[i]);
+            add_row(q, &p, 2 * k, first_out[i] - 1, last_out[i] + 1, first_out[i]);
+            add_row(q, &p, 2 * k + 1, first_out[i] - 1, last_out[i] + 1, last_out[i]);
         }
         measure(q, &p, 2 * n, off);
         size_t still = 0;
@@ -103,7 +112,7 @@ int mt_check_trim(const double *q, size_t frames, size_t runs, const size_t *fir
     for (size_t k = 0; k < whole_runs; k++) {
         const size_t i = kept[k];
         for (size_t r = first_out[i]; r <= last_out[i]; r++)
-            add_row(q, &p, n++, first_out[i], last_out[i], r);
+            add_row(q, &p, n++, first_out[i] - 1, last_out[i] + 1, r);
     }
     measure(q, &p, n, off);
     n = 0;
@@ -111,17 +120,11 @@ int mt_check_trim(const double *q, size_t frames, size_t runs, const size_t *fir
         const size_t i = kept[k];
         double worst = -INFINITY;
         for (size_t r = first_out[i]; r <= last_out[i]; r++, n++)
-            worst = off[n] > worst ? off[n] : worst;
+            worst = larger(worst, off[n]);
         largest[i] = worst;
     }
     free(scratch), free(trimming);
     return MT_OK;
-}
-
-/* The larger of a and b where b is a number (fmax leaves NaN out as numpy's fmax does). */
-static double larger(double a, double b)
-{
-    return b > a ? b : a;
 }
 
 /* At row r, how far the points lie from where the joint's rotation `instead` (a matrix) would
@@ -188,33 +191,31 @@ int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const
             return MT_EINVAL;
         rows += last[i] - first[i] + 1;
     }
-    if (rows > SIZE_MAX / (26 * sizeof(double)))
+    if (rows > SIZE_MAX / (27 * sizeof(double)))
         return MT_ENOMEM;
-    /* per row: the keys and share of its path (9), the path and the actual rotation (4 each),
+    /* per row: its path's keys and share (9), point (4) and row (1), its actual rotation (4) and
        the path's matrix (9); the actual rotation's matrix takes the keys' place once done with */
-    double *scratch = malloc(rows * 26 * sizeof *scratch);
+    double *scratch = malloc(rows * 27 * sizeof *scratch);
     if (!scratch)
         return MT_ENOMEM;
-    double *q0 = scratch, *q1 = q0 + 4 * rows, *share = q1 + 4 * rows, *path = share + rows, *actual = path + 4 * rows,
-           *turned = actual + 4 * rows, *m_actual = scratch;
+    struct paths p = {scratch, scratch + 4 * rows, scratch + 8 * rows, scratch + 9 * rows,
+                      (size_t *)(scratch + 13 * rows)};
+    double *actual = scratch + 14 * rows, *turned = actual + 4 * rows, *m_actual = scratch;
     size_t n = 0;
     for (size_t i = 0; i < runs; i++)
         for (size_t r = first[i]; r <= last[i]; r++, n++) {
-            for (int c = 0; c < 4; c++) {
-                q0[4 * n + c] = q[4 * before[i] + c], q1[4 * n + c] = q[4 * after[i] + c];
+            add_row(q, &p, n, before[i], after[i], r);
+            for (int c = 0; c < 4; c++)
                 actual[4 * n + c] = q[4 * r + c];
-            }
-            share[n] = ((double)r - (double)before[i]) / (double)(after[i] - before[i]);
         }
-    mt_slerp(q0, q1, share, rows, path);
-    mt_quaternions_to_matrices(path, rows, turned);
+    mt_slerp(p.q0, p.q1, p.share, rows, p.out);
+    mt_quaternions_to_matrices(p.out, rows, turned);
     mt_quaternions_to_matrices(actual, rows, m_actual);
     n = 0;
     for (size_t i = 0; i < runs; i++) {
         double where = 0.0, instead = 0.0;
         for (size_t r = first[i]; r <= last[i]; r++, n++) {
-            const double midway = off_midway(k, r, meters);
-            where = midway > where ? midway : where;
+            where = larger(where, off_midway(k, r, meters));
             instead = larger(instead, shift_at(k, r, m_actual + 9 * n, turned + 9 * n));
         }
         off[i] = where * (last[i] > first[i] ? 2.0 : 1.0);

@@ -1205,10 +1205,10 @@ struct mt_turned {
  * before[i] to row after[i] (before < after < frames; at (r - before) / (after - before) of the
  * way: the path between the rows around the run for before = first - 1 and after = last + 1,
  * the pace going on for a row r = after + 1) would put it, the joints below as they are, in
- * metres: its offset from the origin, in the
- * joint's channels' axes, turned by A^T B less itself (A, B the matrices of the actual and the
- * SLERP's rotation).  NaN distances are left out, and a run where none is a number gets 0.
- * MT_ENOMEM where scratch of 26 numbers a row cannot be had.
+ * metres: its offset from the origin, in the joint's channels' axes, turned by A^T B less
+ * itself (A, B the matrices of the actual and the SLERP's rotation).  NaN distances are left
+ * out, and a run where none is a number gets 0.  MT_ENOMEM where scratch of 27 numbers a row
+ * cannot be had.
  */
 int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const size_t *first, const size_t *last,
                   const size_t *before, const size_t *after, double meters, double *off, double *filled);

@@ -26,6 +26,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from mtcore import check as kernel
 from mtcore import median_filter1d
@@ -229,7 +230,9 @@ class _Take:
                 out[i] = (a, b, c)
         return out
 
-    def _seen(self, joint: str, first, last, keys: tuple | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def _seen(
+        self, joint: str, first: ArrayLike, last: ArrayLike, keys: tuple[ArrayLike, ArrayLike] | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """:func:`mtcore.check.seen_runs` of the joint's runs (rows first..last), its rotation's
         SLERP between the rows ``keys`` (default those around each run)."""
         skeleton = self.motion.skeleton
@@ -1095,8 +1098,8 @@ def _trimmed(t: _Take, runs: list[Run], limits: list[float]) -> list[tuple[int, 
     """Each run without the rows at its ends that lie on the path between the rows around them
     (the median of five beside a large spike can leave a fast-moving neighbour), and its largest
     deviation (None where :func:`_deviations` has none): (first, last, deviation).  A joint's
-    rotation is trimmed in C (:func:`mtcore.check.trim_runs`, whose twin is this loop's
-    SLERP); the others at once, a row at a time, while any still loses one."""
+    rotation is trimmed in C (:func:`mtcore.check.trim_runs`); positions, and angles that make
+    no rotation, here, every run at once, a row at a time, while any still loses one."""
     first = np.array([first for _, _, first, _ in runs], dtype=np.intp)
     last = np.array([last for _, _, _, last in runs], dtype=np.intp)
     limit = np.asarray(limits, dtype=float)
