@@ -20,7 +20,6 @@ rescaled (``scale``), jitter low-passed (``butterworth`` at Winter's cut-off), s
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -973,7 +972,10 @@ def _settled(t: _Take, found: list[Finding]) -> list[Finding]:
             if undone
             else f"moving what it turns {nearest * 100:.2g} cm off its path"
         )
-        out[i] = dataclasses.replace(f, severity=severity, detail=f"{f.detail}, {what}", fix=() if undone else f.fix)
+        out[i] = Finding(
+            f.take, f.kind, f.joints, f.first, f.last, severity, f.size, f.unit, f"{f.detail}, {what}", f.channel,
+            () if undone else f.fix,
+        )  # fmt: skip
     t.unsettled.clear()
     return out
 

@@ -243,9 +243,9 @@ class _Legs:
         the frames of a stride and the ground it covers do not depend on the rate; the speed
         they make does, and a person striding that far goes at a known speed."""
         ankles = self.arrays.points[:, :, 1]
-        if len(ankles) != 2 or not np.isfinite(ankles).all():
+        heights = ankles @ self.up  # not finite where a coordinate is not (inf times 0 is NaN)
+        if len(ankles) != 2 or not np.isfinite(heights).all():
             return []
-        heights = ankles @ self.up
         frames = _stride(heights[0] - heights[1])
         if frames is None:
             return []
@@ -288,7 +288,7 @@ def _stride(alternation: np.ndarray) -> int | None:
     if n < 8 or not energy > 0:
         return None
     half = n // 2  # the lags a take of two strides can show
-    size = 1 << (n + half).bit_length()  # no wrap-around into those lags, a length pocketfft is fast at
+    size = _smooth_size(n + half)  # no wrap-around into those lags
     spectrum = np.fft.rfft(x, size)
     alike = np.fft.irfft(spectrum.real**2 + spectrum.imag**2, size)[:half] / energy
     alike /= 1 - np.arange(half) / n  # the share of the take each lag compares
@@ -297,6 +297,12 @@ def _stride(alternation: np.ndarray) -> int | None:
         return None
     lag = int(below[0] + np.argmax(alike[below[0] :]))
     return lag if alike[lag] >= STRIDE_ALIKE else None
+
+
+def _smooth_size(least: int) -> int:
+    """The smallest m 2^k >= least for m in 1, 3, 5, 9, 15: a length pocketfft is fast at, at
+    most a quarter longer than ``least`` (a power of two can be twice as long)."""
+    return min(m << max(-(-least // m) - 1, 0).bit_length() for m in (1, 3, 5, 9, 15))
 
 
 def _merged(slides: list[tuple[int, int, float, str]]) -> list[tuple[int, int, float, str]]:

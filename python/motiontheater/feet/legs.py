@@ -468,8 +468,10 @@ def leg_arrays(
         ("leg channels", legs.rotators.tobytes()), lambda: _leg_channels(tree, legs)
     )
     used = columns >= 0
-    gathered = motion.values[:, np.where(used, columns, 0)] * tree.angle_scale  # (frames, legs, 4, 3)
-    angles = np.ascontiguousarray(np.where(used, gathered, 0.0).transpose(1, 0, 2, 3))
+    gathered = np.take(motion.values, np.where(used, columns, 0).ravel(), axis=1)  # (frames, legs * 4 * 3)
+    gathered *= tree.angle_scale
+    gathered[:, ~used.ravel()] = 0.0
+    angles = np.ascontiguousarray(gathered.reshape(len(gathered), n, 4, 3).transpose(1, 0, 2, 3))
 
     def chains_of(segments: np.ndarray) -> tuple:
         return tuple(kernels.LegChain(axis=frames_axis[i], axes=axes[i], segments=segments[i]) for i in range(n))
