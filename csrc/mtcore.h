@@ -1214,15 +1214,22 @@ int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const
                   const size_t *before, const size_t *after, double meters, double *off, double *filled);
 
 /*
- * The elbows of a take, frame by frame (check_arms.c).  positions (frames x joints x 3) are every
- * joint's, world (frames x turned x 9) the world rotations of some joints (row-major).  Arm a's
- * shoulder, elbow and wrist are where joints place[3a], place[3a + 1] and place[3a + 2] are, and
- * its upper arm turns with world rotation turning[a] (< turned).  turn (arms x frames x 3)
- * receives the cross product of upper arm and forearm in the axes of that rotation (W^T (u x f)),
- * straight (arms x frames) their dot product.  NaN positions give NaN.
+ * The elbows of a take, frame by frame (check_arms.c): how far each bends forward (positive) or
+ * backwards (negative), in degrees.  positions (frames x joints x 3) are every joint's, world
+ * (frames x turned x 9) the world rotations of some joints (row-major).  Arm a's shoulder, elbow
+ * and wrist are where joints place[3a], place[3a + 1] and place[3a + 2] are, and its upper arm
+ * turns with world rotation turning[a] (< turned).  At each frame, with u the upper arm and f the
+ * forearm, n = W^T (u x f) is their turn in the axes of that rotation.  The frames bent past the
+ * angle whose tangent is tan_bent (u . f < |n| / tan_bent, |n| > 0) tell the elbow's axis: the
+ * eigenvector of the largest eigenvalue of the mean of n n^T / |n|^2 over them, the way round
+ * that most of them turn about it.  Where at least max(2, least) frames bend so and that
+ * eigenvalue exceeds hinge (the turns share an axis), judged[a] is 1 and bend (arms x frames)
+ * receives atan2(n . axis, u . f) in degrees (NaN where a position is NaN); elsewhere judged[a]
+ * is 0 and the arm's bends NaN.
  */
 int mt_check_elbows(const double *positions, size_t frames, size_t joints, const double *world, size_t turned,
-                    const size_t *turning, const size_t *place, size_t arms, double *turn, double *straight);
+                    const size_t *turning, const size_t *place, size_t arms, double tan_bent, double least,
+                    double hinge, double *bend, unsigned char *judged);
 
 /* MT_CDEF_END */
 

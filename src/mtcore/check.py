@@ -29,7 +29,7 @@ __all__ = [
     "LegMeasures",
     "Pace",
     "channel_events",
-    "elbow_turns",
+    "elbow_bends",
     "leg_measures",
     "pace",
     "roughness",
@@ -237,26 +237,38 @@ def leg_measures(
     return LegMeasures(drift, depth, back, standing)
 
 
-def elbow_turns(
-    positions: ArrayLike, world: ArrayLike, turning: ArrayLike, placing: ArrayLike
+def elbow_bends(
+    positions: ArrayLike,
+    world: ArrayLike,
+    turning: ArrayLike,
+    placing: ArrayLike,
+    bent_deg: float,
+    least: float,
+    hinge: float,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """How each arm's forearm turns from its upper arm, frame by frame (``mt_check_elbows``,
-    csrc/mtcore.h): the cross product of upper arm and forearm in the axes of the upper arm's
-    world rotation (arms, frames, 3), and their dot product (arms, frames).  ``positions``
-    (frames, joints, 3) and ``world`` (frames, turned, 3, 3) of the joints, ``turning`` (arms) the
-    world rotation each upper arm turns with, ``placing`` (arms, 3) the joints where its
-    shoulder, elbow and wrist are."""
+    """How far each arm's elbow bends, frame by frame, forward positive and backwards negative,
+    in degrees (arms, frames), about the axis the frames bent past ``bent_deg`` share, and whether
+    the take tells that axis (arms,): at least max(2, ``least``) such frames whose turns share it
+    by more than ``hinge`` (NaN bends where it does not; ``mt_check_elbows``, csrc/mtcore.h).
+    ``positions`` (frames, joints, 3) and ``world`` (frames, turned, 3, 3) of the joints,
+    ``turning`` (arms) the world rotation each upper arm turns with, ``placing`` (arms, 3) the
+    joints where its shoulder, elbow and wrist are."""
     p = _checks.real(positions, "positions", (None, None, 3))
     frames, joints = p.shape[:2]
     w = _checks.real(world, "world", (frames, None, 3, 3))
     turned = _checks.integers(turning, "turning", (None,), 0, w.shape[1], np.uintp)
     arms = len(turned)
     place = _checks.integers(placing, "placing", (arms, 3), 0, joints, np.uintp)
-    turn, straight = np.empty((arms, frames, 3)), np.empty((arms, frames))
+    if not 0 < bent_deg < 90:
+        raise ValueError(f"bent_deg must lie between 0 and 90, got {bent_deg}")
+    if not (least >= 0 and 0 <= hinge <= 1):
+        raise ValueError(f"least must be >= 0 and hinge within 0 .. 1, got {least}, {hinge}")
+    bend, judged = np.empty((arms, frames)), np.zeros(arms, np.uint8)
     status = lib.mt_check_elbows(c_array(p), frames, joints, c_array(w), w.shape[1], c_array(turned, "size_t[]"),
-                                 c_array(place, "size_t[]"), arms, c_array(turn), c_array(straight))  # fmt: skip
+                                 c_array(place, "size_t[]"), arms, math.tan(math.radians(bent_deg)), float(least),
+                                 float(hinge), c_array(bend), c_array(judged, "unsigned char[]"))  # fmt: skip
     check(status, "mt_check_elbows")
-    return turn, straight
+    return bend, judged.view(bool)
 
 
 def trim_runs(

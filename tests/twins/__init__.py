@@ -27,7 +27,7 @@ from mtcore import rotations as rot
 from mtcore import search as mt_search
 from mtcore import signal as mt_signal
 from mtcore import text as mt_text
-from mtcore.check import channel_events, elbow_turns, pace, roughness, seen_runs, trim_runs
+from mtcore.check import channel_events, elbow_bends, pace, roughness, seen_runs, trim_runs
 from mtcore.check import leg_measures as check_legs
 from mtcore.combine import combine_frames
 from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
@@ -999,7 +999,7 @@ TWINS: dict[str, Twin] = {
         check.check_legs_cases,
         close(1e-9),
     ),
-    "mt_check_elbows": Twin(elbow_turns, check.elbow_turns_twin, check.elbow_cases, close(1e-12)),
+    "mt_check_elbows": Twin(elbow_bends, check.elbow_bends_twin, check.elbow_cases, close(1e-12)),
     # the twin's SLERP is its own: degrees off the path to rounding (acos near 1 takes its root)
     "mt_check_trim": Twin(trim_runs, check.trim_twin, check.trim_cases, close(1e-6)),
     # the twin's SLERP and products its own: metres to rounding

@@ -333,22 +333,37 @@ def roughness_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
-def elbow_turns_twin(positions, world, turning, placing):
+def elbow_bends_twin(positions, world, turning, placing, bent_deg, least, hinge):
     """Each arm's upper arm and forearm at each frame, their cross product turned into the upper
-    arm's axes by numpy, one frame at a time."""
+    arm's axes by numpy, one frame at a time; the axis by numpy's eigh, of the unit turns of the
+    frames bent past bent_deg."""
     p, w = np.asarray(positions, float), np.asarray(world, float)
     arms, frames = len(turning), len(p)
-    turn, straight = np.zeros((arms, frames, 3)), np.zeros((arms, frames))
+    bend, judged = np.full((arms, frames), math.nan), np.zeros(arms, bool)
     for a, (upper, (shoulder, elbow, hand)) in enumerate(zip(turning, placing)):
+        turn, straight = np.zeros((frames, 3)), np.zeros(frames)
         for t in range(frames):
             arm, forearm = p[t, elbow] - p[t, shoulder], p[t, hand] - p[t, elbow]
-            turn[a, t] = w[t, upper].T @ np.cross(arm, forearm)
-            straight[a, t] = arm @ forearm
-    return turn, straight
+            turn[t] = w[t, upper].T @ np.cross(arm, forearm)
+            straight[t] = arm @ forearm
+        length = np.sqrt((turn**2).sum(axis=1))
+        with np.errstate(invalid="ignore"):
+            bent = (straight < length / math.tan(math.radians(bent_deg))) & (length > 0)
+        if bent.sum() < max(2, least):
+            continue
+        units = turn[bent] / length[bent, None]
+        shares, axes = np.linalg.eigh(units.T @ units / len(units))
+        if not shares[-1] > hinge:
+            continue
+        axis = axes[:, -1] if np.sum(units @ axes[:, -1] > 0) * 2 >= len(units) else -axes[:, -1]
+        bend[a], judged[a] = np.degrees(np.arctan2(turn @ axis, straight)), True
+    return bend, judged
 
 
 def elbow_cases(rng: np.random.Generator) -> list[tuple]:
-    """No arm to two, 0 to 40 frames, world rotations of every joint or of a few, a NaN place."""
+    """No arm to two, 0 to 61 frames, world rotations of every joint or of a few, a NaN place;
+    arms that bend about one axis in the upper arm's (a few frames backwards, a little off the
+    axis), which bend every way, or too seldom for the least count."""
     out = []
     for arms, frames, joints, turned in ((0, 5, 3, 2), (1, 0, 4, 4), (1, 1, 3, 1), (2, 7, 6, 3), (2, 40, 9, 9)):
         positions = rng.normal(size=(frames, joints, 3))
@@ -357,5 +372,17 @@ def elbow_cases(rng: np.random.Generator) -> list[tuple]:
         world = rotations.matrices(rng.uniform(-3, 3, (frames, turned, 3)), "zyx")
         turning = rng.integers(0, turned, arms)
         placing = np.array([rng.permutation(joints)[:3] for _ in range(arms)], np.intp).reshape(arms, 3)
-        out.append((positions, world, turning, placing))
+        out.append((positions, world, turning, placing, 30.0, 3.0, 0.8))
+    for frames, back, off, least in ((12, 3, 0.05, 3.0), (61, 7, 0.05, 30.0), (61, 7, 0.05, 100.0), (25, 4, 2.0, 3.0)):
+        world = rotations.matrices(rng.uniform(-3, 3, (frames, 2, 3)), "zyx")
+        positions = np.zeros((frames, 6, 3))
+        for a in range(2):
+            bends = np.radians(rng.uniform(40, 150, frames))
+            bends[rng.choice(frames, back, replace=False)] *= -0.3  # bent backwards
+            elbow = np.array([1.0, 0.0, 0.0]) + rng.normal(0, 0.01, (frames, 3))
+            forearm = np.stack([np.cos(bends), np.sin(bends), rng.normal(0, off, frames)], axis=1)
+            local = np.stack([np.zeros((frames, 3)), elbow, elbow + forearm], axis=1)
+            positions[:, 3 * a : 3 * a + 3] = np.einsum("fij,fkj->fki", world[:, a], local)
+        positions[frames // 2, 4] = math.nan
+        out.append((positions, world, np.array([0, 1]), np.array([[0, 1, 2], [3, 4, 5]]), 30.0, least, 0.8))
     return out

@@ -12,18 +12,15 @@ way the arm should have bent is not in the take.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from mtcore.check import elbow_turns
+from mtcore.check import elbow_bends
 from mtcore.kinematics import Kinematics, world_kinematics
 
 from ..characters.rigs import recognise, wrist
 from ..feet.contacts import run_peaks
 from ..model.motion import Motion
 from ..model.skeleton import Skeleton
-from ..model.vectors import lengths
 from .findings import Finding
 
 ELBOW_BACK_DEG = 20.0
@@ -50,10 +47,9 @@ def arm_findings(motion: Motion, take: str, kinematics: Kinematics | None = None
         kinematics = world_kinematics(motion.values, skeleton.tree, workers=1)
     names = skeleton.point_names
     out = []
-    turns, straights = elbow_turns(*kinematics, arms[:, 1], placing)
-    for (_, _, elbow, _), turn, straight in zip(arms, turns, straights):
-        bend = _signed_bends(turn, straight, motion.frame_rate)
-        if bend is None:
+    bends, judged = elbow_bends(*kinematics, arms[:, 1], placing, BENT_DEG, BENT_SECONDS * motion.frame_rate, HINGE)
+    for (_, _, elbow, _), bend, told in zip(arms, bends, judged):
+        if not told:  # the take does not tell the elbow's axis (see the module docstring)
             continue
         backwards = -bend[None]
         for _, s, e, worst in run_peaks(backwards > ELBOW_BACK_DEG, backwards):
@@ -90,22 +86,3 @@ def _arms(skeleton: Skeleton) -> tuple[np.ndarray, np.ndarray]:
                              names.index(end)))  # fmt: skip
     table = np.array(arms, dtype=np.intp).reshape(-1, 4)
     return table, _placing(skeleton, table)
-
-
-def _signed_bends(turn: np.ndarray, straight: np.ndarray, rate: float) -> np.ndarray | None:
-    """The elbow's bend per frame in degrees, forward positive and backwards negative, from its
-    turns and dot products (:func:`mtcore.check.elbow_turns`); None where the take does not tell
-    its axis (see the module docstring)."""
-    length = lengths(turn)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        bent = straight < length / math.tan(math.radians(BENT_DEG))  # bends past BENT_DEG, without an arctan
-        if np.count_nonzero(bent) < max(2, BENT_SECONDS * rate):
-            return None
-        units = np.compress(bent, turn, axis=0) / np.compress(bent, length)[:, None]  # compress: half a mask's time
-    # the axis the turns share, whichever way each turns (a long backwards bend is among them),
-    # forward the way most of them turn
-    shares, axes = np.linalg.eigh(units.T @ units / len(units))
-    if not shares[-1] > HINGE:
-        return None
-    axis = axes[:, -1] if np.sum(units @ axes[:, -1] > 0) * 2 >= len(units) else -axes[:, -1]
-    return np.degrees(np.arctan2(turn @ axis, straight))
