@@ -63,6 +63,16 @@ struct fk {
     double *end;   /* scratch: each joint's end point over the block (3 BLOCK values a joint) */
 };
 
+/* m turned on the left by the rotations about kinds[r] by angles[r BLOCK ..] (radians), r = 0 .. count-1 in
+   turn: the sines and cosines of up to three channels in one pass over their lanes */
+static MT_INLINE void turn_left(double *m, const double *angles, const int *kinds, int count)
+{
+    double sn[3 * BLOCK], cs[3 * BLOCK];
+    sincos_lanes(angles, sn, cs, count * BLOCK);
+    for (int r = 0; r < count; r++)
+        rotate_left_n(m, kinds[r], sn + r * BLOCK, cs + r * BLOCK, BLOCK);
+}
+
 /* Frames f0 .. f0+n-1 (n <= BLOCK); lanes past n repeat the last frame and are not written. */
 static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *positions,
                                double *world_out, double *local_out)
@@ -72,18 +82,25 @@ static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *
         rows[f] = k->values + (f0 + ((size_t)f < n ? (size_t)f : n - 1)) * k->channels;
     for (size_t i = 0; i < k->joints; i++) {
         const size_t j = (size_t)k->order[i];
-        double m[9 * BLOCK], t[3 * BLOCK] = {0}, stretch[BLOCK] = {0}, v[BLOCK], sn[BLOCK], cs[BLOCK];
+        double m[9 * BLOCK], t[3 * BLOCK] = {0}, stretch[BLOCK] = {0}, v[BLOCK], angles[3 * BLOCK];
+        /* shifted: the joint has translation or stretch channels (most have none); the rotations
+           of kinds[0 .. turns-1] by angles are yet to be applied, up to three at a time */
+        int shifted = 0, kinds[3], turns = 0;
         spread_n(identity, 9, m, BLOCK);
         for (size_t c = k->dof_start[j]; c < k->dof_start[j + 1]; c++) {
             const size_t column = k->dof_column[c];
             const int kind = k->dof_kind[c];
             for (int f = 0; f < BLOCK; f++)
                 v[f] = rows[f][column];
+            shifted |= kind > MT_DOF_RZ;
             if (kind <= MT_DOF_RZ) {
                 for (int f = 0; f < BLOCK; f++)
-                    v[f] *= k->angle_scale;
-                sincos_lanes(v, sn, cs, BLOCK);
-                rotate_left_n(m, kind, sn, cs, BLOCK);
+                    angles[turns * BLOCK + f] = v[f] * k->angle_scale;
+                kinds[turns++] = kind;
+                if (turns == 3) {
+                    turn_left(m, angles, kinds, turns);
+                    turns = 0;
+                }
             } else if (kind <= MT_DOF_TZ) {
                 for (int f = 0; f < BLOCK; f++)
                     t[(kind - MT_DOF_TX) * BLOCK + f] += v[f];
@@ -92,6 +109,8 @@ static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *
                     stretch[f] += v[f];
             }
         }
+        if (turns)
+            turn_left(m, angles, kinds, turns);
         const double *c9 = k->axis + 9 * j;
         double l[9 * BLOCK];
         if (k->plain[j])
@@ -110,10 +129,13 @@ static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *
             const double *up = k->world + 9 * BLOCK * q;
             mat_mul_n(up, l, w, BLOCK);
             double vec[3 * BLOCK];
-            for (int e = 0; e < 3; e++)
-                for (int f = 0; f < BLOCK; f++)
-                    vec[e * BLOCK + f] = seg[e] + dir[e] * stretch[f] + c9[3 * e] * t[f] + c9[3 * e + 1] * t[BLOCK + f] +
-                                         c9[3 * e + 2] * t[2 * BLOCK + f];
+            if (shifted)
+                for (int e = 0; e < 3; e++)
+                    for (int f = 0; f < BLOCK; f++)
+                        vec[e * BLOCK + f] = seg[e] + dir[e] * stretch[f] + c9[3 * e] * t[f] +
+                                             c9[3 * e + 1] * t[BLOCK + f] + c9[3 * e + 2] * t[2 * BLOCK + f];
+            else
+                spread_n(seg, 3, vec, BLOCK);
             const double *turn = k->parent_frame && k->parent_frame[j] ? up : w, *from = k->end + 3 * BLOCK * q;
             for (int e = 0; e < 3; e++)
                 for (int f = 0; f < BLOCK; f++)
@@ -121,17 +143,17 @@ static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *
                                        turn[(3 * e + 1) * BLOCK + f] * vec[BLOCK + f] +
                                        turn[(3 * e + 2) * BLOCK + f] * vec[2 * BLOCK + f];
         }
-        for (size_t f = 0; f < n; f++) {
-            const size_t at = (f0 + f) * k->joints + j;
+        for (size_t f = 0; f < n; f++)
             for (int e = 0; e < 3; e++)
-                positions[3 * at + e] = p[e * BLOCK + f];
-            for (int e = 0; e < 9; e++) {
-                if (world_out)
-                    world_out[9 * at + e] = w[e * BLOCK + f];
-                if (local_out)
-                    local_out[9 * at + e] = l[e * BLOCK + f];
-            }
-        }
+                positions[3 * ((f0 + f) * k->joints + j) + (size_t)e] = p[e * BLOCK + f];
+        if (world_out)
+            for (size_t f = 0; f < n; f++)
+                for (int e = 0; e < 9; e++)
+                    world_out[9 * ((f0 + f) * k->joints + j) + (size_t)e] = w[e * BLOCK + f];
+        if (local_out)
+            for (size_t f = 0; f < n; f++)
+                for (int e = 0; e < 9; e++)
+                    local_out[9 * ((f0 + f) * k->joints + j) + (size_t)e] = l[e * BLOCK + f];
     }
 }
 
