@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import motiontheater as mt
+from motiontheater._io import PLAIN
 from motiontheater.cli import main
 from motiontheater.formats import table
 
@@ -90,3 +91,22 @@ def test_each_convention_has_its_suffix_and_companion():
     assert not table.states_unit("walk.BVH") and table.states_unit("walk.amc") and table.states_unit("p.csv")
     with pytest.raises(ValueError, match="no format writes motions of 'fbx' skeletons"):
         table.suffix_for("fbx")
+
+
+@pytest.mark.parametrize(
+    "name", ["cmu/01_01.amc", "hdm05/HDM_bd_lieDownFloor_004_120.amc", "bvh/walk01.bvh", "cmu/16_15.bvh"]
+)
+def test_a_take_read_without_its_layout_is_the_same_motion(data_dir, name):
+    """layout=False (a take looked at, not written back) reads the same values, header, rate and
+    frames, and leaves out only how the text is laid out, which a motion written from it then
+    takes plainly."""
+    path = data_dir / name
+    whole, cut = table.read_take_frames(path)
+    bare, bare_cut = table.read_take_frames(path, layout=False)
+    assert cut is None and bare_cut is None
+    np.testing.assert_array_equal(bare.values, whole.values)
+    assert (bare.frame_rate, bare.first_frame, bare.header) == (whole.frame_rate, whole.first_frame, whole.header)
+    assert bare.skeleton.joint_names == whole.skeleton.joint_names
+    assert (bare.style, bare.line_order) == (PLAIN, None)
+    if name.endswith(".amc"):
+        assert whole.line_order  # the file's own: the AMC reader keeps it where layout is read

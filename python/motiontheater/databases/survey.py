@@ -122,7 +122,8 @@ def _read(job: CheckJob) -> TakeCheck | tuple[Motion, Cut | None]:
     try:
         if job.bytes > STREAM_ABOVE and format_of(job.take).suffix == ".amc":
             return _streamed(job)
-        return read_take_frames(job.take, job.asf, job.frame_rate, job.unit, workers=1)
+        # looked at, not written back: the text's layout is not read
+        return read_take_frames(job.take, job.asf, job.frame_rate, job.unit, workers=1, layout=False)
     except (FormatError, ValueError, OSError, MemoryError) as e:
         return _unreadable(job, e)
 

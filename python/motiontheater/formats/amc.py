@@ -15,7 +15,7 @@ from mtcore import format_frames, format_number, scan_frames
 from mtcore.errors import ChangedFileError, TruncatedError
 from mtcore.text import copy_text, frame_line, line_breaks
 
-from .._io import LINE_BREAK, Source, Text, TextStyle, decode, encode, mapped_source, open_regular, output
+from .._io import LINE_BREAK, PLAIN, Source, Text, TextStyle, decode, encode, mapped_source, open_regular, output
 from ..model.errors import FormatError, SequenceError
 from ..model.motion import DEFAULT_FRAME_RATE, Motion
 from ..model.skeleton import Skeleton
@@ -95,7 +95,12 @@ def _header_rate(header: list[tuple[int, str]]) -> float | None:
 
 
 def read_amc(
-    source: Source, skeleton: Skeleton, frame_rate: float | None = None, *, workers: int | None = None
+    source: Source,
+    skeleton: Skeleton,
+    frame_rate: float | None = None,
+    *,
+    workers: int | None = None,
+    layout: bool = True,
 ) -> Motion:
     """Read an AMC file (path or file object) of ``skeleton`` into a :class:`Motion`.
 
@@ -110,31 +115,45 @@ def read_amc(
     what was expected; an AMC of another skeleton fails on its first unknown
     or missing bone.  Files of several megabytes are scanned on all cores;
     ``workers=1`` keeps to the calling thread (as batch jobs in processes should).
+    ``layout=False`` reads the values and the header only, not how the text is laid out (line
+    endings, exponents, the order of a frame's lines): for a take that is looked at, not
+    written back (what is written from it is laid out plainly).
     """
-    return _read_source(source, skeleton, frame_rate, workers, whole_frames=False)[0]
+    return _read_source(source, skeleton, frame_rate, workers, whole_frames=False, layout=layout)[0]
 
 
 def read_amc_frames(
-    source: Source, skeleton: Skeleton, frame_rate: float | None = None, *, workers: int | None = None
+    source: Source,
+    skeleton: Skeleton,
+    frame_rate: float | None = None,
+    *,
+    workers: int | None = None,
+    layout: bool = True,
 ) -> tuple[Motion, Cut | None]:
     """:func:`read_amc`, but of a file that breaks off in its last frame (a capture or a copy
     cut short), the frames before it, and where it breaks off (None for a whole file).  Such a
     motion has no file to be written back from: it is written anew, whole."""
-    return _read_source(source, skeleton, frame_rate, workers, whole_frames=True)
+    return _read_source(source, skeleton, frame_rate, workers, whole_frames=True, layout=layout)
 
 
 def _read_source(
-    source: Source, skeleton: Skeleton, frame_rate: float | None, workers: int | None, *, whole_frames: bool
+    source: Source,
+    skeleton: Skeleton,
+    frame_rate: float | None,
+    workers: int | None,
+    *,
+    whole_frames: bool,
+    layout: bool,
 ) -> tuple[Motion, Cut | None]:
     with mapped_source(source) as (data, name):
         try:
             try:
-                return _read(data, name, skeleton, frame_rate, workers).read_from(source), None
+                return _read(data, name, skeleton, frame_rate, workers, layout).read_from(source), None
             except TruncatedError as e:
                 if not whole_frames:
                     raise
                 last = frame_line(data, 0, len(data), last=True)  # the frame the file breaks off in
-                motion = _read(copy_text(data, 0, max(last, 0)), name, skeleton, frame_rate, workers)
+                motion = _read(copy_text(data, 0, max(last, 0)), name, skeleton, frame_rate, workers, layout)
                 reason = f"the file breaks off in its last frame: the {motion.frames} frames before it are whole"
                 return motion, Cut(reason, e.line, motion.frames)
         except ChangedFileError:
@@ -160,7 +179,9 @@ def _read_header(
     return header, body, header_lines, rate or frame_rate or DEFAULT_FRAME_RATE
 
 
-def _read(data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | None, workers: int | None) -> Motion:
+def _read(
+    data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | None, workers: int | None, layout: bool
+) -> Motion:
     # Python reads a copy of the head (header, first frame, style); only the C scanner, which is
     # guarded against a file that shrinks meanwhile, reads a mapped file itself
     head = _head(data)
@@ -180,8 +201,8 @@ def _read(data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | 
         frame_rate=rate,
         first_frame=first if len(values) else 1,
         header=tuple(text for _, text in header),
-        line_order=_first_frame_order(head, body, set(joints)),
-        style=TextStyle.of(data),
+        line_order=_first_frame_order(head, body, set(joints)) if layout else None,
+        style=TextStyle.of(data) if layout else PLAIN,
     )
 
 

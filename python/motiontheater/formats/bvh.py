@@ -18,7 +18,7 @@ import numpy as np
 from mtcore.errors import CountError, FormatError, MissingError, SequenceError, TruncatedError
 from mtcore.text import format_number, format_table, parse_number, scan_table
 
-from .._io import LINE_BREAK, Source, TextStyle, decode, output, read_source
+from .._io import LINE_BREAK, PLAIN, Source, TextStyle, decode, output, read_source
 from ..model.motion import Motion
 from ..model.rates import rate_of_frame_time
 from ..model.rig import STANDING, sampled_poses, standing_frame, standing_height
@@ -40,7 +40,9 @@ _FRAMES = re.compile(rb"^[ \t]*Frames[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECAS
 _FRAME_TIME = re.compile(rb"^[ \t]*Frame[ \t]+Time[ \t]*:[ \t]*(\S+)[ \t]*\r?$", re.IGNORECASE | re.MULTILINE)
 
 
-def read_bvh(source: Source, *, unit: str | None = None, frame_rate: float | None = None) -> Motion:
+def read_bvh(
+    source: Source, *, unit: str | None = None, frame_rate: float | None = None, layout: bool = True
+) -> Motion:
     """Read a BVH file (path or file object) into a :class:`Motion` of a BVH skeleton.
 
     A BVH file states no length unit: ``unit`` gives it (m, cm, mm, in, or a
@@ -57,27 +59,29 @@ def read_bvh(source: Source, *, unit: str | None = None, frame_rate: float | Non
     30 Hz), or ``frame_rate`` (Hz) when given; the Frame Time's text is
     written back as found while the rate stays the one it stands for.  Bad
     input raises a :class:`~mtcore.errors.FormatError` subclass naming the
-    file and line.
+    file and line.  ``layout=False`` reads the values and the header only, not how
+    the text is laid out (line endings, exponents): for a take that is looked at,
+    not written back (what is written from it is laid out plainly).
     """
-    return _read_source(source, unit, frame_rate, whole_frames=False)[0]
+    return _read_source(source, unit, frame_rate, whole_frames=False, layout=layout)[0]
 
 
 def read_bvh_frames(
-    source: Source, *, unit: str | None = None, frame_rate: float | None = None
+    source: Source, *, unit: str | None = None, frame_rate: float | None = None, layout: bool = True
 ) -> tuple[Motion, Cut | None]:
     """:func:`read_bvh`, but of a file whose MOTION section disagrees with its header (fewer
     rows than ``Frames:`` says, more, or a last row cut short), the rows it holds whole, and how
     it disagrees (None for a whole file).  Such a motion has no file to be written back from: it
     is written anew, with a header that says its frames."""
-    return _read_source(source, unit, frame_rate, whole_frames=True)
+    return _read_source(source, unit, frame_rate, whole_frames=True, layout=layout)
 
 
 def _read_source(
-    source: Source, unit: str | None, frame_rate: float | None, *, whole_frames: bool
+    source: Source, unit: str | None, frame_rate: float | None, *, whole_frames: bool, layout: bool
 ) -> tuple[Motion, Cut | None]:
     data, name = read_source(source)
     try:
-        motion, cut = _read(data, whole_frames)
+        motion, cut = _read(data, whole_frames, layout)
     except FormatError as e:
         raise e.at(name) from None
     motion = motion.replace(skeleton=settle_length_unit(_posed(motion), unit))
@@ -109,7 +113,7 @@ def _posed(motion: Motion) -> Skeleton:
     return replace(skeleton, posed=posed) if posed.unit is not None else skeleton
 
 
-def _read(data, whole_frames: bool = False) -> tuple[Motion, Cut | None]:
+def _read(data, whole_frames: bool = False, layout: bool = True) -> tuple[Motion, Cut | None]:
     motion_at = re.search(rb"^[ \t]*MOTION[ \t]*\r?$", data, re.MULTILINE)
     if motion_at is None:
         raise MissingError("no MOTION section", data.count(b"\n") + 1)
@@ -166,7 +170,7 @@ def _read(data, whole_frames: bool = False) -> tuple[Motion, Cut | None]:
         first_frame=1,
         header=(f"Frame Time: {frame_time}",),
         line_order=None,
-        style=TextStyle.of(data),
+        style=TextStyle.of(data) if layout else PLAIN,
     )
     return motion, cut
 

@@ -45,7 +45,9 @@ class Format:
     ``states_unit`` whether its files state their length unit (a BVH file does not);
     ``takes`` the names of the takes a file holds where it may hold several (glTF's animations;
     ``read`` gives the first); ``read_frames`` reads as ``read`` does but keeps the frames of a
-    file that breaks off (:func:`read_take_frames`), where the format can break off so.
+    file that breaks off (:func:`read_take_frames`), where the format can break off so;
+    ``layout`` whether both also take ``layout=`` (:func:`read_file`: a text format that keeps
+    how its text is laid out, to write it back so).
     """
 
     suffix: str
@@ -59,6 +61,7 @@ class Format:
     states_unit: bool = True
     takes: Callable[[str | os.PathLike], list[str]] | None = None
     read_frames: ReadFrames | None = None
+    layout: bool = False
 
     @property
     def holds_takes(self) -> bool:
@@ -66,20 +69,20 @@ class Format:
         return self.read is not None
 
 
-def _read_amc(path, skeleton, frame_rate, unit, workers) -> Motion:
-    return read_amc(path, skeleton, frame_rate, workers=workers)
+def _read_amc(path, skeleton, frame_rate, unit, workers, layout=True) -> Motion:
+    return read_amc(path, skeleton, frame_rate, workers=workers, layout=layout)
 
 
-def _read_bvh(path, skeleton, frame_rate, unit, workers) -> Motion:
-    return read_bvh(path, unit=unit, frame_rate=frame_rate)
+def _read_bvh(path, skeleton, frame_rate, unit, workers, layout=True) -> Motion:
+    return read_bvh(path, unit=unit, frame_rate=frame_rate, layout=layout)
 
 
-def _amc_frames(path, skeleton, frame_rate, unit, workers) -> tuple[Motion, Cut | None]:
-    return read_amc_frames(path, skeleton, frame_rate, workers=workers)
+def _amc_frames(path, skeleton, frame_rate, unit, workers, layout=True) -> tuple[Motion, Cut | None]:
+    return read_amc_frames(path, skeleton, frame_rate, workers=workers, layout=layout)
 
 
-def _bvh_frames(path, skeleton, frame_rate, unit, workers) -> tuple[Motion, Cut | None]:
-    return read_bvh_frames(path, unit=unit, frame_rate=frame_rate)
+def _bvh_frames(path, skeleton, frame_rate, unit, workers, layout=True) -> tuple[Motion, Cut | None]:
+    return read_bvh_frames(path, unit=unit, frame_rate=frame_rate, layout=layout)
 
 
 def _bvh_skeleton(path) -> Skeleton:
@@ -93,7 +96,9 @@ def _read_gltf(path, skeleton, frame_rate, unit, workers) -> Motion:
 
 FORMATS: dict[str, Format] = {
     ".asf": Format(".asf", "ASF", "asf", read_skeleton=read_asf, write_skeleton=write_asf),
-    ".amc": Format(".amc", "ASF/AMC", "asf", _read_amc, write_amc, companion=".asf", read_frames=_amc_frames),
+    ".amc": Format(
+        ".amc", "ASF/AMC", "asf", _read_amc, write_amc, companion=".asf", read_frames=_amc_frames, layout=True
+    ),
     ".bvh": Format(
         ".bvh",
         "BVH",
@@ -103,6 +108,7 @@ FORMATS: dict[str, Format] = {
         read_skeleton=_bvh_skeleton,
         states_unit=False,
         read_frames=_bvh_frames,
+        layout=True,
     ),
     # glTF takes are read as BVH motions and written by the export step (views/export.py)
     ".glb": Format(".glb", "glTF binary", "bvh", _read_gltf, takes=animation_names),
@@ -216,7 +222,7 @@ def read_take(
     its header states none, and a BVH's in place of its Frame Time.  ``unit`` is its length unit
     (m, cm, mm, in, or a number L for inch / L) when given: a BVH's is detected from its size
     otherwise, an ASF's is its ``:units length``.  The take must hold at least one frame."""
-    return _read_take(path, asf, frame_rate, unit, workers, whole_frames=False)[0]
+    return _read_take(path, asf, frame_rate, unit, workers, whole_frames=False, layout=True)[0]
 
 
 def read_take_frames(
@@ -226,12 +232,13 @@ def read_take_frames(
     unit: str | None = None,
     *,
     workers: int | None = None,
+    layout: bool = True,
 ) -> tuple[Motion, Cut | None]:
     """:func:`read_take`, but of a file that breaks off before its header says it ends, or goes
     on past it (a BVH of fewer or more rows than ``Frames:`` says, a last frame cut short), the
     frames it holds whole, and how it disagrees (None for a whole file, or a format that cannot
-    break off so)."""
-    return _read_take(path, asf, frame_rate, unit, workers, whole_frames=True)
+    break off so).  ``layout`` as for :func:`read_file`."""
+    return _read_take(path, asf, frame_rate, unit, workers, whole_frames=True, layout=layout)
 
 
 def _read_take(
@@ -242,12 +249,13 @@ def _read_take(
     workers: int | None,
     *,
     whole_frames: bool,
+    layout: bool,
 ) -> tuple[Motion, Cut | None]:
     format_of(path)  # an unknown suffix is told before a missing file
     regular_file(path)
     companion = skeleton_for(path, asf)
     skeleton = None if companion is None else read_skeleton(companion, unit)
-    motion, cut = read_file(path, skeleton, frame_rate, unit, workers, whole_frames=whole_frames)
+    motion, cut = read_file(path, skeleton, frame_rate, unit, workers, whole_frames=whole_frames, layout=layout)
     return require_frames(motion, path), cut
 
 
@@ -259,15 +267,20 @@ def read_file(
     workers: int | None,
     *,
     whole_frames: bool = False,
+    layout: bool = True,
 ) -> tuple[Motion, Cut | None]:
     """The motion of a take file by its format's reader, its skeleton read already (an AMC's;
     None where the file holds its own), and None; with ``whole_frames``, where the format can
-    break off, the frames it holds whole and where it breaks off (:func:`read_take_frames`)."""
+    break off, the frames it holds whole and where it breaks off (:func:`read_take_frames`).
+    ``layout=False`` reads the values and the header only, not how a text format lays them out
+    (line endings, exponents, the order of an AMC frame's lines): for a take that is looked at,
+    not written back (what is written from it is laid out plainly)."""
     row = format_of(path)
+    options = {"layout": layout} if row.layout else {}
     if whole_frames and row.read_frames is not None:
-        return row.read_frames(path, skeleton, frame_rate, unit, workers)
+        return row.read_frames(path, skeleton, frame_rate, unit, workers, **options)
     assert row.read is not None
-    return row.read(path, skeleton, frame_rate, unit, workers), None
+    return row.read(path, skeleton, frame_rate, unit, workers, **options), None
 
 
 def require_frames(motion: Motion, path: str | os.PathLike) -> Motion:
