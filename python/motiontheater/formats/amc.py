@@ -180,7 +180,12 @@ def _read_header(
 
 
 def _read(
-    data: Text, name: str | None, skeleton: Skeleton, frame_rate: float | None, workers: int | None, layout: bool
+    data: Text,
+    name: str | None,
+    skeleton: Skeleton,
+    frame_rate: float | None,
+    workers: int | None,
+    layout: bool = True,
 ) -> Motion:
     # Python reads a copy of the head (header, first frame, style); only the C scanner, which is
     # guarded against a file that shrinks meanwhile, reads a mapped file itself
