@@ -133,7 +133,7 @@ int mt_check_trim(const double *q, size_t frames, size_t runs, const size_t *fir
    NaN left out, 0 for none. */
 static double shift_at(const struct mt_turned *k, size_t r, const double *actual, const double *instead)
 {
-    const double *w = k->world + 9 * (k->joints * r + k->joint), *c = k->axis;
+    const double *w = k->world + 9 * (k->turned * r + k->row), *c = k->axis;
     double frame[9], error[9];
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {
@@ -179,7 +179,7 @@ int mt_check_seen(const struct mt_turned *k, const double *q, size_t runs, const
     if (runs == 0)
         return MT_OK;
     if (!k || !q || !first || !last || !before || !after || !off || !filled || !k->places || !k->world || !k->axis ||
-        (k->count > 0 && !k->points) || k->joint >= k->joints || k->origin >= k->joints)
+        (k->count > 0 && !k->points) || k->joint >= k->joints || k->origin >= k->joints || k->row >= k->turned)
         return MT_EINVAL;
     for (size_t p = 0; p < k->count; p++)
         if (k->points[p] >= k->joints)

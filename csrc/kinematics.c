@@ -58,6 +58,8 @@ struct fk {
     const int *dof_kind;
     const unsigned char *parent_frame; /* the segment turns with the parent (BVH), or NULL */
     const unsigned char *plain;        /* C is the identity: L = M */
+    const long long *world_rows;       /* each joint's row of the world output (-1: none), or NULL: its own */
+    size_t world_count;                /* the world output's rows a frame */
     double angle_scale;
     double *world; /* scratch: each joint's world rotation over the block (9 BLOCK values a joint) */
     double *end;   /* scratch: each joint's end point over the block (3 BLOCK values a joint) */
@@ -146,10 +148,11 @@ static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *
         for (size_t f = 0; f < n; f++)
             for (int e = 0; e < 3; e++)
                 positions[3 * ((f0 + f) * k->joints + j) + (size_t)e] = p[e * BLOCK + f];
-        if (world_out)
+        const long long row = k->world_rows ? k->world_rows[j] : (long long)j;
+        if (world_out && row >= 0)
             for (size_t f = 0; f < n; f++)
                 for (int e = 0; e < 9; e++)
-                    world_out[9 * ((f0 + f) * k->joints + j) + (size_t)e] = w[e * BLOCK + f];
+                    world_out[9 * ((f0 + f) * k->world_count + (size_t)row) + (size_t)e] = w[e * BLOCK + f];
         if (local_out)
             for (size_t f = 0; f < n; f++)
                 for (int e = 0; e < 9; e++)
@@ -162,7 +165,8 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
                           const double *direction, const double *segment, const size_t *dof_start,
                           const int *dof_kind, const size_t *dof_column,
                           const unsigned char *parent_frame, double angle_scale, size_t begin,
-                          size_t end, double *positions, double *world, double *local)
+                          size_t end, double *positions, double *world, double *local,
+                          const long long *world_rows, size_t world_count)
 {
     if (begin > end || end > frames)
         return MT_EINVAL;
@@ -171,11 +175,28 @@ int mt_forward_kinematics(const double *values, size_t frames, size_t channels, 
     if (!parent || !order || !direction || !segment || !positions ||
         check_channels(values, frames, channels, joints, axis, dof_start, dof_kind, dof_column) != MT_OK)
         return MT_EINVAL;
+    if (world_rows)
+        for (size_t j = 0; j < joints; j++)
+            if (world_rows[j] < -1 || (world_rows[j] >= 0 && (size_t)world_rows[j] >= world_count))
+                return MT_EINVAL;
     int status = check_tree(joints, parent, order);
     if (status != MT_OK)
         return status;
-    struct fk k = {values,    channels,   joints,   parent,       order, axis,        direction, segment,
-                   dof_start, dof_column, dof_kind, parent_frame, NULL,  angle_scale, NULL,      NULL};
+    struct fk k = {.values = values,
+                   .channels = channels,
+                   .joints = joints,
+                   .parent = parent,
+                   .order = order,
+                   .axis = axis,
+                   .direction = direction,
+                   .segment = segment,
+                   .dof_start = dof_start,
+                   .dof_column = dof_column,
+                   .dof_kind = dof_kind,
+                   .parent_frame = parent_frame,
+                   .world_rows = world_rows,
+                   .world_count = world_rows ? world_count : joints,
+                   .angle_scale = angle_scale};
     unsigned char *plain = malloc(joints);
     k.world = malloc(joints * 9 * BLOCK * sizeof *k.world);
     k.end = malloc(joints * 3 * BLOCK * sizeof *k.end);

@@ -313,15 +313,19 @@ enum mt_dof {
  * parent).  parent_frame may be NULL (no joint set).
  *
  * Writes, for frames begin .. end-1, positions (frames x joints x 3) and,
- * where not NULL, world and local (frames x joints x 9).  NaN in a channel
- * gives NaN in that joint and its descendants.
+ * where not NULL, world and local (frames x joints x 9).  world_rows, where
+ * not NULL, keeps world to some joints (a caller that reads a few of them
+ * writes a fraction of the memory): joint j's world rotation goes to row
+ * world_rows[j] (-1: none) of world, then frames x world_count x 9.  NaN in a
+ * channel gives NaN in that joint and its descendants.
  */
 int mt_forward_kinematics(const double *values, size_t frames, size_t channels, size_t joints,
                           const long long *parent, const long long *order, const double *axis,
                           const double *direction, const double *segment, const size_t *dof_start,
                           const int *dof_kind, const size_t *dof_column,
                           const unsigned char *parent_frame, double angle_scale, size_t begin,
-                          size_t end, double *positions, double *world, double *local);
+                          size_t end, double *positions, double *world, double *local,
+                          const long long *world_rows, size_t world_count);
 
 /*
  * Local rotations of chosen joints of a tree (the tables of mt_forward_kinematics) as unit
@@ -1183,14 +1187,14 @@ int mt_check_trim(const double *q, size_t frames, size_t runs, const size_t *fir
 
 /*
  * What spikes of one joint's rotation move (check_spikes.c): the points the joint turns, from a
- * take's forward kinematics.  places (frames x joints x 3) and world (frames x joints x 9,
- * row-major) are every joint's end and world rotation; the joint's channels turn about its
- * world rotation times axis (9); the points (count of them, indices of joints) are what it
- * turns, their offsets taken from joint `origin`'s place.
+ * take's forward kinematics.  places (frames x joints x 3) are every joint's end, world (frames
+ * x turned x 9, row-major) world rotations, the joint's at row `row`; the joint's channels turn
+ * about its world rotation times axis (9); the points (count of them, indices of joints) are
+ * what it turns, their offsets taken from joint `origin`'s place.
  */
 struct mt_turned {
     const double *places, *world;
-    size_t frames, joints, joint, origin;
+    size_t frames, joints, joint, origin, turned, row;
     const double *axis;
     const size_t *points;
     size_t count;

@@ -537,7 +537,7 @@ int mt_retarget(const double *values, size_t frames, const struct mt_tree *sourc
         status = mt_forward_kinematics(values + c0 * source->channels, n, source->channels, js, source->parent,
                                        source->order, source->axis, source->direction, source->segment,
                                        source->dof_start, source->dof_kind, source->dof_column,
-                                       source->parent_frame, source->angle_scale, 0, n, points, world, NULL);
+                                       source->parent_frame, source->angle_scale, 0, n, points, world, NULL, NULL, 0);
         for (size_t f0 = 0; f0 < n && status == MT_OK; f0 += BLOCK)
             status = retarget_block(&k, world, points, f0, n - f0 < BLOCK ? n - f0 : BLOCK, out + c0 * target->channels);
     }

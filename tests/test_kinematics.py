@@ -9,7 +9,7 @@ from scipy.spatial.transform import Rotation
 import motiontheater as mt
 from corpus import ids, real_files
 from mtcore import rotations as rot
-from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions
+from mtcore.kinematics import JointTree, forward_kinematics, local_quaternions, world_kinematics
 from twins.kinematics import motion_kinematics as twin
 
 REFS = real_files("hdm05/*.ref.npz")
@@ -226,7 +226,7 @@ def test_the_c_kernel_checks_the_tree_again():
     status = lib.mt_forward_kinematics(
         c_array(np.zeros((1, 1))), 1, 1, 2, c_array(parent, "long long[]"), c_array(order, "long long[]"),
         c_array(np.tile(np.eye(3), (2, 1))), c_array(np.zeros(6)), c_array(np.zeros(6)), c_array(start, "size_t[]"),
-        ffi.NULL, ffi.NULL, ffi.NULL, 1.0, 0, 1, c_array(positions), ffi.NULL, ffi.NULL,
+        ffi.NULL, ffi.NULL, ffi.NULL, 1.0, 0, 1, c_array(positions), ffi.NULL, ffi.NULL, ffi.NULL, 0,
     )  # fmt: skip
     assert status == lib.MT_EINVAL
 
@@ -330,3 +330,23 @@ def test_euler_conversions_equal_the_numpy_twin(rng, order, extrinsic):
     back = rot.matrices_to_euler(matrices, order, extrinsic=extrinsic)
     np.testing.assert_allclose(back, angles, rtol=0, atol=1e-11)
     np.testing.assert_allclose(back, euler_twin.matrices_to_euler(matrices, order, extrinsic=extrinsic), atol=1e-11)
+
+
+@pytest.mark.parametrize("amc", AMCS[:2], ids=ids(AMCS[:2]))
+def test_world_rotations_kept_to_a_few_joints_are_theirs_of_every_joint(amc):
+    """turned keeps the world rotations to those joints, in their order, the same numbers as
+    every joint's; the positions do not change; a joint left out is named when asked for."""
+    take = load(amc)
+    tree = take.skeleton.tree
+    every = world_kinematics(take.values, tree)
+    few = world_kinematics(take.values, tree, turned=[0, 3, 7])
+    np.testing.assert_array_equal(few.positions, every.positions)
+    np.testing.assert_array_equal(few.world, every.world[:, [0, 3, 7]])
+    np.testing.assert_array_equal(few.world[:, few.rows([7, 0])], every.world[:, [7, 0]])
+    np.testing.assert_array_equal(every.rows([5]), [5])
+    with pytest.raises(ValueError, match="joint 4 was kept"):
+        few.rows([3, 4])
+    with pytest.raises(ValueError, match="ascending"):
+        world_kinematics(take.values, tree, turned=[3, 0])
+    with pytest.raises(ValueError, match="turned must lie"):
+        world_kinematics(take.values, tree, turned=[0, tree.joints])

@@ -306,17 +306,19 @@ def seen_runs(
     last: ArrayLike,
     meters: float,
     keys: tuple[ArrayLike, ArrayLike] | None = None,
+    row: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """What runs of rows first .. last (1 <= first <= last <= frames - 2) of a joint's rotation
     move (``mt_check_seen``, csrc/mtcore.h), from the take's ``places`` (frames, joints, 3) and
-    ``world`` rotations (frames, joints, 3, 3): the ``points`` it turns (joint indices, offsets
+    ``world`` rotations (frames, turned, 3, 3; the joint's at ``row``, by default every joint's
+    and the joint's own index): the ``points`` it turns (joint indices, offsets
     from joint ``origin``'s place) about its world rotation times ``axis`` (3, 3), its rotation
     at each frame ``quaternions`` (frames, 4): how far they lie off midway between the rows
     around, and how far from where the SLERP between the rows ``keys`` (before, after; by
     default those around the run) would put them, in metres (``meters`` a unit), per run."""
     p = _checks.real(places, "places", (None, None, 3))
     frames, joints = p.shape[:2]
-    w = _checks.real(world, "world", (frames, joints, 3, 3))
+    w = _checks.real(world, "world", (frames, None if row is not None else joints, 3, 3))
     q = _checks.real(quaternions, "quaternions", (frames, 4))
     c = _checks.real(axis, "axis", (3, 3))
     chosen = _checks.integers(points, "points", (None,), 0, joints, np.uintp)
@@ -335,6 +337,8 @@ def seen_runs(
     turned.frames, turned.joints, turned.count = frames, joints, len(chosen)
     turned.joint = _checks.integer(joint, "joint", 0, joints - 1)
     turned.origin = _checks.integer(origin, "origin", 0, joints - 1)
+    turned.turned = w.shape[1]
+    turned.row = turned.joint if row is None else _checks.integer(row, "row", 0, w.shape[1] - 1)
     off, filled = np.empty(len(b)), np.empty(len(b))
     status = lib.mt_check_seen(turned, c_array(q), len(b), c_array(a, "size_t[]"), c_array(b, "size_t[]"),
                                c_array(k0, "size_t[]"), c_array(k1, "size_t[]"), float(meters), c_array(off),

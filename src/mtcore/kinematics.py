@@ -6,8 +6,10 @@ Array level: joints are indices; motiontheater builds the tables from a skeleton
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _checks
 from ._cdata import c_array
@@ -135,23 +137,53 @@ def _values_of(values: np.ndarray, tree: JointTree) -> np.ndarray:
     return values
 
 
-Kinematics = tuple[np.ndarray, np.ndarray]
-"""Every joint's position (frames, joints, 3) and world rotation (frames, joints, 3, 3), as
-:func:`forward_kinematics` gives them with ``world=True``: what a caller that needs both for
-several purposes works out once and hands on."""
+class Kinematics(NamedTuple):
+    """Every joint's position (frames, joints, 3) and the world rotations (frames, len(turned), 3,
+    3) of the joints ``turned`` lists (ascending; every joint unless fewer were asked for), as
+    :func:`world_kinematics` gives them: what a caller that needs both for several purposes works
+    out once and hands on."""
+
+    positions: np.ndarray
+    world: np.ndarray
+    turned: np.ndarray
+
+    def rows(self, joints: ArrayLike) -> np.ndarray:
+        """Each joint's row of ``world``; ValueError for a joint whose rotation was not kept."""
+        wanted = np.asarray(joints, dtype=np.intp)
+        at = np.searchsorted(self.turned, wanted)
+        kept = at < len(self.turned)
+        kept[kept] = self.turned[at[kept]] == wanted[kept]
+        if not kept.all():
+            raise ValueError(f"no world rotation of joint {int(wanted[~kept].flat[0])} was kept")
+        return at
 
 
 def forward_kinematics(
-    values: np.ndarray, tree: JointTree, *, world: bool = False, local: bool = False, workers: int | None = None
+    values: np.ndarray,
+    tree: JointTree,
+    *,
+    world: bool = False,
+    local: bool = False,
+    turned: ArrayLike | None = None,
+    workers: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
     """Positions (frames, joints, 3) of each joint's end, and optionally world and
-    local rotations (frames, joints, 3, 3), for values (frames, channels).
+    local rotations (frames, joints, 3, 3), for values (frames, channels); ``turned`` (joint
+    indices, ascending) keeps the world rotations to those joints' (frames, len(turned), 3, 3),
+    for a caller that reads a few of them (they are most of the memory written).
     Frames are split over the cores for large motions (``workers`` as for the filters)."""
     values = _values_of(values, tree)
     frames, channels = values.shape
     n = tree.joints
+    kept = None if turned is None else _checks.integers(turned, "turned", (None,), 0, n)
+    if kept is not None and np.any(np.diff(kept) <= 0):
+        raise ValueError("turned must list joints in ascending order, each once")
+    rows = None
+    if kept is not None:
+        rows = np.full(n, -1, np.int64)
+        rows[kept] = np.arange(len(kept))
     positions = np.empty((frames, n, 3))
-    world_out = np.empty((frames, n, 3, 3)) if world else None
+    world_out = np.empty((frames, n if kept is None else len(kept), 3, 3)) if world else None
     local_out = np.empty((frames, n, 3, 3)) if local else None
     bounds = even_bounds(frames, thread_count(workers, frames * n >= _PARALLEL_MIN_TRANSFORMS))
     args = (
@@ -170,18 +202,27 @@ def forward_kinematics(
         c_array(tree.parent_frame, "unsigned char[]"),
         tree.angle_scale,
     )
-    outs = (c_array(positions), c_array(world_out), c_array(local_out))
+    outs = (
+        c_array(positions),
+        c_array(world_out),
+        c_array(local_out),
+        c_array(rows, "long long[]"),
+        0 if kept is None else len(kept),
+    )
 
     run_ranges(lambda begin, end: lib.mt_forward_kinematics(*args, begin, end, *outs), bounds, "mt_forward_kinematics")
     return positions, world_out, local_out
 
 
-def world_kinematics(values: np.ndarray, tree: JointTree, *, workers: int | None = None) -> Kinematics:
-    """Every joint's position and world rotation (:data:`Kinematics`): :func:`forward_kinematics`
-    with ``world=True``."""
-    positions, world, _ = forward_kinematics(values, tree, world=True, workers=workers)
+def world_kinematics(
+    values: np.ndarray, tree: JointTree, *, turned: ArrayLike | None = None, workers: int | None = None
+) -> Kinematics:
+    """Every joint's position and the world rotations of ``turned`` (default every joint's):
+    :func:`forward_kinematics` with ``world=True``."""
+    positions, world, _ = forward_kinematics(values, tree, world=True, turned=turned, workers=workers)
     assert world is not None  # asked for
-    return positions, world
+    kept = np.arange(tree.joints) if turned is None else np.asarray(turned, dtype=np.intp)
+    return Kinematics(positions, world, kept)
 
 
 def local_quaternions(values: np.ndarray, tree: JointTree, joints, turn: np.ndarray | None = None) -> np.ndarray:

@@ -259,10 +259,10 @@ def trim_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
-def seen_twin(places, world, joint, origin, axis, points, quaternions, first, last, meters, keys=None):
+def seen_twin(places, world, joint, origin, axis, points, quaternions, first, last, meters, keys=None, row=None):
     """Each run's rows one at a time: the points' distance from midway between the rows around,
     and from where the SLERP (the twin's) between the rows ``keys`` (those around the run)
-    would put them."""
+    would put them; the joint's world rotation at ``row`` of world (default its own index)."""
     places, world, q = np.asarray(places, float), np.asarray(world, float), np.asarray(quaternions, float)
     points = np.asarray(points, int)
     off, filled = np.zeros(len(first)), np.zeros(len(first))
@@ -278,7 +278,7 @@ def seen_twin(places, world, joint, origin, axis, points, quaternions, first, la
             p = places * meters
             off[i] = max(off[i], farthest(p[r, points] - 0.5 * (p[r - 1, points] + p[r + 1, points])))
             path = rotations.slerp(q[k0], q[k1], (r - k0) / (k1 - k0))
-            frame = world[r, joint] @ np.asarray(axis, float)
+            frame = world[r, joint if row is None else row] @ np.asarray(axis, float)
             error = rotations.quaternions_to_matrices(q[r]).T @ rotations.quaternions_to_matrices(path)
             local = [frame.T @ (places[r, k] - places[r, origin]) for k in points]
             filled[i] = max(filled[i], farthest([error @ x - x for x in local]) * meters)
@@ -306,6 +306,8 @@ def seen_cases(rng: np.random.Generator) -> list[tuple]:
         out.append((places, world, 1, 0, axis, points, q, first, last, 0.05))
         at = np.arange(2, frames - 1)  # jumps: the rotation going on from the two rows before
         out.append((places, world, 1, 0, axis, points, q, at, at, 0.05, (at - 2, at - 1)))
+        # the world rotations of a few joints only, the joint's in the second row
+        out.append((places, world[:, [0, 1]], 1, 0, axis, points, q, first, last, 0.05, None, 1))
     return out
 
 

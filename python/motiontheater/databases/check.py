@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -39,6 +40,7 @@ from ..model.rig import body_joint
 from ..model.skeleton import ROTATIONS, TRANSLATIONS, Skeleton
 from ..model.units import HUMAN_HEIGHT
 from ..model.vectors import lengths
+from . import check_arms, check_feet
 from .check_arms import arm_findings
 from .check_feet import leg_findings
 from .check_pace import dropped_findings
@@ -130,14 +132,28 @@ class _Take:
         # each channel's joint, and its joint's rotation or position channels, numbered in the
         # order of their names (the order events are joined in)
         self.joints, self.kinds = skeleton.derived("check channel groups", lambda: _groups(self.channels))
+        self.joint_of = skeleton.derived("check channel joints", lambda: _joint_indices(skeleton, self.channels))
         self._quaternions: dict[str, np.ndarray] = {}
         self._turns: dict[tuple[str, int], np.ndarray] = {}
-        # the joints' places and turns, for the spikes, steps, legs and arms alike (a piece's at most)
-        self.held: Kinematics = world_kinematics(motion.values, skeleton.tree, workers=1)
+        # the joints whose world rotations the detectors read (:attr:`held`): the legs' and arms',
+        # and those of the joints with spikes or steps (:meth:`keep`)
+        self._turned = set(skeleton.derived("check turned joints", lambda: _turned_joints(skeleton)))
         # the turning spikes that what they move settles (:func:`_settled`), by id: (finding,
         # first row, last row, degrees, high by their angles)
         self.unsettled: dict[int, tuple[Finding, int, int, float, bool]] = {}
         self.begins, self.ends = True, True  # whether these frames begin and end the take
+
+    def keep(self, joints: Iterable[int]) -> None:
+        """Keep the world rotations of these joints (indices) too, before :attr:`held` is first read."""
+        self._turned.update(joints)
+
+    @cached_property
+    def held(self) -> Kinematics:
+        """The joints' places and the world rotations kept (:meth:`keep`), for the spikes, steps,
+        legs and arms alike (a piece's at most): world rotations are most of what forward
+        kinematics writes, and the detectors read a few joints'."""
+        tree = self.motion.skeleton.tree
+        return world_kinematics(self.motion.values, tree, turned=sorted(self._turned), workers=1)
 
     def frame(self, row: int) -> int:
         return self.motion.first_frame + int(row)
@@ -237,8 +253,8 @@ class _Take:
         skeleton = self.motion.skeleton
         j = skeleton.joint_names.index(joint)
         return kernel.seen_runs(
-            *self.held, j, self._origin(j), skeleton.tree.axis[j], self._points(joint),
-            self.quaternions(joint, slice(None)), first, last, self.meters, keys,
+            self.held.positions, self.held.world, j, self._origin(j), skeleton.tree.axis[j], self._points(joint),
+            self.quaternions(joint, slice(None)), first, last, self.meters, keys, int(self.held.rows([j])[0]),
         )  # fmt: skip
 
     def _origin(self, j: int) -> int:
@@ -332,6 +348,17 @@ def _groups(channels: list[_Channel]) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
+def _joint_indices(skeleton: Skeleton, channels: list[_Channel]) -> np.ndarray:
+    """Each channel's joint's index among the skeleton's joints."""
+    index = {name: i for i, name in enumerate(skeleton.joint_names)}
+    return np.array([index[c.joint] for c in channels], dtype=np.intp)
+
+
+def _turned_joints(skeleton: Skeleton) -> list[int]:
+    """The joints whose world rotations the legs' and arms' detectors read."""
+    return check_feet.turned_joints(skeleton) + check_arms.turned_joints(skeleton)
+
+
 def _angle_deg(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
     """The angle of the rotation between unit quaternions, in degrees."""
     p = q0 * q1  # summed as np.sum does, a third of its time (numpy reduces an axis of 4 slowly)
@@ -385,6 +412,7 @@ def _check_piece(motion: Motion, take: str, begins: bool, ends: bool) -> list[Fi
         min_run = max(3, round(FROZEN_SECONDS * t.rate))
         found = kernel.channel_events(motion.values, spikes, steps, min_run)
         ev, sizes = found.events, found.sizes
+        t.keep(t.joint_of[ev[(ev[:, 3] == kernel.SPIKE) | (ev[:, 3] == kernel.STEP), 0]].tolist())
         by_kind = {kind: (ev[ev[:, 3] == kind], sizes[ev[:, 3] == kind]) for kind in kernel.KINDS}
         repeats = by_kind[kernel.REPEAT][0]
         findings += _repeats(t, repeats, rows)

@@ -47,7 +47,10 @@ def arm_findings(motion: Motion, take: str, kinematics: Kinematics | None = None
         kinematics = world_kinematics(motion.values, skeleton.tree, workers=1)
     names = skeleton.point_names
     out = []
-    bends, judged = elbow_bends(*kinematics, arms[:, 1], placing, BENT_DEG, BENT_SECONDS * motion.frame_rate, HINGE)
+    bends, judged = elbow_bends(
+        kinematics.positions, kinematics.world, kinematics.rows(arms[:, 1]), placing, BENT_DEG,
+        BENT_SECONDS * motion.frame_rate, HINGE,
+    )  # fmt: skip
     for (_, _, elbow, _), bend, told in zip(arms, bends, judged):
         if not told:  # the take does not tell the elbow's axis (see the module docstring)
             continue
@@ -61,6 +64,13 @@ def arm_findings(motion: Motion, take: str, kinematics: Kinematics | None = None
                 )
             )  # fmt: skip
     return out
+
+
+def turned_joints(skeleton: Skeleton) -> list[int]:
+    """The joints whose world rotations :func:`arm_findings` reads from the take's kinematics: the
+    joint each upper arm turns with."""
+    arms, _ = skeleton.derived("check arms", lambda: _arms(skeleton))
+    return arms[:, 1].tolist()
 
 
 def _placing(skeleton: Skeleton, arms: np.ndarray) -> np.ndarray:

@@ -22,9 +22,10 @@ from mtcore.kinematics import Kinematics
 
 from ..feet.contacts import run_peaks
 from ..feet.footskate import prepare
-from ..feet.legs import Ground, LegArrays
+from ..feet.legs import Ground, LegArrays, resolve_legs
 from ..model.motion import Motion
 from ..model.rig import body_view
+from ..model.skeleton import Skeleton
 from ..model.vectors import lengths
 from .findings import Finding
 
@@ -69,6 +70,15 @@ only the capture's notes can say which rate it was; ``retime`` is the step that 
 BLEND_SECONDS = 0.2 + 0.1
 """The cleanup's fades (its blend) and root smoothing: a recipe's cleanup range reaches this far
 beyond the frames it fixes, so that the adjustments fade within it."""
+
+
+def turned_joints(skeleton: Skeleton) -> list[int]:
+    """The joints whose world rotations :func:`leg_findings` reads from the take's kinematics: the
+    legs' parents (none where the check finds no legs)."""
+    try:
+        return [int(j) for j in resolve_legs(skeleton).parents]
+    except ValueError:
+        return []
 
 
 def leg_findings(motion: Motion, take: str, meters: float, kinematics: Kinematics | None = None) -> list[Finding]:

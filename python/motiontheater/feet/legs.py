@@ -410,9 +410,9 @@ def _upper_kinematics(
     frames, 3, 3): from ``kinematics`` where given, else by forward kinematics of the joints above
     the legs only, in chunks of frames."""
     if kinematics is not None:
-        places, turns = kinematics
-        hips = np.ascontiguousarray(places[:, legs.points[:, 0]].transpose(1, 0, 2))
-        return hips, np.ascontiguousarray(turns[:, legs.parents].transpose(1, 0, 2, 3))
+        hips = np.ascontiguousarray(kinematics.positions[:, legs.points[:, 0]].transpose(1, 0, 2))
+        turns = kinematics.world[:, kinematics.rows(legs.parents)]
+        return hips, np.ascontiguousarray(turns.transpose(1, 0, 2, 3))
     joints = (*map(int, legs.parents), *map(int, legs.points[:, 0]))
     upper, where = skeleton.derived(("pruned tree", joints), lambda: skeleton.tree.pruned(list(joints)))
     hip_rows = where[legs.points[:, 0]]
