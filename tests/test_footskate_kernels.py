@@ -283,3 +283,12 @@ def test_the_c_kernels_check_their_arguments_again():
     assert lib.mt_footskate_write(1, 1, 8, buf, buf, buf, columns, 1.0, buf, [0, 1, 2], buf) == lib.MT_EINVAL
     columns[5] = -1
     assert lib.mt_footskate_write(1, 1, 8, buf, buf, buf, columns, 0.0, buf, [0, 1, 2], buf) == lib.MT_EINVAL
+
+
+def test_one_toe_tip_flag_stands_for_every_leg_and_a_wrong_count_is_named(rng):
+    """tips: one flag for every leg, or one per leg; another count is refused, naming tips."""
+    points, _, up, rate, mpu, speed, needed = twin.ground_cases(rng)[4]  # two legs, 60 frames
+    one = fs.resting_points(points, True, up, rate, mpu, speed, needed)
+    np.testing.assert_array_equal(one, fs.resting_points(points, [True, True], up, rate, mpu, speed, needed))
+    with pytest.raises(ValueError, match="tips must be one flag or 2"):
+        fs.resting_points(points, [True, False, True], up, rate, mpu, speed, needed)

@@ -132,6 +132,17 @@ def integers(a, name: str, shape: tuple, low: int, high: int, dtype=np.int64) ->
     return np.asarray(array, dtype=dtype, order="C")
 
 
+def flags(a, name: str, count: int, dtype=np.intc) -> np.ndarray:
+    """``a``, one flag or ``count`` of them, as ``count`` 0s and 1s of ``dtype`` (C-contiguous);
+    ValueError for another shape.  (np.broadcast_to costs several microseconds a call.)"""
+    array = np.asarray(a, dtype=bool)
+    if array.shape in ((), (1,)):
+        return np.full(count, bool(array.reshape(())), dtype)
+    if array.shape != (count,):
+        raise ValueError(f"{name} must be one flag or {count} of them, got shape {array.shape}")
+    return array.astype(dtype)
+
+
 def fractions(a, name: str, length: int) -> np.ndarray:
     """``a`` as float64 of shape (length,) with every entry in [0, 1] (NaN refused)."""
     array = real(a, name, (length,))

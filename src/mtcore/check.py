@@ -227,7 +227,7 @@ def leg_measures(
     legs, frames = p.shape[:2]
     h = _checks.real(hips, "hips", (legs, frames, 3))
     r = _checks.real(rest, "rest", (legs, 3))
-    t = np.ascontiguousarray(np.broadcast_to(np.asarray(tips, dtype=bool), (legs,)), dtype=np.intc)
+    t = _checks.flags(tips, "tips", legs)
     struct = settings.as_struct()
     drift, depth, back = np.empty((legs, 2, frames)), np.empty((legs, frames)), np.empty((legs, frames))
     standing = np.empty(6, np.uintp)

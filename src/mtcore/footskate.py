@@ -645,7 +645,7 @@ def _contact_legs(points, tips, up) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     p = np.ascontiguousarray(points, dtype=np.float64)
     if p.ndim != 4 or p.shape[2:] != (5, 3):
         raise ValueError(f"points must have shape (legs, frames, 5, 3), got {p.shape}")
-    t = np.ascontiguousarray(np.broadcast_to(np.asarray(tips, dtype=bool), p.shape[:1]), dtype=np.intc)
+    t = _checks.flags(tips, "tips", p.shape[0])
     u = _doubles(up, "up", (3,))
     if np.count_nonzero(u) != 1 or abs(u).max() != 1.0:
         raise ValueError(f"up must be a signed coordinate axis such as (0, 1, 0), got {u.tolist()}")

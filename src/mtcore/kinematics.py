@@ -149,13 +149,13 @@ class Kinematics(NamedTuple):
 
     def rows(self, joints: ArrayLike) -> np.ndarray:
         """Each joint's row of ``world``; ValueError for a joint whose rotation was not kept."""
+        # a few joints of a few kept: Python's lookups cost less than numpy's calls
+        index = {joint: row for row, joint in enumerate(self.turned.tolist())}
         wanted = np.asarray(joints, dtype=np.intp)
-        at = np.searchsorted(self.turned, wanted)
-        kept = at < len(self.turned)
-        kept[kept] = self.turned[at[kept]] == wanted[kept]
-        if not kept.all():
-            raise ValueError(f"no world rotation of joint {int(wanted[~kept].flat[0])} was kept")
-        return at
+        try:
+            return np.array([index[joint] for joint in wanted.ravel().tolist()], np.intp).reshape(wanted.shape)
+        except KeyError as e:
+            raise ValueError(f"no world rotation of joint {e.args[0]} was kept") from None
 
 
 def forward_kinematics(
