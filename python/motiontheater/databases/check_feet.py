@@ -256,14 +256,18 @@ class _Legs:
         heights = ankles @ self.up  # not finite where a coordinate is not (inf times 0 is NaN)
         if len(ankles) != 2 or not np.isfinite(heights).all():
             return []
+        hips = self.arrays.hips.mean(axis=0)
+        ground = hips - (hips @ self.up)[:, None] * self.up
+        hip = float(np.median(hips @ self.up - heights.min(axis=0))) * self.mpu
+        # no stride is longer than the ground the hips cover: where that is too short, no search
+        # (the takes that do not walk or run, a third of those here)
+        if not (hip > 0 and math.hypot(*np.ptp(ground, axis=0)) * self.mpu > STRIDE_HIPS * hip):
+            return []
         frames = _stride(heights[0] - heights[1])
         if frames is None:
             return []
-        hips = self.arrays.hips.mean(axis=0)
-        ground = hips - (hips @ self.up)[:, None] * self.up
         stride = float(np.median(lengths(ground[frames:] - ground[:-frames]))) * self.mpu
-        hip = float(np.median(hips @ self.up - heights.min(axis=0))) * self.mpu
-        if not (hip > 0 and stride > STRIDE_HIPS * hip):
+        if not stride > STRIDE_HIPS * hip:
             return []
         expected = STRIDE_SPEED_SHARE * math.sqrt(9.81 * hip) * (stride / (2.3 * hip)) ** (1 / 0.6)
         rate = self.motion.frame_rate
