@@ -20,6 +20,7 @@ ankle, ball, heel, toe tip.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -247,7 +248,10 @@ def _output(a, name: str, shape: tuple[int, ...]) -> None:
         raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
 
 
+@functools.lru_cache(maxsize=64)
 def _leg_struct(chains: tuple[LegChain, ...]):
+    """The legs as the kernels take them, made once for the same chains (a skeleton's, on each of
+    its takes; the kernels only read them)."""
     legs = ffi.new("struct mt_leg[]", max(len(chains), 1))
     for leg, chain in zip(legs, chains):
         ffi.memmove(leg.axis, chain.axis.tobytes(), 4 * 9 * 8)
