@@ -124,12 +124,21 @@ def integers(a, name: str, shape: tuple, low: int, high: int, dtype=np.int64) ->
     if array.dtype.kind not in "biu" and array.size:
         raise TypeError(f"{name} must hold integers, got dtype {array.dtype}")
     _shape(array, name, shape)
-    outside = (array < low) | (array >= high) if array.size else np.zeros(array.shape, bool)
-    if outside.any():
+    if array.size and not _within(array, low, high):
+        outside = (array < low) | (array >= high)
         at = tuple(int(i) for i in np.argwhere(outside)[0])
         where = at[0] if len(at) == 1 else at
         raise ValueError(f"{name} must lie in {low} .. {high - 1}, got {name}[{where}] = {int(array[at])}")
     return np.asarray(array, dtype=dtype, order="C")
+
+
+def _within(array: np.ndarray, low: int, high: int) -> bool:
+    """Whether every entry of a non-empty integer array lies in low .. high - 1: as Python numbers
+    for the few entries most calls pass (a microsecond less than numpy's masks)."""
+    if array.size <= 64:
+        values = array.ravel().tolist()
+        return min(values) >= low and max(values) < high
+    return bool(array.min() >= low and array.max() < high)
 
 
 def flags(a, name: str, count: int, dtype=np.intc) -> np.ndarray:
