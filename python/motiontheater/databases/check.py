@@ -145,6 +145,8 @@ class _Take:
 
     def keep(self, joints: Iterable[int]) -> None:
         """Keep the world rotations of these joints (indices) too, before :attr:`held` is first read."""
+        if "held" in self.__dict__:  # worked out already: these joints' rotations would be missing
+            raise RuntimeError("world rotations are kept before the take's kinematics are first read")
         self._turned.update(joints)
 
     @cached_property
@@ -412,6 +414,7 @@ def _check_piece(motion: Motion, take: str, begins: bool, ends: bool) -> list[Fi
         min_run = max(3, round(FROZEN_SECONDS * t.rate))
         found = kernel.channel_events(motion.values, spikes, steps, min_run)
         ev, sizes = found.events, found.sizes
+        # the joints whose spikes and steps are judged by what their rotations move (:meth:`_Take.seen`)
         t.keep(t.joint_of[ev[(ev[:, 3] == kernel.SPIKE) | (ev[:, 3] == kernel.STEP), 0]].tolist())
         by_kind = {kind: (ev[ev[:, 3] == kind], sizes[ev[:, 3] == kind]) for kind in kernel.KINDS}
         repeats = by_kind[kernel.REPEAT][0]
