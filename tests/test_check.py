@@ -12,7 +12,7 @@ import motiontheater as mt
 from artifacts import KINDS, hits, inject
 from corpus import real_files
 from motiontheater.databases import pieces
-from motiontheater.databases.check import check_motion, recipe
+from motiontheater.databases.check import _Take, check_motion, recipe
 from motiontheater.databases.check_feet import STRIDE_SPEED_RANGE, STRIDE_SPEED_SHARE
 from motiontheater.databases.check_pace import DROP_EVIDENCE, step_pace
 from motiontheater.databases.findings import KINDS as FINDING_KINDS
@@ -513,3 +513,25 @@ def test_a_take_that_does_not_stand_along_y_is_told(turn, axis, severity):
         assert [(f.severity, f.unit) for f in found] == [(severity, "%")]
         assert ("upside down" if axis == "-y" else f"along {axis}") in found[0].detail
         assert found[0].size == pytest.approx(100.0)
+
+
+def test_a_flip_near_gimbal_lock_says_how_near_and_one_far_from_it_does_not():
+    """A joint's Euler triple turned to the other triple of the same rotation over 40 frames is a
+    medium flip; where its middle angle nears the lock (+-90 deg here) the finding says how near,
+    as for lafan1's shoulders, and elsewhere it says nothing of it."""
+    take = _walk()
+    order, _, columns = _Take(take, "walk").triples["lhumerus"]
+    assert order[0] != order[2]  # Tait-Bryan: the lock is at +-90
+    for middle, near in ((30.0, False), (88.0, True)):
+        values = take.values.copy()
+        values[:, columns[1]] = middle  # the middle angle held, the others as captured
+        flipped = values.copy()
+        rows = slice(200, 240)
+        flipped[rows, columns[0]] += 180.0
+        flipped[rows, columns[1]] = 180.0 - middle
+        flipped[rows, columns[2]] += 180.0
+        flips = [
+            f for f in check_motion(take.replace(values=flipped)) if f.kind == "flip" and f.joints == ("lhumerus",)
+        ]
+        assert [(f.first, f.last, f.severity) for f in flips] == [(201, 240, "medium")], middle
+        assert ("near gimbal lock: the middle angle comes within 2 deg of it" in flips[0].detail) == near, flips[0]

@@ -644,17 +644,38 @@ def _flips(t: _Take, steps: tuple, spikes: tuple) -> list[Finding]:
             jump = float(np.nan_to_num(np.abs(angles[edge] - angles[edge - 1])).max()) * t.degrees if edge else 0.0
             fixable = not whole and first > 0
             what = "wrap by whole turns" if whole else "flip to the other Euler triple of the same rotation"
+            lock = _lock_gap(t, joint, angles[max(first - 1, 0) : last + 2]) if not whole else None
             out.append(
                 Finding(
                     t.name, "flip", (joint,), t.frame(first), t.frame(last), "low" if whole else "medium",
                     round(jump, 6), "deg",
                     f"{joint}'s Euler angles {what} for {last - first + 1} frame(s): a jump of {jump:.3g} deg "
-                    "with no jump of the rotation",
+                    "with no jump of the rotation"
+                    + (f" (near gimbal lock: the middle angle comes within {lock:.2g} deg of it, where the first "
+                       "and third swing fast)" if lock is not None else ""),
                     t.channels[int(columns[0])].name,
                     (("unroll", {"joints": [joint], "frames": [t.frame(first), t.frame(last)]}),) if fixable else (),
                 )
             )  # fmt: skip
     return out
+
+
+LOCK_DEG = 10.0
+"""Degrees from gimbal lock within which a flip's middle angle tells the lock (the first and third
+angles swing there, and the other triple is often the smoother)."""
+
+
+def _lock_gap(t: _Take, joint: str, angles: np.ndarray) -> float | None:
+    """How near the joint's Euler triple comes to gimbal lock over the rows ``angles`` (the middle
+    angle's degrees from +-90 for Tait-Bryan orders, from 0 or 180 for proper Euler ones), where
+    within LOCK_DEG; else None."""
+    if joint not in t.triples:
+        return None
+    order = t.triples[joint][0]
+    middle = np.radians(angles[:, 1] * t.degrees)
+    off = np.abs(np.sin(middle) if order[0] == order[2] else np.cos(middle))  # 0 at the lock
+    gap = float(np.degrees(np.arcsin(np.minimum(np.nanmin(off, initial=1.0), 1.0))))
+    return gap if gap <= LOCK_DEG else None
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
