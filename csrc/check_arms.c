@@ -23,6 +23,12 @@ static double measure(const double *at, const double *w, const size_t *p, double
     return dot3(arm, forearm);
 }
 
+/* Whether a frame bends past the angle whose tangent is tan_bent: u . f = s, |n| = length (NaN: no) */
+static int bent_past(double s, double length, double tan_bent)
+{
+    return s < length / tan_bent && length > 0;
+}
+
 /* The eigenvalues d and eigenvectors (the columns of v) of the symmetric a (3 x 3, row-major;
    overwritten) by cyclic Jacobi rotations, which converge on any symmetric matrix. */
 static void symmetric_eigen3(double a[9], double d[3], double v[9])
@@ -79,7 +85,7 @@ int mt_check_elbows(const double *positions, size_t frames, size_t joints, const
         for (size_t t = 0; t < frames; t++) { /* the second moment of the bent frames' unit turns */
             const double s = measure(positions + 3 * joints * t, world + 9 * (turned * t + turning[a]), p, n);
             const double length = sqrt(dot3(n, n));
-            if (s < length / tan_bent && length > 0) { /* NaN compares false */
+            if (bent_past(s, length, tan_bent)) {
                 for (int i = 0; i < 3; i++)
                     for (int k = 0; k < 3; k++)
                         moment[3 * i + k] += n[i] / length * (n[k] / length);
@@ -101,12 +107,12 @@ int mt_check_elbows(const double *positions, size_t frames, size_t joints, const
             continue;
         }
         const double axis[3] = {axes[top], axes[3 + top], axes[6 + top]};
-        size_t forward = 0;
+        size_t forward = 0; /* the turns again, not kept from the pass above: no scratch of a take's length */
         for (size_t t = 0; t < frames; t++) {
             const double s = measure(positions + 3 * joints * t, world + 9 * (turned * t + turning[a]), p, n);
             const double along = n[0] * axis[0] + n[1] * axis[1] + n[2] * axis[2];
             const double length = sqrt(dot3(n, n));
-            forward += s < length / tan_bent && length > 0 && along > 0;
+            forward += bent_past(s, length, tan_bent) && along > 0;
             out[t] = atan2(along, s) * (180.0 / pi);
         }
         if (2 * forward < count) /* forward is the way most of the bent frames turn */

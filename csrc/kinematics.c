@@ -75,6 +75,16 @@ static MT_INLINE void turn_left(double *m, const double *angles, const int *kind
         rotate_left_n(m, kinds[r], sn + r * BLOCK, cs + r * BLOCK, BLOCK);
 }
 
+/* Lanes 0 .. n-1 of a quantity of `width` numbers (lanes[e BLOCK + f]) to frames f0 .. f0+n-1 of
+   out, a frame's `rows` quantities side by side, this one at `row` */
+static MT_INLINE void put_lanes(double *out, size_t rows, size_t row, size_t f0, size_t n, const double *lanes,
+                                int width)
+{
+    for (size_t f = 0; f < n; f++)
+        for (int e = 0; e < width; e++)
+            out[(size_t)width * ((f0 + f) * rows + row) + (size_t)e] = lanes[e * BLOCK + f];
+}
+
 /* Frames f0 .. f0+n-1 (n <= BLOCK); lanes past n repeat the last frame and are not written. */
 static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *positions,
                                double *world_out, double *local_out)
@@ -145,18 +155,12 @@ static MT_CLONES void fk_block(const struct fk *k, size_t f0, size_t n, double *
                                        turn[(3 * e + 1) * BLOCK + f] * vec[BLOCK + f] +
                                        turn[(3 * e + 2) * BLOCK + f] * vec[2 * BLOCK + f];
         }
-        for (size_t f = 0; f < n; f++)
-            for (int e = 0; e < 3; e++)
-                positions[3 * ((f0 + f) * k->joints + j) + (size_t)e] = p[e * BLOCK + f];
+        put_lanes(positions, k->joints, j, f0, n, p, 3);
         const long long row = k->world_rows ? k->world_rows[j] : (long long)j;
         if (world_out && row >= 0)
-            for (size_t f = 0; f < n; f++)
-                for (int e = 0; e < 9; e++)
-                    world_out[9 * ((f0 + f) * k->world_count + (size_t)row) + (size_t)e] = w[e * BLOCK + f];
+            put_lanes(world_out, k->world_count, (size_t)row, f0, n, w, 9);
         if (local_out)
-            for (size_t f = 0; f < n; f++)
-                for (int e = 0; e < 9; e++)
-                    local_out[9 * ((f0 + f) * k->joints + j) + (size_t)e] = l[e * BLOCK + f];
+            put_lanes(local_out, k->joints, j, f0, n, l, 9);
     }
 }
 

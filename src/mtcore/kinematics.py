@@ -175,11 +175,11 @@ def forward_kinematics(
     values = _values_of(values, tree)
     frames, channels = values.shape
     n = tree.joints
-    kept = None if turned is None else _checks.integers(turned, "turned", (None,), 0, n)
-    if kept is not None and np.any(np.diff(kept) <= 0):
-        raise ValueError("turned must list joints in ascending order, each once")
-    rows = None
-    if kept is not None:
+    kept, rows = None, None  # rows: each joint's row of the world rotations (-1: not kept)
+    if turned is not None:
+        kept = _checks.integers(turned, "turned", (None,), 0, n)
+        if np.any(np.diff(kept) <= 0):
+            raise ValueError("turned must list joints in ascending order, each once")
         rows = np.full(n, -1, np.int64)
         rows[kept] = np.arange(len(kept))
     positions = np.empty((frames, n, 3))

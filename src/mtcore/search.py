@@ -429,7 +429,7 @@ def hysteresis(values: ArrayLike, low: ArrayLike, high: ArrayLike, initial: Arra
     if wrong.any():
         f = int(np.flatnonzero(wrong)[0])
         raise ValueError(f"low must be at most high for every feature, got low {lo[f]} and high {hi[f]} at {f}")
-    start = np.broadcast_to(np.asarray(initial, dtype=bool), (features,)).astype(np.uint8)
+    start = _checks.flags(initial, "initial", features, np.uint8)
     on = np.empty(x.shape, dtype=np.uint8)
     status = lib.mt_hysteresis(
         c_array(x), len(x), features, c_array(lo), c_array(hi), c_array(start, "unsigned char[]"),

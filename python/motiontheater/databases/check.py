@@ -271,7 +271,7 @@ class _Take:
 
     def _places(self, joint: str, rows: np.ndarray) -> np.ndarray:
         """The places (rows, points, 3) in metres of the points the joint's rotation moves."""
-        return self.held[0][rows[:, None], self._points(joint)] * self.meters
+        return self.held.positions[rows[:, None], self._points(joint)] * self.meters
 
 
 _NONE = np.zeros(0, np.intp)
@@ -414,9 +414,9 @@ def _check_piece(motion: Motion, take: str, begins: bool, ends: bool) -> list[Fi
         min_run = max(3, round(FROZEN_SECONDS * t.rate))
         found = kernel.channel_events(motion.values, spikes, steps, min_run)
         ev, sizes = found.events, found.sizes
-        # the joints whose spikes and steps are judged by what their rotations move (:meth:`_Take.seen`)
-        t.keep(t.joint_of[ev[(ev[:, 3] == kernel.SPIKE) | (ev[:, 3] == kernel.STEP), 0]].tolist())
         by_kind = {kind: (ev[ev[:, 3] == kind], sizes[ev[:, 3] == kind]) for kind in kernel.KINDS}
+        # the joints whose spikes and steps are judged by what their rotations move (:meth:`_Take.seen`)
+        t.keep(t.joint_of[by_kind[kernel.SPIKE][0][:, 0]].tolist() + t.joint_of[by_kind[kernel.STEP][0][:, 0]].tolist())
         repeats = by_kind[kernel.REPEAT][0]
         findings += _repeats(t, repeats, rows)
         findings += _gaps(t, *by_kind[kernel.GAP])

@@ -95,7 +95,7 @@ def step_pace(motion: Motion, kinematics: Kinematics | None = None) -> kernel.Pa
         return kernel.Pace(np.zeros(rows), np.zeros(rows), np.zeros(rows))
     if kinematics is None:
         kinematics = world_kinematics(motion.values, motion.skeleton.tree, workers=1)
-    places = kinematics[0].reshape(rows, -1)  # in file units: the unit goes into the weights
+    places = kinematics.positions.reshape(rows, -1)  # in file units: the unit goes into the weights
     meters = motion.skeleton.meters_per_unit
     squares, counts = np.zeros(places.shape[1]), np.zeros(places.shape[1], np.uintp)
     kernel.roughness(places, squares, counts)  # a gap's left out
