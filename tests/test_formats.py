@@ -98,8 +98,7 @@ def test_each_convention_has_its_suffix_and_companion():
 )
 def test_a_take_read_without_its_layout_is_the_same_motion(data_dir, name):
     """layout=False (a take looked at, not written back) reads the same values, header, rate and
-    frames, and leaves out only how the text is laid out, which a motion written from it then
-    takes plainly."""
+    frames, and leaves out only how the text is laid out: the plain style, no line order."""
     path = data_dir / name
     whole, cut = table.read_take_frames(path)
     bare, bare_cut = table.read_take_frames(path, layout=False)
