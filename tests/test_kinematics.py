@@ -350,3 +350,34 @@ def test_world_rotations_kept_to_a_few_joints_are_theirs_of_every_joint(amc):
         world_kinematics(take.values, tree, turned=[3, 0])
     with pytest.raises(ValueError, match="turned must lie"):
         world_kinematics(take.values, tree, turned=[0, tree.joints])
+
+
+@pytest.mark.parametrize("amc", AMCS[:2], ids=ids(AMCS[:2]))
+def test_kinematics_written_into_arrays_given_are_the_new_ones(amc):
+    """out: the positions and rotations written into the arrays given (and returned as they are)
+    are those of new arrays, whatever the arrays held before; arrays that do not fit, or that
+    share the values' memory, are refused before anything is written."""
+    take = load(amc)
+    tree, frames, n = take.skeleton.tree, take.frames, take.skeleton.tree.joints
+    fresh = forward_kinematics(take.values, tree, world=True, local=True)
+    given = tuple(np.full(shape, np.nan) for shape in ((frames, n, 3), (frames, n, 3, 3), (frames, n, 3, 3)))
+    written = forward_kinematics(take.values, tree, world=True, local=True, out=given)
+    for new, into, got in zip(fresh, given, written):
+        assert got is into
+        np.testing.assert_array_equal(got, new)
+    few = world_kinematics(take.values, tree, turned=[1, 4], out=(given[0], np.zeros((frames, 2, 3, 3))))
+    np.testing.assert_array_equal(few.world, fresh[1][:, [1, 4]])
+    with pytest.raises(ValueError, match=r"out world must be .*shape \(\d+, 2, 3, 3\), got shape"):
+        world_kinematics(take.values, tree, turned=[1, 4], out=(given[0], given[1]))
+    with pytest.raises(ValueError, match="out positions must be .*float64.*got dtype float32"):
+        forward_kinematics(take.values, tree, out=(given[0].astype(np.float32), None, None))
+    with pytest.raises(ValueError, match="out local is given, but its rotations are not asked for"):
+        forward_kinematics(take.values, tree, out=(None, None, given[2]))
+    with pytest.raises(ValueError, match="out must be"):
+        forward_kinematics(take.values, tree, out=(given[0],))
+    channels = take.values.shape[1]
+    memory = np.zeros(frames * max(channels, n * 3))
+    values = memory[: frames * channels].reshape(frames, channels)
+    values[:] = take.values
+    with pytest.raises(ValueError, match="shares memory with the values"):
+        forward_kinematics(values, tree, out=(memory[: frames * n * 3].reshape(frames, n, 3), None, None))

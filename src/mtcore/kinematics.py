@@ -166,11 +166,15 @@ def forward_kinematics(
     local: bool = False,
     turned: ArrayLike | None = None,
     workers: int | None = None,
+    out: tuple[np.ndarray | None, np.ndarray | None, np.ndarray | None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
     """Positions (frames, joints, 3) of each joint's end, and optionally world and
     local rotations (frames, joints, 3, 3), for values (frames, channels); ``turned`` (joint
     indices, ascending) keeps the world rotations to those joints' (frames, len(turned), 3, 3),
     for a caller that reads a few of them (they are most of the memory written).
+    ``out``: C-contiguous float64 arrays of those shapes to write the positions, world and local
+    rotations into (None: a new one), for a caller that works out many takes one after another
+    (fresh memory costs more than the kinematics of a short take).
     Frames are split over the cores for large motions (``workers`` as for the filters)."""
     values = _values_of(values, tree)
     frames, channels = values.shape
@@ -182,9 +186,15 @@ def forward_kinematics(
             raise ValueError("turned must list joints in ascending order, each once")
         rows = np.full(n, -1, np.int64)
         rows[kept] = np.arange(len(kept))
-    positions = np.empty((frames, n, 3))
-    world_out = np.empty((frames, n if kept is None else len(kept), 3, 3)) if world else None
-    local_out = np.empty((frames, n, 3, 3)) if local else None
+    into = (None, None, None) if out is None else out
+    if len(into) != 3:
+        raise ValueError(f"out must be (positions, world, local), each an array or None; got {len(into)} items")
+    for given, name, asked in zip(into[1:], ("world", "local"), (world, local)):
+        if given is not None and not asked:
+            raise ValueError(f"out {name} is given, but its rotations are not asked for")
+    positions = _made(into[0], "out positions", (frames, n, 3), values)
+    world_out = _made(into[1], "out world", (frames, n if kept is None else len(kept), 3, 3), values) if world else None
+    local_out = _made(into[2], "out local", (frames, n, 3, 3), values) if local else None
     bounds = even_bounds(frames, thread_count(workers, frames * n >= _PARALLEL_MIN_TRANSFORMS))
     args = (
         c_array(values),
@@ -214,12 +224,27 @@ def forward_kinematics(
     return positions, world_out, local_out
 
 
+def _made(given: np.ndarray | None, name: str, shape: tuple, values: np.ndarray) -> np.ndarray:
+    """The output array given (checked), or a new one."""
+    if given is None:
+        return np.empty(shape)
+    if np.may_share_memory(given, values):
+        raise ValueError(f"{name} shares memory with the values it would be worked out from")
+    return _checks.output(given, name, shape)
+
+
 def world_kinematics(
-    values: np.ndarray, tree: JointTree, *, turned: ArrayLike | None = None, workers: int | None = None
+    values: np.ndarray,
+    tree: JointTree,
+    *,
+    turned: ArrayLike | None = None,
+    workers: int | None = None,
+    out: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> Kinematics:
     """Every joint's position and the world rotations of ``turned`` (default every joint's):
-    :func:`forward_kinematics` with ``world=True``."""
-    positions, world, _ = forward_kinematics(values, tree, world=True, turned=turned, workers=workers)
+    :func:`forward_kinematics` with ``world=True``, into ``out`` (positions, world) where given."""
+    into = None if out is None else (*out, None)
+    positions, world, _ = forward_kinematics(values, tree, world=True, turned=turned, workers=workers, out=into)
     assert world is not None  # asked for
     kept = np.arange(tree.joints) if turned is None else np.asarray(turned, dtype=np.intp)
     return Kinematics(positions, world, kept)

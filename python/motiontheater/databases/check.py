@@ -46,6 +46,7 @@ from .check_feet import leg_findings
 from .check_pace import dropped_findings
 from .findings import Finding
 from .pieces import check_frames
+from .workspace import Workspace, lent
 
 SPIKE_DEG = 5.0
 """Degrees a joint's rotation must leave the median of the five frames around it to be a spike."""
@@ -114,8 +115,9 @@ class _Channel:
 class _Take:
     """A take as the detectors see it: its channels, units and rate."""
 
-    def __init__(self, motion: Motion, name: str):
+    def __init__(self, motion: Motion, name: str, space: Workspace | None = None):
         self.motion = motion
+        self.space = Workspace() if space is None else space  # where the kinematics go
         self.name = name
         self.rate = motion.frame_rate
         self.dt = 1.0 / motion.frame_rate
@@ -154,8 +156,13 @@ class _Take:
         """The joints' places and the world rotations kept (:meth:`keep`), for the spikes, steps,
         legs and arms alike (a piece's at most): world rotations are most of what forward
         kinematics writes, and the detectors read a few joints'."""
-        tree = self.motion.skeleton.tree
-        return world_kinematics(self.motion.values, tree, turned=sorted(self._turned), workers=1)
+        tree, frames = self.motion.skeleton.tree, self.motion.frames
+        turned = sorted(self._turned)
+        out = (
+            self.space.array("positions", (frames, tree.joints, 3)),
+            self.space.array("world", (frames, len(turned), 3, 3)),
+        )
+        return world_kinematics(self.motion.values, tree, turned=turned, workers=1, out=out)
 
     def frame(self, row: int) -> int:
         return self.motion.first_frame + int(row)
@@ -402,7 +409,12 @@ def _check_piece(motion: Motion, take: str, begins: bool, ends: bool) -> list[Fi
         unsure = not np.isfinite(motion.values.sum())
     if unsure and np.isinf(motion.values).any():
         motion = motion.replace(values=np.where(np.isinf(motion.values), np.nan, motion.values))
-    t = _Take(motion, take)
+    with lent() as space:
+        return _piece_findings(_Take(motion, take, space), begins, ends)
+
+
+def _piece_findings(t: _Take, begins: bool, ends: bool) -> list[Finding]:
+    motion, take = t.motion, t.name
     t.begins, t.ends = begins, ends
     findings = _unit(t)
     for finding in findings:  # lengths are judged in the unit the fix makes them
