@@ -26,7 +26,7 @@ from ..feet.legs import Ground, LegArrays, resolve_legs
 from ..model.motion import Motion
 from ..model.rig import body_view
 from ..model.skeleton import Skeleton
-from ..model.vectors import lengths
+from ..model.vectors import lengths, median, spans
 from .findings import Finding
 
 SKATE_M = 0.12
@@ -256,17 +256,18 @@ class _Legs:
         heights = ankles @ self.up  # not finite where a coordinate is not (inf times 0 is NaN)
         if len(ankles) != 2 or not np.isfinite(heights).all():
             return []
-        hips = self.arrays.hips.mean(axis=0)
-        ground = hips - (hips @ self.up)[:, None] * self.up
-        hip = float(np.median(hips @ self.up - heights.min(axis=0))) * self.mpu
+        hips = (self.arrays.hips[0] + self.arrays.hips[1]) * 0.5  # their mean
+        along = hips @ self.up
+        ground = hips - along[:, None] * self.up
+        hip = median(along - np.minimum(heights[0], heights[1])) * self.mpu
         # no stride is longer than the ground the hips cover: where that is too short, no search
         # (the takes that do not walk or run, a third of those here)
-        if not (hip > 0 and math.hypot(*np.ptp(ground, axis=0)) * self.mpu > STRIDE_HIPS * hip):
+        if not (hip > 0 and math.hypot(*spans(ground)) * self.mpu > STRIDE_HIPS * hip):
             return []
         frames = _stride(heights[0] - heights[1])
         if frames is None:
             return []
-        stride = float(np.median(lengths(ground[frames:] - ground[:-frames]))) * self.mpu
+        stride = median(lengths(ground[frames:] - ground[:-frames])) * self.mpu
         if not stride > STRIDE_HIPS * hip:
             return []
         expected = STRIDE_SPEED_SHARE * math.sqrt(9.81 * hip) * (stride / (2.3 * hip)) ** (1 / 0.6)
