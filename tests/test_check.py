@@ -18,6 +18,7 @@ from motiontheater.databases.check_pace import DROP_EVIDENCE, step_pace
 from motiontheater.databases.findings import KINDS as FINDING_KINDS
 from motiontheater.databases.findings import SEVERITIES
 from motiontheater.feet.footskate import prepare
+from mtcore import check as kernel
 from variants import with_offset_channels, with_static_root
 
 TAKES = real_files("*/*.amc") + real_files("*/*.bvh")
@@ -535,3 +536,24 @@ def test_a_flip_near_gimbal_lock_says_how_near_and_one_far_from_it_does_not():
         ]
         assert [(f.first, f.last, f.severity) for f in flips] == [(201, 240, "medium")], middle
         assert ("near gimbal lock: the middle angle comes within 2 deg of it" in flips[0].detail) == near, flips[0]
+
+
+def test_events_by_kind_are_those_of_each_kind_in_their_order(rng):
+    """ChannelEvents.by_kind: every kind's events and sizes, in the pass's order, as a mask of
+    each kind picks them (a kind with none gets none)."""
+    values = np.cumsum(rng.normal(size=(300, 6)), axis=0)
+    values[40:60, 1] = values[40, 1]  # frozen
+    values[100, 2] += 50.0  # a spike
+    values[150:, 3] += 30.0  # a step
+    values[200:205, 4] = np.nan  # a gap
+    values[250] = values[249]  # a repeated row
+    found = kernel.channel_events(values, 5.0, 5.0, 10)
+    kinds = found.by_kind()
+    assert list(kinds) == sorted(kernel.KINDS)
+    for code in kernel.KINDS:
+        mask = found.events[:, 3] == code
+        np.testing.assert_array_equal(kinds[code][0], found.events[mask])
+        np.testing.assert_array_equal(kinds[code][1], found.sizes[mask])
+        assert len(kinds[code][0]), kernel.KINDS[code]  # each made above
+    empty = kernel.channel_events(np.arange(300.0)[:, None], 5.0, 5.0, 10).by_kind()  # a steady ramp
+    assert all(e.shape == (0, 5) and s.shape == (0,) for e, s in empty.values())

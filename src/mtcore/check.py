@@ -46,6 +46,7 @@ GAP, FROZEN, SPIKE, STEP, REPEAT = (
 )
 KINDS = {GAP: "gap", FROZEN: "frozen", SPIKE: "spike", STEP: "step", REPEAT: "repeat"}
 """The kind codes of the events, named."""
+_CODES = np.array(sorted(KINDS))
 
 
 @dataclass(frozen=True)
@@ -60,6 +61,15 @@ class ChannelEvents:
     sizes: np.ndarray
     roughness: np.ndarray
     smooth_rows: np.ndarray
+
+    def by_kind(self) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+        """The events and their sizes of each kind (every code of KINDS, in its order), each
+        kind's in the order they come."""
+        kinds = self.events[:, 3]
+        order = np.argsort(kinds, kind="stable")  # one sort in place of a mask a kind
+        bounds = np.searchsorted(kinds[order], _CODES).tolist() + [len(kinds)]
+        events, sizes = self.events[order], self.sizes[order]
+        return {code: (events[a:b], sizes[a:b]) for code, a, b in zip(_CODES.tolist(), bounds, bounds[1:])}
 
 
 def channel_events(

@@ -6,7 +6,8 @@ Array level: joints are indices; motiontheater builds the tables from a skeleton
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
+from functools import cached_property
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -16,6 +17,9 @@ from ._cdata import c_array
 from ._mtcore import lib
 from ._parallel import even_bounds, run_ranges, thread_count
 from ._status import check
+
+if TYPE_CHECKING:
+    from _cffi_backend import _CDataBase as CData
 
 __all__ = ["DOFS", "JointTree", "Kinematics", "forward_kinematics", "local_quaternions", "world_kinematics"]
 
@@ -96,6 +100,28 @@ class JointTree:
         """The number of joints."""
         return len(self.parent)
 
+    @cached_property
+    def kernel_tables(self) -> tuple[CData, CData, CData, CData, CData, CData, CData, CData, CData]:
+        """The tables as ``mt_forward_kinematics`` takes them, made once (a tree serves every
+        take of its skeleton): parent, order, axis, direction, segment, dof_start, dof_kind,
+        dof_column, parent_frame."""
+        return (
+            c_array(self.parent, "long long[]"),
+            c_array(self.order, "long long[]"),
+            c_array(self.axis),
+            c_array(self.direction),
+            c_array(self.segment),
+            c_array(self.dof_start, "size_t[]"),
+            c_array(self.dof_kind, "int[]"),
+            c_array(self.dof_column, "size_t[]"),
+            c_array(self.parent_frame, "unsigned char[]"),
+        )
+
+    @cached_property
+    def channels_read(self) -> int:
+        """How many channels a frame must have for the tree to read it (its last column + 1)."""
+        return int(self.dof_column.max()) + 1 if len(self.dof_column) else 0
+
     def pruned(self, joints) -> tuple[JointTree, np.ndarray]:
         """The tree of ``joints`` (indices) and their ancestors only, and for each joint of this
         tree its index in that one (-1 where left out).  Forward kinematics of the pruned tree,
@@ -132,8 +158,8 @@ def _values_of(values: np.ndarray, tree: JointTree) -> np.ndarray:
     if not isinstance(tree, JointTree):
         raise TypeError(f"tree must be a JointTree, got {type(tree).__name__}")
     values = _checks.real(values, "values", (None, None))
-    if len(tree.dof_column) and tree.dof_column.max() >= values.shape[1]:
-        raise ValueError(f"the tree reads column {tree.dof_column.max()} but values have {values.shape[1]} channels")
+    if tree.channels_read > values.shape[1]:
+        raise ValueError(f"the tree reads column {tree.channels_read - 1} but values have {values.shape[1]} channels")
     return values
 
 
@@ -196,22 +222,7 @@ def forward_kinematics(
     world_out = _made(into[1], "out world", (frames, n if kept is None else len(kept), 3, 3), values) if world else None
     local_out = _made(into[2], "out local", (frames, n, 3, 3), values) if local else None
     bounds = even_bounds(frames, thread_count(workers, frames * n >= _PARALLEL_MIN_TRANSFORMS))
-    args = (
-        c_array(values),
-        frames,
-        channels,
-        n,
-        c_array(tree.parent, "long long[]"),
-        c_array(tree.order, "long long[]"),
-        c_array(tree.axis),
-        c_array(tree.direction),
-        c_array(tree.segment),
-        c_array(tree.dof_start, "size_t[]"),
-        c_array(tree.dof_kind, "int[]"),
-        c_array(tree.dof_column, "size_t[]"),
-        c_array(tree.parent_frame, "unsigned char[]"),
-        tree.angle_scale,
-    )
+    args = (c_array(values), frames, channels, n, *tree.kernel_tables, tree.angle_scale)
     outs = (
         c_array(positions),
         c_array(world_out),

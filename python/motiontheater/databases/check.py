@@ -425,8 +425,7 @@ def _piece_findings(t: _Take, begins: bool, ends: bool) -> list[Finding]:
         rows = motion.frames
         min_run = max(3, round(FROZEN_SECONDS * t.rate))
         found = kernel.channel_events(motion.values, spikes, steps, min_run)
-        ev, sizes = found.events, found.sizes
-        by_kind = {kind: (ev[ev[:, 3] == kind], sizes[ev[:, 3] == kind]) for kind in kernel.KINDS}
+        by_kind = found.by_kind()
         # the joints whose spikes and steps are judged by what their rotations move (:meth:`_Take.seen`)
         t.keep(t.joint_of[by_kind[kernel.SPIKE][0][:, 0]].tolist() + t.joint_of[by_kind[kernel.STEP][0][:, 0]].tolist())
         repeats = by_kind[kernel.REPEAT][0]
