@@ -406,6 +406,40 @@ int mt_leg_points(const struct mt_leg *legs, size_t nlegs, size_t frames, const 
     return MT_OK;
 }
 
+int mt_placed_legs(const double *positions, size_t frames, size_t joints, const double *world, size_t world_count,
+                   size_t nlegs, const long long *at, const double *heels, double *hips, double *points)
+{
+    if (nlegs == 0 || frames == 0)
+        return MT_OK;
+    if (!positions || !world || !at || !heels || !hips || !points)
+        return MT_EINVAL;
+    for (size_t i = 0; i < nlegs; i++) {
+        const long long *a = at + 6 * i;
+        for (int k = 0; k < 5; k++)
+            if (a[k] < (k == 4 ? -1 : 0) || a[k] >= (long long)joints)
+                return MT_EINVAL;
+        if (a[5] < 0 || (unsigned long long)a[5] >= world_count)
+            return MT_EINVAL;
+    }
+    for (size_t i = 0; i < nlegs; i++) {
+        const long long *a = at + 6 * i;
+        const double *heel = heels + 3 * i;
+        /* knee, ankle, ball, the heel's ankle and the tip (the ball where there is none) */
+        const size_t from[5] = {(size_t)a[1], (size_t)a[2], (size_t)a[3], (size_t)a[2], (size_t)(a[4] >= 0 ? a[4] : a[3])};
+        for (size_t f = 0; f < frames; f++) {
+            const double *p = positions + f * joints * 3, *w = world + (f * world_count + (size_t)a[5]) * 9;
+            double *out = points + (i * frames + f) * 15, *hip = hips + (i * frames + f) * 3;
+            for (int e = 0; e < 3; e++) {
+                hip[e] = p[3 * (size_t)a[0] + (size_t)e];
+                for (int k = 0; k < 5; k++)
+                    out[3 * k + e] = p[3 * from[k] + (size_t)e];
+                out[9 + e] += w[3 * e] * heel[0] + w[3 * e + 1] * heel[1] + w[3 * e + 2] * heel[2];
+            }
+        }
+    }
+    return MT_OK;
+}
+
 /* ---------------------------------------------------------------- the floor */
 
 static double height(const struct mt_footskate *opt, const double *p)

@@ -647,6 +647,17 @@ int mt_leg_points(const struct mt_leg *legs, size_t nlegs, size_t frames, const 
                   const double *parents, const double *angles, double *points, double *feet);
 
 /*
+ * The hips (nlegs x frames x 3) and points (nlegs x frames x 5 x 3, as mt_leg_points gives them)
+ * of legs placed by forward kinematics (mt_forward_kinematics): positions (frames x joints x 3)
+ * of every joint, world (frames x world_count x 9) the world rotations kept.  at (nlegs x 6): the
+ * joints whose positions are each leg's hip, knee, ankle, ball and toe tip (-1: no tip, which is
+ * then the ball), and the row of world that turns the foot; heels (nlegs x 3): the heel from the
+ * ankle in the foot's frame.  A joint or row out of range is MT_EINVAL.
+ */
+int mt_placed_legs(const double *positions, size_t frames, size_t joints, const double *world, size_t world_count,
+                   size_t nlegs, const long long *at, const double *heels, double *hips, double *points);
+
+/*
  * Phases 1 and 2 for one leg, of its angles and points (frames x 5 x 3, as
  * mt_leg_points gives them).  planted (frames x 2): heel and ball planted;
  * targets (frames x 2 x 3): where, read where planted; clearance (3): the

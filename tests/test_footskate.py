@@ -12,11 +12,14 @@ import pytest
 
 import motiontheater as mt
 from conftest import DATA
+from corpus import ids, real_files
 from motiontheater.cli import main
 from motiontheater.feet.contacts import Contacts, Plant
 from motiontheater.feet.footskate import clean_footskate, contacts_of, prepare
 from motiontheater.feet.legs import find_legs, leg_arrays, resolve_legs
 from motiontheater.feet.skate import knee_bends, measure, skate_metrics
+from motiontheater.model.rig import body_view
+from mtcore.kinematics import world_kinematics
 
 CMU = 0.0254 / 0.45  # metres per CMU/HDM05 unit
 TAKES = {  # take: (skeleton, file, metres per unit for BVH)
@@ -504,3 +507,34 @@ def test_the_report_prints_no_negative_zero(data_dir):
     foot = report.feet[0]
     tiny = dataclasses.replace(report, feet=(dataclasses.replace(foot, penetration_mm=-0.001, float_mm=-0.0),))
     assert "-0.00" not in tiny.text() and "| 0.00 | 0.00 |" in tiny.text()
+
+
+REAL_TAKES = real_files("*/*.amc") + real_files("*/*.bvh")
+
+
+@pytest.mark.parametrize("path", REAL_TAKES, ids=ids(REAL_TAKES))
+def test_legs_placed_by_the_takes_kinematics_are_those_of_their_angles(path):
+    """leg_arrays from the take's kinematics (the check's: mtcore.footskate.placed_legs) puts the
+    hips and every leg point where leg_points of the legs' angles does, to rounding, on every
+    rig; what the cleanup reads besides (angles, parents, chains, columns) is worked out, when
+    read, as the legs' own kinematics give it."""
+    view = body_view(mt.read_take(path)).motion
+    try:
+        legs = resolve_legs(view.skeleton)
+    except ValueError as e:
+        pytest.skip(f"no legs: {e}")
+    kinematics = world_kinematics(view.values, view.skeleton.tree, turned=sorted({*legs.rotators[:, 2], *legs.parents}))
+    placed, worked = leg_arrays(view, legs, kinematics=kinematics), leg_arrays(view, legs)
+    derived_heels = bool(np.isnan(legs.segments[:, 3]).any())  # worked out from the take's angles
+    assert ("angles" in vars(placed)) == derived_heels  # else placed without reading them
+    scale = float(np.nanmax(np.abs(worked.points)))
+    for name in ("points", "hips", "parents", "angles"):
+        got, want = getattr(placed, name), getattr(worked, name)
+        assert got.shape == want.shape and np.array_equal(np.isnan(got), np.isnan(want)), name
+        np.testing.assert_allclose(
+            got, want, rtol=0, atol=1e-12 * (1.0 if name in ("parents", "angles") else scale), err_msg=name
+        )
+    np.testing.assert_array_equal(placed.columns, worked.columns)
+    for mine, theirs in zip(placed.chains, worked.chains):
+        for field in ("axis", "axes", "segments"):
+            np.testing.assert_array_equal(getattr(mine, field), getattr(theirs, field))

@@ -42,6 +42,7 @@ __all__ = [
     "cleanup",
     "fit_floor",
     "leg_points",
+    "placed_legs",
     "plan_leg",
     "plant_masks",
     "point_speeds",
@@ -308,6 +309,32 @@ def leg_points(chains, hips, parents, angles, *, feet: bool = False):
         "mt_leg_points",
     )
     return (out, rotations) if feet else out
+
+
+def placed_legs(positions, world, at, heels) -> tuple[np.ndarray, np.ndarray]:
+    """The hips (legs, frames, 3) and points (legs, frames, 5, 3, as :func:`leg_points` gives
+    them) of legs placed by forward kinematics: ``positions`` (frames, joints, 3) and ``world``
+    (frames, kept, 3, 3) as :func:`mtcore.kinematics.world_kinematics` gives them; ``at`` (legs,
+    6) the joints at each leg's hip, knee, ankle, ball and toe tip (-1: no tip, the ball's place)
+    and the row of ``world`` that turns the foot; ``heels`` (legs, 3) the heel from the ankle in
+    the foot's frame.  The same points as :func:`leg_points` of the legs' angles, without
+    working out the legs again (``mt_placed_legs``)."""
+    p = _checks.real(positions, "positions", ("frames", None, 3))
+    frames, joints = p.shape[:2]
+    w = _checks.real(world, "world", (frames, None, 3, 3))
+    where = _checks.integers(at, "at", (None, 6), -1, max(joints, w.shape[1]))
+    legs = len(where)
+    h = _checks.real(heels, "heels", (legs, 3))
+    hips, points = np.empty((legs, frames, 3)), np.empty((legs, frames, 5, 3))
+    status = lib.mt_placed_legs(c_array(p), frames, joints, c_array(w), w.shape[1], legs,
+                                c_array(where, "long long[]"), c_array(h), c_array(hips), c_array(points))  # fmt: skip
+    if status == lib.MT_EINVAL:  # the kernel checks each leg's joints and row
+        raise ValueError(
+            f"at must name joints 0 .. {joints - 1} (the tip -1 where there is none) and world rows "
+            f"0 .. {w.shape[1] - 1}, got {where.tolist()}"
+        )
+    check(status, "mt_placed_legs")
+    return hips, points
 
 
 def _clearance(clearance) -> np.ndarray:

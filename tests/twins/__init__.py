@@ -739,6 +739,18 @@ def leg_points_cases(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
+def placed_cases(rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for legs, frames, joints, kept in ((1, 0, 5, 1), (1, 1, 5, 1), (2, 7, 9, 3), (2, 33, 31, 4)):
+        positions = rng.normal(size=(frames, joints, 3)) * 50
+        world = rotations.matrices(rng.uniform(-3, 3, (frames, kept, 3)), "zyx")
+        at = rng.integers(0, joints, (legs, 6))
+        at[:, 5] = rng.integers(0, kept, legs)
+        at[0, 4] = -1  # no toe tip
+        out.append((positions, world, at, rng.normal(size=(legs, 3)) * 5))
+    return out
+
+
 def plan_cases(rng: np.random.Generator) -> list[tuple]:
     return [
         (chain, w["angles"], w["points"], w["planted"], w["targets"], w["clearance"], w["options"])
@@ -1013,6 +1025,7 @@ TWINS: dict[str, Twin] = {
         leg_points_cases,
         close(1e-12),
     ),
+    "mt_placed_legs": Twin(fs.placed_legs, footskate.placed_legs, placed_cases, close(1e-12)),
     # the plan's goals and turns and the solved rotations to 1e-9 and 1e-6: acos and asin near 1
     # (a knee almost straight, a toe just touching the floor) take square roots of rounding
     "mt_footskate_plan": Twin(fast_plan, footskate.plan_leg, plan_cases, close(1e-9)),

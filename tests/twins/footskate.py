@@ -217,6 +217,18 @@ def leg_points(chains, hips, parents, angles, *, feet=False):
     return (points, np.stack([leg[1] for leg in legs])) if feet else points
 
 
+def placed_legs(positions, world, at, heels):
+    """The hips and points of legs from the joints' positions and the feet's world rotations."""
+    at = np.asarray(at)
+    hips = np.stack([positions[:, a[0]] for a in at]) if len(at) else np.zeros((0, len(positions), 3))
+    points = np.zeros((len(at), len(positions), 5, 3))
+    for i, (hip, knee, ankle, ball, tip, row) in enumerate(at.tolist()):
+        points[i, :, 0], points[i, :, 1], points[i, :, 2] = positions[:, knee], positions[:, ankle], positions[:, ball]
+        points[i, :, 3] = positions[:, ankle] + np.einsum("fij,j->fi", world[:, row], heels[i])
+        points[i, :, 4] = positions[:, tip if tip >= 0 else ball]
+    return hips, points
+
+
 def height(p, options: CleanupOptions):
     return p @ (np.asarray(options.up) - np.asarray(options.slope)) - options.level
 

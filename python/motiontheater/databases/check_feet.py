@@ -74,9 +74,11 @@ beyond the frames it fixes, so that the adjustments fade within it."""
 
 def turned_joints(skeleton: Skeleton) -> list[int]:
     """The joints whose world rotations :func:`leg_findings` reads from the take's kinematics: the
-    legs' parents (none where the check finds no legs)."""
+    ankles', which turn the heels, and the legs' parents, which turn the legs of a take whose
+    heels it derives (none where the check finds no legs)."""
     try:
-        return [int(j) for j in resolve_legs(skeleton).parents]
+        legs = resolve_legs(skeleton)
+        return [int(j) for j in (*legs.rotators[:, 2], *legs.parents)]
     except ValueError:
         return []
 

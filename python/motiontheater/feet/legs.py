@@ -45,13 +45,13 @@ from __future__ import annotations
 import itertools
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import InitVar, dataclass
 from functools import cached_property
 
 import numpy as np
 
 from mtcore import footskate as kernels
-from mtcore.kinematics import JointTree, Kinematics, forward_kinematics
+from mtcore.kinematics import Kinematics, forward_kinematics
 
 from ..model.errors import UnknownNameError
 from ..model.motion import Motion
@@ -383,21 +383,48 @@ def body_scale(legs: Legs, meters_per_unit: float) -> float:
 
 @dataclass(frozen=True, eq=False)
 class LegArrays:
-    """A motion's legs as arrays for the kernels of :mod:`mtcore.footskate` (see there for shapes).
-
-    ``angles`` are radians; ``columns`` (legs, 4, 3) are the columns of
-    ``motion.values`` they come from (-1 unused), in the order they apply;
-    ``points`` (legs, frames, 5, 3): knee, ankle, ball, heel, toe tip.
-    """
+    """A motion's legs as arrays for the kernels of :mod:`mtcore.footskate` (see there for shapes):
+    ``points`` (legs, frames, 5, 3), knee, ankle, ball, heel and toe tip, and ``hips`` (legs,
+    frames, 3).  What the cleanup needs besides is worked out from ``motion`` when first read
+    (the check reads the points alone), where the maker did not have it (``given``): the legs'
+    ``chains``, the ``angles`` (radians) of the channels ``columns`` (legs, 4, 3) of
+    ``motion.values`` (-1 unused), in the order they apply, and the world rotations of the hips'
+    ``parents`` (legs, frames, 3, 3)."""
 
     legs: Legs
-    chains: tuple
+    motion: Motion
     hips: np.ndarray
-    parents: np.ndarray
-    angles: np.ndarray
-    columns: np.ndarray
     points: np.ndarray
-    angle_scale: float
+    given: InitVar[dict[str, object] | None] = None
+
+    def __post_init__(self, given: dict[str, object] | None) -> None:
+        for name, value in (given or {}).items():  # what the properties below would work out again
+            object.__setattr__(self, name, value)
+
+    @property
+    def angle_scale(self) -> float:
+        """Radians per unit of the motion's angles."""
+        return self.motion.skeleton.tree.angle_scale
+
+    @cached_property
+    def chains(self) -> tuple:
+        """Each leg's :class:`mtcore.footskate.LegChain`."""
+        return _chains(self.motion.skeleton, self.legs)
+
+    @cached_property
+    def columns(self) -> np.ndarray:
+        """The columns of the legs' rotation channels (legs, 4, 3; -1 unused)."""
+        return _leg_channels(self.motion.skeleton, self.legs)[0]
+
+    @cached_property
+    def angles(self) -> np.ndarray:
+        """The legs' rotation channels over the frames in radians (legs, frames, 4, 3)."""
+        return _leg_angles(self.motion, self.legs)
+
+    @cached_property
+    def parents(self) -> np.ndarray:
+        """The world rotations of the hips' parents (legs, frames, 3, 3)."""
+        return _upper_kinematics(self.motion.values, self.motion.skeleton, self.legs)[1]
 
 
 _CHUNK = 16384  # frames of forward kinematics at a time: the joints' rotations stay in cache, not in memory
@@ -429,22 +456,52 @@ def _upper_kinematics(
     return hips, parents
 
 
-def _leg_channels(tree: JointTree, legs: Legs) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+def _leg_channels(skeleton: Skeleton, legs: Legs) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
     """The legs' rotation channels: their columns (legs, 4, 3) in the order they apply (-1
-    unused), their axes (0 x, 1 y, 2 z; -1 unused) and each leg's joints' axis frames (4, 3, 3)."""
-    n = len(legs)
-    columns = np.full((n, 4, 3), -1, np.int64)
-    axes = np.full((n, 4, 3), -1, np.intc)
-    for i in range(n):
-        for r, j in enumerate(legs.rotators[i]):
-            if j < 0:
-                continue
-            a, b = tree.dof_start[j], tree.dof_start[j + 1]
-            rot = [(k, c) for k, c in zip(tree.dof_kind[a:b], tree.dof_column[a:b]) if k <= 2]
-            for m, (k, c) in enumerate(rot):
-                axes[i, r, m], columns[i, r, m] = k, c
-    frames_axis = [np.stack([tree.axis[j] if j >= 0 else np.eye(3) for j in legs.rotators[i]]) for i in range(n)]
-    return columns, axes, frames_axis
+    unused), their axes (0 x, 1 y, 2 z; -1 unused) and each leg's joints' axis frames (4, 3, 3);
+    worked out once per skeleton."""
+
+    def made() -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+        tree, n = skeleton.tree, len(legs)
+        columns = np.full((n, 4, 3), -1, np.int64)
+        axes = np.full((n, 4, 3), -1, np.intc)
+        for i in range(n):
+            for r, j in enumerate(legs.rotators[i]):
+                if j < 0:
+                    continue
+                a, b = tree.dof_start[j], tree.dof_start[j + 1]
+                rot = [(k, c) for k, c in zip(tree.dof_kind[a:b], tree.dof_column[a:b]) if k <= 2]
+                for m, (k, c) in enumerate(rot):
+                    axes[i, r, m], columns[i, r, m] = k, c
+        frames_axis = [np.stack([tree.axis[j] if j >= 0 else np.eye(3) for j in legs.rotators[i]]) for i in range(n)]
+        return columns, axes, frames_axis
+
+    return skeleton.derived(("leg channels", legs.rotators.tobytes()), made)
+
+
+def _chains(skeleton: Skeleton, legs: Legs, segments: np.ndarray | None = None) -> tuple:
+    """The legs' chains for the kernels, of ``segments`` (default the legs' own, the rest pose's:
+    worked out once per skeleton)."""
+    _, axes, frames_axis = _leg_channels(skeleton, legs)
+
+    def made(segments: np.ndarray) -> tuple:
+        return tuple(
+            kernels.LegChain(axis=frames_axis[i], axes=axes[i], segments=segments[i]) for i in range(len(legs))
+        )
+
+    if segments is not None:
+        return made(segments)
+    return skeleton.derived(("leg chains", legs.segments.tobytes()), lambda: made(legs.segments))
+
+
+def _leg_angles(motion: Motion, legs: Legs) -> np.ndarray:
+    """The legs' rotation channels over the frames, in radians (legs, frames, 4, 3; 0 unused)."""
+    columns = _leg_channels(motion.skeleton, legs)[0]
+    used = columns >= 0
+    gathered = np.take(motion.values, np.where(used, columns, 0).ravel(), axis=1)  # (frames, legs * 4 * 3)
+    gathered *= motion.skeleton.tree.angle_scale
+    gathered[:, ~used.ravel()] = 0.0
+    return np.ascontiguousarray(gathered.reshape(len(gathered), len(legs), 4, 3).transpose(1, 0, 2, 3))
 
 
 def leg_arrays(
@@ -455,43 +512,47 @@ def leg_arrays(
     meters_per_unit: float | None = None,
     kinematics: Kinematics | None = None,
 ) -> LegArrays:
-    """The legs of a motion as arrays: forward kinematics of the joints above the legs (in C;
-    ``kinematics``, the motion's, where the caller has them), the legs' channels as angles, and
-    the legs' points by ``leg_points``.  Heels the rest pose could not give are derived from this
-    take (see the module docstring), along ``up`` (:func:`choose_up`), with thresholds in metres
-    by ``meters_per_unit`` (default the skeleton's)."""
+    """The legs of a motion as arrays: their points from ``kinematics`` (the motion's, where the
+    caller has them with the feet's world rotations: :func:`mtcore.footskate.placed_legs`), else
+    by forward kinematics of the joints above the legs (in C) and ``leg_points`` of the legs'
+    angles.  Heels the rest pose could not give are derived from this take (see the module
+    docstring), along ``up`` (:func:`choose_up`), with thresholds in metres by
+    ``meters_per_unit`` (default the skeleton's)."""
     skeleton = motion.skeleton
-    tree = skeleton.tree
-    hips, parents = _upper_kinematics(motion.values, skeleton, legs, kinematics)
-    n = len(legs)
-    columns, axes, frames_axis = skeleton.derived(
-        ("leg channels", legs.rotators.tobytes()), lambda: _leg_channels(tree, legs)
-    )
-    used = columns >= 0
-    gathered = np.take(motion.values, np.where(used, columns, 0).ravel(), axis=1)  # (frames, legs * 4 * 3)
-    gathered *= tree.angle_scale
-    gathered[:, ~used.ravel()] = 0.0
-    angles = np.ascontiguousarray(gathered.reshape(len(gathered), n, 4, 3).transpose(1, 0, 2, 3))
-
-    def chains_of(segments: np.ndarray) -> tuple:
-        return tuple(kernels.LegChain(axis=frames_axis[i], axes=axes[i], segments=segments[i]) for i in range(n))
-
     missing = np.isnan(legs.segments[:, 3]).any(axis=1)
+    placed = None if missing.any() or kinematics is None else _placed(legs, kinematics)
+    if placed is not None:
+        return LegArrays(legs, motion, *placed)
+    hips, parents = _upper_kinematics(motion.values, skeleton, legs, kinematics)
+    angles = _leg_angles(motion, legs)
+    columns = _leg_channels(skeleton, legs)[0]
     if missing.any():
         segments = legs.segments.copy()
         segments[missing, 3] = 0.0
-        points, feet = kernels.leg_points(chains_of(segments), hips, parents, angles, feet=True)
-        partial = LegArrays(legs, chains_of(segments), hips, parents, angles, columns, points, tree.angle_scale)
+        chains = _chains(skeleton, legs, segments)
+        points, feet = kernels.leg_points(chains, hips, parents, angles, feet=True)
+        partial = LegArrays(legs, motion, hips, points)
         mpu = skeleton.meters_per_unit if meters_per_unit is None else meters_per_unit
         direction = choose_up(partial, up)
         for i in map(int, np.flatnonzero(missing)):
             segments[i, 3] = _heel_from_take(points[i], feet[i], direction, motion.frame_rate, mpu, legs, i)
         legs = Legs(legs.skeleton, legs.legs, legs.rotators, legs.points, segments, legs.parents)
-        chains = chains_of(legs.segments)
-    else:  # the rest pose's: the same on every take of the skeleton
-        chains = skeleton.derived(("leg chains", legs.segments.tobytes()), lambda: chains_of(legs.segments))
+        chains = _chains(skeleton, legs, legs.segments)  # the take's own heels: not kept with the skeleton
+    else:
+        chains = _chains(skeleton, legs)
     points = kernels.leg_points(chains, hips, parents, angles)
-    return LegArrays(legs, chains, hips, parents, angles, columns, points, tree.angle_scale)
+    return LegArrays(legs, motion, hips, points, dict(chains=chains, parents=parents, angles=angles, columns=columns))
+
+
+def _placed(legs: Legs, kinematics: Kinematics) -> tuple[np.ndarray, np.ndarray] | None:
+    """The hips and points of the legs from the take's kinematics, or None where they do not hold
+    the feet's world rotations."""
+    try:
+        feet = kinematics.rows(legs.rotators[:, 2])
+    except ValueError:
+        return None
+    at = np.column_stack([legs.points[:, :5], feet])  # hip, knee, ankle, ball and tip; the foot's row
+    return kernels.placed_legs(kinematics.positions, kinematics.world, at, legs.segments[:, 3])
 
 
 _FLAT_SPEED = 0.2  # m/s: ankle and ball slower than this (at the reference size) in flat stance
