@@ -20,7 +20,7 @@ from motiontheater import Pipeline
 from motiontheater.databases import batch, survey
 
 COPIES = 10
-ROUNDS = 3
+ROUNDS = 5
 
 
 @pytest.fixture(scope="module")
