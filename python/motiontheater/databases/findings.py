@@ -8,6 +8,7 @@ from typing import Any
 
 SEVERITIES = ("low", "medium", "high")
 """From a note worth knowing to a problem that spoils the take."""
+_RANKS = {severity: rank for rank, severity in enumerate(SEVERITIES)}
 
 KINDS = {
     "spike": "a joint's rotation or position far outside its neighbours for a few frames",
@@ -61,13 +62,13 @@ class Finding:
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise ValueError(f"unknown kind of finding {self.kind!r}; one of {', '.join(KINDS)}")
-        if self.severity not in SEVERITIES:
+        if self.severity not in _RANKS:
             raise ValueError(f"severity must be one of {SEVERITIES}, got {self.severity!r}")
 
     @property
     def rank(self) -> int:
         """0 for low .. 2 for high: the order a report sorts by."""
-        return SEVERITIES.index(self.severity)
+        return _RANKS[self.severity]
 
     def as_dict(self) -> dict[str, Any]:
         """The finding as JSON holds it: every field, ``joints`` a list, ``fix`` the step names."""

@@ -65,6 +65,8 @@ def check_frames(template: Motion, blocks: Iterable[np.ndarray], check: Check) -
 
 def _joined(pieces: list[list[Finding]], rate: float) -> list[Finding]:
     """The pieces' findings, each that goes on in the next piece joined to its continuation."""
+    if len(pieces) == 1:  # nearly every take: nothing to join
+        return pieces[0]
     out: list[Finding] = []
     open_: dict[tuple[str, tuple[str, ...]], int] = {}  # (kind, joints) -> index in out of the last piece's
     for found in pieces:
