@@ -74,11 +74,12 @@ beyond the frames it fixes, so that the adjustments fade within it."""
 
 def turned_joints(skeleton: Skeleton) -> list[int]:
     """The joints whose world rotations :func:`leg_findings` reads from the take's kinematics: the
-    ankles', which turn the heels, and the legs' parents, which turn the legs of a take whose
-    heels it derives (none where the check finds no legs)."""
+    ankles', which turn the heels, and where the rest pose gives no heel, the legs' parents, which
+    turn the legs the heels are derived from (none where the check finds no legs)."""
     try:
         legs = resolve_legs(skeleton)
-        return [int(j) for j in (*legs.rotators[:, 2], *legs.parents)]
+        derived = np.isnan(legs.segments[:, 3]).any()
+        return [int(j) for j in (*legs.rotators[:, 2], *(legs.parents if derived else ()))]
     except ValueError:
         return []
 
