@@ -122,7 +122,7 @@ static size_t mirrored(ptrdiff_t i, size_t rows)
 static MT_CLONES int row_pass(const double *restrict x, const double *restrict before, const double *restrict after,
                               const double *restrict earlier, size_t channels, int interior, int has_before,
                               int has_after, const double *restrict spike_limit, const double *restrict step_limit,
-                              double *restrict roughness, size_t *restrict smooth_rows, unsigned char *restrict quiet)
+                              double *restrict roughness, size_t *restrict smooth_rows, size_t *restrict quiet)
 {
     int same = 1;
     for (size_t k = 0; k < channels; k++) {
@@ -135,7 +135,7 @@ static MT_CLONES int row_pass(const double *restrict x, const double *restrict b
         const double change = v - b;
         const int step = (has_before || has_after) && (!has_before || fabs(change - (b - earlier[k])) > lim) &&
                          (!has_after || fabs(change - (a - v)) > lim);
-        quiet[k] = (unsigned char)(v != b && fabs(v - b) <= limit && fabs(v - a) <= limit && !step);
+        quiet[k] = (size_t)(v != b && fabs(v - b) <= limit && fabs(v - a) <= limit && !step);
     }
     return same;
 }
@@ -156,13 +156,16 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
     if (channels == 0)
         return MT_OK;
     struct open *open = calloc(channels * OPEN_KINDS, sizeof *open);
-    unsigned char *flags = calloc(2 * channels, 1); /* quiet in this row; an event open */
+    /* quiet in this row (as wide as the values, so that row_pass's loop runs 8 lanes of doubles
+       and not 32 of bytes, whose remainder of a take's 62 channels runs one at a time); an event
+       open */
+    size_t *flags = calloc(2 * channels, sizeof *flags);
     if (open == NULL || flags == NULL) {
         free(open);
         free(flags);
         return MT_ENOMEM;
     }
-    unsigned char *quiet = flags, *busy = flags + channels;
+    size_t *quiet = flags, *busy = flags + channels;
     struct sink sink = {.events = events, .sizes = sizes, .capacity = capacity};
     struct open repeat = {0};
     for (size_t k = 0; k < channels; k++) {
@@ -181,6 +184,14 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
                 continue;
             struct open *o = open + k * OPEN_KINDS;
             const double x = row[k];
+            /* a value held on into the next row, with nothing else open: its run only grows (a
+               channel that never moves comes here every row; no spike or step is told in a row
+               whose neighbours equal it) */
+            if (o[FROZEN].active && !o[GAP].active && !o[SPIKE].active && !o[STEP].active && t + 1 < rows &&
+                x == before[k] && x == after[k]) {
+                o[FROZEN].last = t;
+                continue;
+            }
             if (x != x) {
                 extend(&o[GAP], t, 0.0);
                 close_frozen(&o[FROZEN], &sink, k, min_run, begin, end);
@@ -234,7 +245,7 @@ int mt_check_channels(const double *values, size_t rows, size_t channels, size_t
                 extend(&o[STEP], t, jump);
             else
                 close_event(&o[STEP], &sink, k, MT_CHECK_STEP);
-            busy[k] = (unsigned char)(o[GAP].active | o[FROZEN].active | o[SPIKE].active | o[STEP].active);
+            busy[k] = (size_t)(o[GAP].active | o[FROZEN].active | o[SPIKE].active | o[STEP].active);
         }
         if (same_row)
             extend(&repeat, t, 0.0);
