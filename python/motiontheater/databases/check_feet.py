@@ -78,8 +78,7 @@ def turned_joints(skeleton: Skeleton) -> list[int]:
     turn the legs the heels are derived from (none where the check finds no legs)."""
     try:
         legs = resolve_legs(skeleton)
-        derived = np.isnan(legs.segments[:, 3]).any()
-        return [int(j) for j in (*legs.rotators[:, 2], *(legs.parents if derived else ()))]
+        return [int(j) for j in (*legs.rotators[:, 2], *(legs.parents if legs.heels_missing.any() else ()))]
     except ValueError:
         return []
 

@@ -143,9 +143,9 @@ def _require_finite_legs(motion: Motion, legs: Legs) -> None:
     legs' and the joints' between them) as a number: a take of NaN has no feet to plant."""
     skeleton = motion.skeleton
     columns = skeleton.derived(("leg columns", legs.rotators.tobytes()), lambda: _placing_columns(motion, legs))
-    values = motion.values[:, columns]
-    # nearly every take's first frame is whole: no need to look at the others
-    if len(values) and not (np.isfinite(values[0]).all() or np.isfinite(values).all(axis=1).any()):
+    values = motion.values
+    # nearly every take's first frame is whole: no need to look at (or gather) the others
+    if len(values) and not (np.isfinite(values[0, columns]).all() or np.isfinite(values[:, columns]).all(axis=1).any()):
         raise ValueError(
             "no frame holds the legs as numbers (their channels are NaN or inf in every frame): there are "
             "no feet to measure or plant; fill the gaps first (the fill_gaps step)"

@@ -122,6 +122,11 @@ class Legs:
         """Every joint the legs turn."""
         return tuple(name for leg in self.legs for name in leg.joints)
 
+    @property
+    def heels_missing(self) -> np.ndarray:
+        """Which legs' heels the rest pose does not give (NaN segments: derived from a take)."""
+        return np.isnan(self.segments[:, 3]).any(axis=1)
+
     @cached_property
     def _length(self) -> float:
         return float(np.mean(np.linalg.norm(self.segments[:, :2], axis=-1).sum(axis=1)))
@@ -519,7 +524,7 @@ def leg_arrays(
     docstring), along ``up`` (:func:`choose_up`), with thresholds in metres by
     ``meters_per_unit`` (default the skeleton's)."""
     skeleton = motion.skeleton
-    missing = np.isnan(legs.segments[:, 3]).any(axis=1)
+    missing = legs.heels_missing
     placed = None if missing.any() or kinematics is None else _placed(legs, kinematics)
     if placed is not None:
         return LegArrays(legs, motion, *placed)
